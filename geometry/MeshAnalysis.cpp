@@ -1,0 +1,270 @@
+#include "geometry/MeshAnalysis.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <numeric>
+#include <queue>
+
+namespace rotafab::geometry {
+namespace {
+
+class DisjointSets {
+ public:
+  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
+  int find(int x) {
+    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+
+ private:
+  std::vector<int> parent_;
+};
+
+// One side of an edge: face `face` runs from `from` to `to` at corner `corner`
+// (the corner of `from`; corners are numbered over all faces in order).
+struct EdgeUse {
+  int low, high;  // the edge's endpoints, low < high
+  int face;
+  int corner;
+  bool forward;  // from == low
+};
+
+}  // namespace
+
+MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
+  MeshAnalysis analysis;
+  MeshTopology& topology = analysis.topology;
+  topology.vertices = mesh.vertexCount();
+  topology.faces = mesh.faceCount();
+  const double diagonal = boundingBoxDiagonal(mesh);
+
+  std::vector<int> firstCorner(mesh.faces.size() + 1, 0);
+  for (size_t f = 0; f < mesh.faces.size(); ++f)
+    firstCorner[f + 1] = firstCorner[f] + static_cast<int>(mesh.faces[f].size());
+  const int cornerCount = firstCorner.back();
+
+  std::vector<EdgeUse> uses;
+  uses.reserve(cornerCount);
+  std::vector<char> faceHasRepeat(mesh.faces.size(), 0);
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    const auto& face = mesh.faces[f];
+    std::vector<int> sorted = face;
+    std::sort(sorted.begin(), sorted.end());
+    if (auto repeat = std::adjacent_find(sorted.begin(), sorted.end()); repeat != sorted.end()) {
+      faceHasRepeat[f] = 1;
+      analysis.problems.push_back(
+          {MeshProblemKind::RepeatedCorner, fmt::format("face {} visits vertex {} more than once", f, *repeat)});
+    }
+    if (fanArea(mesh, f) <= 1e-12 * diagonal * diagonal) {
+      analysis.problems.push_back(
+          {MeshProblemKind::ZeroAreaFace,
+           fmt::format("face {} has zero area (its corners {} are collinear)", f, formatIndexList(face))});
+    }
+    for (size_t i = 0; i < face.size(); ++i) {
+      const int from = face[i], to = face[(i + 1) % face.size()];
+      uses.push_back({std::min(from, to), std::max(from, to), f, firstCorner[f] + static_cast<int>(i), from < to});
+    }
+  }
+  std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
+    return std::tie(a.low, a.high, a.face) < std::tie(b.low, b.high, b.face);
+  });
+
+  // Corner of `face` at vertex v, given the corner where the face leaves `from`.
+  auto cornerAt = [&](const EdgeUse& use, int vertex) {
+    const int from = use.forward ? use.low : use.high;
+    if (vertex == from) return use.corner;
+    const int size = static_cast<int>(mesh.faces[use.face].size());
+    const int local = use.corner - firstCorner[use.face];
+    return firstCorner[use.face] + (local + 1) % size;
+  };
+
+  DisjointSets fans(cornerCount);  // corners around a vertex joined across shared edges
+  DisjointSets vertexComponents(mesh.positions.size());
+  DisjointSets boundaryLoops(mesh.positions.size());
+  std::vector<char> onBoundary(mesh.positions.size(), 0), onBadEdge(mesh.positions.size(), 0);
+  // Faces joined by a two-sided edge, and whether their orientations agree there.
+  struct Adjacency {
+    int face, neighbour;
+    bool agree;
+    int low, high;
+  };
+  std::vector<std::vector<Adjacency>> adjacency(mesh.faces.size());
+  for (size_t begin = 0; begin < uses.size();) {
+    size_t end = begin;
+    while (end < uses.size() && uses[end].low == uses[begin].low && uses[end].high == uses[begin].high) ++end;
+    const EdgeUse& first = uses[begin];
+    ++topology.edges;
+    vertexComponents.unite(first.low, first.high);
+    const size_t count = end - begin;
+    if (count == 1) {
+      onBoundary[first.low] = onBoundary[first.high] = 1;
+      boundaryLoops.unite(first.low, first.high);
+    } else if (count == 2 && uses[begin].face != uses[begin + 1].face) {
+      const EdgeUse& second = uses[begin + 1];
+      for (int v : {first.low, first.high}) fans.unite(cornerAt(first, v), cornerAt(second, v));
+      const bool agree = first.forward != second.forward;
+      adjacency[first.face].push_back({first.face, second.face, agree, first.low, first.high});
+      adjacency[second.face].push_back({second.face, first.face, agree, first.low, first.high});
+    } else if (count > 2) {
+      std::vector<int> faces;
+      for (size_t i = begin; i < end; ++i) faces.push_back(uses[i].face);
+      analysis.problems.push_back(
+          {MeshProblemKind::NonManifoldEdge, fmt::format("edge ({}, {}) is shared by {} faces {}", first.low,
+                                                         first.high, count, formatIndexList(faces))});
+      onBadEdge[first.low] = onBadEdge[first.high] = 1;
+    }
+    begin = end;
+  }
+
+  // Bow-tie vertices: the faces around a vertex must form a single fan.
+  {
+    std::vector<int> fanCount(mesh.positions.size(), 0);
+    std::vector<int> seenRoot(cornerCount, 0);
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      if (faceHasRepeat[f]) continue;
+      for (size_t i = 0; i < mesh.faces[f].size(); ++i) {
+        const int corner = firstCorner[f] + static_cast<int>(i);
+        const int root = fans.find(corner);
+        if (!seenRoot[root]) {
+          seenRoot[root] = 1;
+          ++fanCount[mesh.faces[f][i]];
+        }
+      }
+    }
+    for (int v = 0; v < mesh.vertexCount(); ++v) {
+      if (fanCount[v] > 1 && !onBadEdge[v]) {
+        analysis.problems.push_back(
+            {MeshProblemKind::BowTieVertex, fmt::format("vertex {} at {} is a bow-tie: its faces form {} separate fans",
+                                                        v, formatPoint(mesh.positions[v]), fanCount[v])});
+      }
+    }
+  }
+  topology.manifold = std::none_of(analysis.problems.begin(), analysis.problems.end(), [](const MeshProblem& p) {
+    return p.kind == MeshProblemKind::NonManifoldEdge || p.kind == MeshProblemKind::BowTieVertex ||
+           p.kind == MeshProblemKind::RepeatedCorner;
+  });
+
+  // Orientation: breadth-first over faces; a neighbour across an edge both
+  // faces run the same way must be flipped relative to its parent.
+  std::vector<int> flip(mesh.faces.size(), -1);
+  std::vector<int> faceComponent(mesh.faces.size(), -1);
+  topology.orientable = true;
+  int componentCount = 0;
+  for (int start = 0; start < mesh.faceCount(); ++start) {
+    if (flip[start] >= 0) continue;
+    const int component = componentCount++;
+    std::vector<int> members{start};
+    flip[start] = 0;
+    faceComponent[start] = component;
+    bool conflictReported = false;
+    for (size_t next = 0; next < members.size(); ++next) {
+      const int f = members[next];
+      for (const Adjacency& a : adjacency[f]) {
+        const int wanted = a.agree ? flip[f] : 1 - flip[f];
+        if (flip[a.neighbour] < 0) {
+          flip[a.neighbour] = wanted;
+          faceComponent[a.neighbour] = component;
+          members.push_back(a.neighbour);
+        } else if (flip[a.neighbour] != wanted && !conflictReported) {
+          conflictReported = true;
+          topology.orientable = false;
+          analysis.problems.push_back(
+              {MeshProblemKind::NonOrientable,
+               fmt::format("the surface is not orientable (a Moebius-like band): faces {} and {} cannot be oriented "
+                           "consistently across edge ({}, {})",
+                           f, a.neighbour, a.low, a.high)});
+        }
+      }
+    }
+    if (conflictReported) {
+      for (int f : members) flip[f] = 0;  // leave a non-orientable piece as it came
+      continue;
+    }
+    // Keep the orientation most faces already have.
+    const auto flipped = std::count_if(members.begin(), members.end(), [&](int f) { return flip[f] == 1; });
+    if (2 * flipped > static_cast<long>(members.size()))
+      for (int f : members) flip[f] = 1 - flip[f];
+  }
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (flip[f] == 1) {
+      std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
+      ++analysis.flippedFaces;
+    }
+  }
+  // A closed orientable component faces outwards: its enclosed volume is positive.
+  int reversedComponents = 0;
+  if (topology.manifold && topology.orientable) {
+    std::vector<double> volume(componentCount, 0.0);
+    std::vector<char> closed(componentCount, 1);
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      const auto& face = mesh.faces[f];
+      for (int v : face)
+        if (onBoundary[v]) closed[faceComponent[f]] = 0;
+      const Point3& p0 = mesh.positions[face[0]];
+      for (size_t i = 1; i + 1 < face.size(); ++i) {
+        volume[faceComponent[f]] += p0.dot(mesh.positions[face[i]].cross(mesh.positions[face[i + 1]])) / 6.0;
+      }
+    }
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      if (closed[faceComponent[f]] && volume[faceComponent[f]] < 0.0) {
+        std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
+      }
+    }
+    for (int c = 0; c < componentCount; ++c) reversedComponents += closed[c] && volume[c] < 0.0;
+  }
+  if (analysis.flippedFaces > 0) {
+    analysis.notes.push_back(fmt::format("flipped {} face{} to make the orientation consistent", analysis.flippedFaces,
+                                         analysis.flippedFaces == 1 ? "" : "s"));
+  }
+  if (reversedComponents > 0) {
+    analysis.notes.push_back(fmt::format("reversed all faces of {} closed component{} so that they face outwards",
+                                         reversedComponents, reversedComponents == 1 ? "" : "s"));
+  }
+
+  // Counts per connected component (through shared vertices).
+  for (const auto& face : mesh.faces)
+    for (size_t i = 1; i < face.size(); ++i) vertexComponents.unite(face[0], face[i]);
+  std::vector<int> componentOf(mesh.positions.size());
+  std::vector<int> componentIndex(mesh.positions.size(), -1);
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    const int root = vertexComponents.find(v);
+    if (componentIndex[root] < 0) componentIndex[root] = topology.components++;
+    componentOf[v] = componentIndex[root];
+  }
+  std::vector<long long> chiPlusLoops(topology.components, 0);  // V - E + F + B per component
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    ++chiPlusLoops[componentOf[v]];
+    if (onBoundary[v] && boundaryLoops.find(v) == v) {
+      ++topology.boundaryLoops;
+      ++chiPlusLoops[componentOf[v]];
+    }
+  }
+  for (size_t begin = 0, end = 0; begin < uses.size(); begin = end) {
+    while (end < uses.size() && uses[end].low == uses[begin].low && uses[end].high == uses[begin].high) ++end;
+    --chiPlusLoops[componentOf[uses[begin].low]];
+  }
+  for (const auto& face : mesh.faces) ++chiPlusLoops[componentOf[face[0]]];
+  topology.euler = topology.vertices - topology.edges + topology.faces;
+  if (topology.manifold && topology.orientable) {
+    long long genus = 0;
+    for (long long chi : chiPlusLoops) genus += (2 - chi) / 2;
+    topology.genus = static_cast<int>(genus);
+  }
+  return analysis;
+}
+
+void requireUsable(const MeshAnalysis& analysis) {
+  if (analysis.usable()) return;
+  const size_t more = analysis.problems.size() - 1;
+  throw InvalidMeshError(more == 0 ? analysis.problems.front().message
+                                   : fmt::format("{} (and {} more problem{}; `rotafab inspect` lists them)",
+                                                 analysis.problems.front().message, more, more == 1 ? "" : "s"));
+}
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,266 @@
+#include "geometry/MeshImport.h"
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <fmt/format.h>
+#include <assimp/Importer.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstring>
+#include <fstream>
+#include <unordered_map>
+
+#include "geometry/MeshReaders.h"
+
+namespace rotafab::geometry {
+namespace {
+
+std::string lowercase(std::string_view text) {
+  std::string lower(text);
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  return lower;
+}
+
+bool startsWithWord(std::string_view line, std::string_view word) {
+  size_t i = line.find_first_not_of(" \t");
+  if (i == std::string_view::npos) return false;
+  line.remove_prefix(i);
+  return line.size() > word.size() && line.substr(0, word.size()) == word &&
+         (line[word.size()] == ' ' || line[word.size()] == '\t');
+}
+
+// The faces a file states, where that can be counted cheaply; Assimp's result
+// is compared with it so that a short read is refused, not passed on.
+struct StatedFaces {
+  long long count = -1;       // -1: unknown
+  bool polygonsOnly = false;  // count only faces with 3 or more corners
+};
+
+StatedFaces statedFaceCount(std::string_view bytes, const std::string& extension) {
+  StatedFaces stated;
+  if (extension == "obj") {
+    // Each `f` line with at least three vertex references is one polygon.
+    stated.count = 0;
+    stated.polygonsOnly = true;
+    size_t position = 0;
+    while (position < bytes.size()) {
+      size_t end = bytes.find('\n', position);
+      if (end == std::string_view::npos) end = bytes.size();
+      std::string_view line = bytes.substr(position, end - position);
+      position = end + 1;
+      if (!startsWithWord(line, "f")) continue;
+      int references = 0;
+      bool inWord = false;
+      for (char c : line.substr(line.find('f') + 1)) {
+        if (c == '#') break;
+        const bool space = c == ' ' || c == '\t' || c == '\r' || c == '\\';
+        if (!space && !inWord) ++references;
+        inWord = !space;
+      }
+      if (references >= 3) ++stated.count;
+    }
+  } else if (extension == "stl") {
+    const bool ascii = bytes.substr(0, 5) == "solid" && bytes.find("facet") != std::string_view::npos;
+    if (!ascii && bytes.size() >= 84) {
+      uint32_t triangles = 0;
+      std::memcpy(&triangles, bytes.data() + 80, 4);
+      stated.count = triangles;
+      if (bytes.size() < 84 + 50ull * triangles) {
+        throw InvalidMeshError(fmt::format("truncated: the binary STL header states {} triangles, the file holds {}",
+                                           triangles, (bytes.size() - 84) / 50));
+      }
+    } else if (ascii) {
+      stated.count = 0;
+      size_t position = 0;
+      while ((position = bytes.find("facet", position)) != std::string_view::npos) {
+        const bool isEndFacet = position >= 3 && bytes.substr(position - 3, 3) == "end";
+        if (!isEndFacet) ++stated.count;
+        position += 5;
+      }
+    }
+  }
+  return stated;
+}
+
+void appendScene(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parentTransform, PolygonMesh& mesh,
+                 long long& polygonCount, long long& faceCount) {
+  const aiMatrix4x4 transform = parentTransform * node.mTransformation;
+  for (unsigned n = 0; n < node.mNumMeshes; ++n) {
+    if (node.mMeshes[n] >= scene.mNumMeshes) continue;
+    const aiMesh& source = *scene.mMeshes[node.mMeshes[n]];
+    const int base = mesh.vertexCount();
+    for (unsigned v = 0; v < source.mNumVertices; ++v) {
+      const aiVector3D p = transform * source.mVertices[v];
+      mesh.positions.emplace_back(p.x, p.y, p.z);
+      if (!mesh.positions.back().allFinite()) {
+        throw InvalidMeshError(fmt::format("vertex {} has a non-finite coordinate {}", mesh.vertexCount() - 1,
+                                           formatPoint(mesh.positions.back())));
+      }
+    }
+    for (unsigned f = 0; f < source.mNumFaces; ++f) {
+      const aiFace& face = source.mFaces[f];
+      ++faceCount;
+      if (face.mNumIndices < 3) continue;  // points and lines are not surface
+      ++polygonCount;
+      std::vector<int> corners;
+      corners.reserve(face.mNumIndices);
+      for (unsigned i = 0; i < face.mNumIndices; ++i) {
+        if (face.mIndices[i] >= source.mNumVertices) {
+          throw InvalidMeshError(fmt::format("face {} refers to vertex {}, but its mesh has {} vertices", faceCount - 1,
+                                             face.mIndices[i], source.mNumVertices));
+        }
+        corners.push_back(base + static_cast<int>(face.mIndices[i]));
+      }
+      mesh.faces.push_back(std::move(corners));
+    }
+  }
+  for (unsigned c = 0; c < node.mNumChildren; ++c) {
+    appendScene(scene, *node.mChildren[c], transform, mesh, polygonCount, faceCount);
+  }
+}
+
+std::string firstLine(const char* text) {
+  std::string line = text ? text : "";
+  if (size_t end = line.find('\n'); end != std::string::npos) line.resize(end);
+  return line.empty() ? "the file could not be read" : line;
+}
+
+PolygonMesh readWithAssimp(std::string_view bytes, const std::string& extension, const std::filesystem::path* path) {
+  const StatedFaces stated = statedFaceCount(bytes, extension);
+  Assimp::Importer importer;
+  // No post-processing: polygons stay polygons; we weld and validate ourselves.
+  const aiScene* scene = path ? importer.ReadFile(path->string(), 0)
+                              : importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, extension.c_str());
+  if (!scene || !scene->mRootNode) throw InvalidMeshError(firstLine(importer.GetErrorString()));
+  PolygonMesh mesh;
+  long long polygons = 0, faces = 0;
+  appendScene(*scene, *scene->mRootNode, aiMatrix4x4(), mesh, polygons, faces);
+  const long long read = stated.polygonsOnly ? polygons : faces;
+  if (stated.count >= 0 && read < stated.count) {
+    throw InvalidMeshError(fmt::format(
+        "only {} of the {} faces in the file could be read (malformed or truncated file)", read, stated.count));
+  }
+  return mesh;
+}
+
+PolygonMesh readAny(std::string_view bytes, const std::string& extension, const std::filesystem::path* path) {
+  if (bytes.empty()) throw InvalidMeshError("the file is empty");
+  if (extension == "off") return readOff(bytes);
+  if (extension == "ply") return readPly(bytes);
+  return readWithAssimp(bytes, extension, path);
+}
+
+ImportedMesh finishImport(PolygonMesh mesh) {
+  ImportedMesh result;
+  const CleaningReport report = cleanMesh(mesh);
+  if (report.droppedFaces > 0 || report.droppedVertices > 0) {
+    result.warnings.push_back(fmt::format(
+        "dropped {} face{} with fewer than 3 distinct vertices and {} unreferenced vertex{}", report.droppedFaces,
+        report.droppedFaces == 1 ? "" : "s", report.droppedVertices, report.droppedVertices == 1 ? "" : "es"));
+  }
+  if (mesh.faces.empty()) throw InvalidMeshError("the file holds no polygon faces");
+  result.mesh = std::move(mesh);
+  return result;
+}
+
+ImportedMesh importBytes(std::string_view bytes, std::string_view extension, std::string_view displayName,
+                         const std::filesystem::path* path) {
+  try {
+    return finishImport(readAny(bytes, lowercase(extension), path));
+  } catch (const InvalidMeshError& error) {
+    throw InvalidMeshError(fmt::format("{}: {}", displayName, error.what()));
+  } catch (const std::bad_alloc&) {
+    throw InvalidMeshError(fmt::format("{}: the mesh does not fit in memory", displayName));
+  } catch (const std::exception& error) {
+    // Assimp throws DeadlyImportError and others on some malformed inputs.
+    throw InvalidMeshError(fmt::format("{}: {}", displayName, firstLine(error.what())));
+  }
+}
+
+}  // namespace
+
+ImportedMesh importMesh(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::error_code error;
+  if (!std::filesystem::exists(path, error)) throw InvalidMeshError(fmt::format("{}: no such file", name));
+  if (std::filesystem::is_directory(path, error))
+    throw InvalidMeshError(fmt::format("{}: is a directory, not a mesh file", name));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InvalidMeshError(fmt::format("{}: cannot open the file: {}", name, std::strerror(errno)));
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw InvalidMeshError(fmt::format("{}: cannot read the file: {}", name, std::strerror(errno)));
+  std::string extension = path.extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  return importBytes(bytes, extension, name, &path);
+}
+
+ImportedMesh importMeshFromMemory(std::string_view bytes, std::string_view extension, std::string_view displayName) {
+  return importBytes(bytes, extension, displayName, nullptr);
+}
+
+CleaningReport cleanMesh(PolygonMesh& mesh) {
+  CleaningReport report;
+  // Weld: every vertex maps to the first vertex at exactly its position.
+  struct PositionHash {
+    size_t operator()(const Point3& p) const {
+      size_t h = 0;
+      for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>{}(p[i] == 0.0 ? 0.0 : p[i]);
+      return h;
+    }
+  };
+  struct PositionEqual {
+    bool operator()(const Point3& a, const Point3& b) const { return a == b; }
+  };
+  std::unordered_map<Point3, int, PositionHash, PositionEqual> firstAt;
+  firstAt.reserve(mesh.positions.size());
+  std::vector<int> weldedTo(mesh.positions.size());
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    Point3 key = mesh.positions[v];
+    for (int i = 0; i < 3; ++i)
+      if (key[i] == 0.0) key[i] = 0.0;  // -0 welds with +0
+    auto [it, inserted] = firstAt.emplace(key, v);
+    weldedTo[v] = it->second;
+    if (!inserted) ++report.weldedVertices;
+  }
+
+  std::vector<std::vector<int>> kept;
+  kept.reserve(mesh.faces.size());
+  std::vector<char> referenced(mesh.positions.size(), 0);
+  for (auto& face : mesh.faces) {
+    std::vector<int> corners;
+    corners.reserve(face.size());
+    for (int v : face) {
+      const int w = weldedTo[v];
+      if (corners.empty() || corners.back() != w) corners.push_back(w);
+    }
+    while (corners.size() > 1 && corners.front() == corners.back()) corners.pop_back();
+    std::vector<int> distinct = corners;
+    std::sort(distinct.begin(), distinct.end());
+    if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3) {
+      ++report.droppedFaces;
+      continue;
+    }
+    for (int v : corners) referenced[v] = 1;
+    kept.push_back(std::move(corners));
+  }
+
+  std::vector<int> newIndex(mesh.positions.size(), -1);
+  std::vector<Point3> positions;
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    if (weldedTo[v] != v) continue;
+    if (!referenced[v]) {
+      ++report.droppedVertices;
+      continue;
+    }
+    newIndex[v] = static_cast<int>(positions.size());
+    positions.push_back(mesh.positions[v]);
+  }
+  for (auto& face : kept)
+    for (int& v : face) v = newIndex[v];
+  mesh.positions = std::move(positions);
+  mesh.faces = std::move(kept);
+  return report;
+}
+
+}  // namespace rotafab::geometry
