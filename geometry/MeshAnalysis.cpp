@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <numeric>
 #include <queue>
+#include <unordered_map>
 
 namespace rotafab::geometry {
 namespace {
@@ -86,7 +87,7 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
 
   DisjointSets fans(cornerCount);  // corners around a vertex joined across shared edges
   DisjointSets vertexComponents(mesh.positions.size());
-  DisjointSets boundaryLoops(mesh.positions.size());
+  std::vector<EdgeUse> boundaryUses;  // the one side of each boundary edge
   std::vector<char> onBoundary(mesh.positions.size(), 0), onBadEdge(mesh.positions.size(), 0);
   // Faces joined by a two-sided edge, and whether their orientations agree there.
   struct Adjacency {
@@ -104,7 +105,7 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     const size_t count = end - begin;
     if (count == 1) {
       onBoundary[first.low] = onBoundary[first.high] = 1;
-      boundaryLoops.unite(first.low, first.high);
+      boundaryUses.push_back(first);
     } else if (count == 2 && uses[begin].face != uses[begin + 1].face) {
       const EdgeUse& second = uses[begin + 1];
       for (int v : {first.low, first.high}) fans.unite(cornerAt(first, v), cornerAt(second, v));
@@ -113,11 +114,17 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
       adjacency[second.face].push_back({second.face, first.face, agree, first.low, first.high});
     } else if (count > 2) {
       std::vector<int> faces;
-      for (size_t i = begin; i < end; ++i) faces.push_back(uses[i].face);
-      analysis.problems.push_back(
-          {MeshProblemKind::NonManifoldEdge, fmt::format("edge ({}, {}) is shared by {} faces {}", first.low,
-                                                         first.high, count, formatIndexList(faces))});
+      bool explainedByRepeat = false;  // a face running the edge twice is reported as such
+      for (size_t i = begin; i < end; ++i) {
+        faces.push_back(uses[i].face);
+        explainedByRepeat = explainedByRepeat || faceHasRepeat[uses[i].face];
+      }
       onBadEdge[first.low] = onBadEdge[first.high] = 1;
+      if (!explainedByRepeat) {
+        analysis.problems.push_back(
+            {MeshProblemKind::NonManifoldEdge, fmt::format("edge ({}, {}) is shared by {} faces {}", first.low,
+                                                           first.high, count, formatIndexList(faces))});
+      }
     }
     begin = end;
   }
@@ -238,11 +245,23 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     componentOf[v] = componentIndex[root];
   }
   std::vector<long long> chiPlusLoops(topology.components, 0);  // V - E + F + B per component
-  for (int v = 0; v < mesh.vertexCount(); ++v) {
-    ++chiPlusLoops[componentOf[v]];
-    if (onBoundary[v] && boundaryLoops.find(v) == v) {
+  for (int v = 0; v < mesh.vertexCount(); ++v) ++chiPlusLoops[componentOf[v]];
+  // Boundary loops, as a walk along the boundary would find them: two boundary
+  // edges continue each other at a vertex only within the same fan there, so a
+  // bow-tie vertex where two holes touch keeps them apart.
+  {
+    DisjointSets loops(boundaryUses.size());
+    std::unordered_map<long long, int> edgeAtFan;  // fan (root corner) -> a boundary edge in it
+    for (int b = 0; b < static_cast<int>(boundaryUses.size()); ++b) {
+      for (int v : {boundaryUses[b].low, boundaryUses[b].high}) {
+        auto [it, inserted] = edgeAtFan.emplace(fans.find(cornerAt(boundaryUses[b], v)), b);
+        if (!inserted) loops.unite(b, it->second);
+      }
+    }
+    for (int b = 0; b < static_cast<int>(boundaryUses.size()); ++b) {
+      if (loops.find(b) != b) continue;
       ++topology.boundaryLoops;
-      ++chiPlusLoops[componentOf[v]];
+      ++chiPlusLoops[componentOf[boundaryUses[b].low]];
     }
   }
   for (size_t begin = 0, end = 0; begin < uses.size(); begin = end) {

@@ -91,12 +91,13 @@ void appendScene(const aiScene& scene, const aiNode& node, const aiMatrix4x4& pa
     const aiMesh& source = *scene.mMeshes[node.mMeshes[n]];
     const int base = mesh.vertexCount();
     for (unsigned v = 0; v < source.mNumVertices; ++v) {
+      // Checked before the transform, which would spread a NaN to all three coordinates.
+      const Point3 raw(source.mVertices[v].x, source.mVertices[v].y, source.mVertices[v].z);
+      if (!raw.allFinite()) {
+        throw InvalidMeshError(fmt::format("vertex {} has a non-finite coordinate {}", base + v, formatPoint(raw)));
+      }
       const aiVector3D p = transform * source.mVertices[v];
       mesh.positions.emplace_back(p.x, p.y, p.z);
-      if (!mesh.positions.back().allFinite()) {
-        throw InvalidMeshError(fmt::format("vertex {} has a non-finite coordinate {}", mesh.vertexCount() - 1,
-                                           formatPoint(mesh.positions.back())));
-      }
     }
     for (unsigned f = 0; f < source.mNumFaces; ++f) {
       const aiFace& face = source.mFaces[f];

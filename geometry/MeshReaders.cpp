@@ -105,20 +105,26 @@ PolygonMesh readOff(std::string_view text) {
   auto header = lines.next();
   if (!header) throw InvalidMeshError("the file is empty");
   std::string_view keyword = (*header)[0];
-  // Optional prefixes: ST (texture), C (colour), N (normal), 4 / n (dimension).
-  if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
-    failAtLine(lines.lineNumber(), fmt::format("expected the OFF header, found {}", quoted(keyword)));
-  }
-  if (keyword.find('4') != std::string_view::npos || keyword.find('n') != std::string_view::npos) {
-    failAtLine(lines.lineNumber(), fmt::format("{} (4D or nD) files are not supported; 3D OFF is", quoted(keyword)));
-  }
-  std::vector<std::string_view> counts(header->begin() + 1, header->end());
-  if (!counts.empty() && counts[0] == "BINARY")
-    failAtLine(lines.lineNumber(), "binary OFF is not supported; write it as text");
-  if (counts.empty()) {
-    auto next = lines.next();
-    if (!next) throw InvalidMeshError("truncated: the file ends before the vertex and face counts");
-    counts = *next;
+  std::vector<std::string_view> counts;
+  if (parseInteger(keyword)) {
+    // Geomview's OFF spec makes the keyword optional: the file opens with the counts.
+    counts = *header;
+  } else {
+    // Optional prefixes: ST (texture), C (colour), N (normal), 4 / n (dimension).
+    if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
+      failAtLine(lines.lineNumber(), fmt::format("expected the OFF header, found {}", quoted(keyword)));
+    }
+    if (keyword.find('4') != std::string_view::npos || keyword.find('n') != std::string_view::npos) {
+      failAtLine(lines.lineNumber(), fmt::format("{} (4D or nD) files are not supported; 3D OFF is", quoted(keyword)));
+    }
+    counts.assign(header->begin() + 1, header->end());
+    if (!counts.empty() && counts[0] == "BINARY")
+      failAtLine(lines.lineNumber(), "binary OFF is not supported; write it as text");
+    if (counts.empty()) {
+      auto next = lines.next();
+      if (!next) throw InvalidMeshError("truncated: the file ends before the vertex and face counts");
+      counts = *next;
+    }
   }
   const int countsLine = lines.lineNumber();
   if (counts.size() < 2) failAtLine(countsLine, "expected the vertex and face counts");
@@ -350,9 +356,9 @@ PolygonMesh readPly(std::string_view bytes) {
         failAtLine(line, "a property needs a type and a name");
       }
       elements.back().properties.push_back(std::move(property));
-    } else {
-      failAtLine(line, fmt::format("unknown header keyword {}", quoted(w[0])));
     }
+    // Anything else is a free-form line some writers add (Blender: "Created by
+    // Blender3D ..."); like a comment, it is ignored.
   }
   if (!format) throw InvalidMeshError("the header has no format line");
 

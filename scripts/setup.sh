@@ -18,6 +18,9 @@ packages=(
   hershey-fonts-data libumockdev-dev umockdev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev ghostscript hyperfine
+  # meshes other people made, read by the tests where these packages install
+  # them (tests/data/external/README.md)
+  assimp-testmodels geomview openscad-testing-data libcgal-demo
 )
 
 if [[ -z "${ROTAFAB_SKIP_APT:-}" ]]; then

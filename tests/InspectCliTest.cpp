@@ -1,1 +1,142 @@
+// `rotafab inspect` through the built program: SPEC's JSON, exit statuses and
+// one-line errors, on our examples and on meshes we did not make.
+
 #include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+const std::string kCli = ROTAFAB_CLI;
+const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
+
+nlohmann::json inspectJson(const std::filesystem::path& mesh) {
+  const CommandResult result = run(kCli + " inspect --json '" + mesh.string() + "'");
+  EXPECT_EQ(result.status, 0) << result.err;
+  return nlohmann::json::parse(result.out);
+}
+
+TEST(InspectCli, ExamplesGiveSpecJsonInSpecOrder) {
+  struct Case {
+    const char* file;
+    const char* json;
+  };
+  const Case cases[] = {
+      {"bunny.obj",
+       R"({"vertices":1839,"edges":5511,"faces":3674,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+      {"soccer-ball.obj",
+       R"({"vertices":60,"edges":90,"faces":32,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+      {"torus.obj",
+       R"({"vertices":288,"edges":576,"faces":288,"boundary_loops":0,"components":1,"euler":0,"genus":1,"orientable":true,"manifold":true})"},
+      {"genus2.obj",
+       R"({"vertices":48,"edges":100,"faces":50,"boundary_loops":0,"components":1,"euler":-2,"genus":2,"orientable":true,"manifold":true})"},
+      {"cube.obj",
+       R"({"vertices":8,"edges":12,"faces":6,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.file);
+    const CommandResult result = run(kCli + " inspect --json " + (kSource / "examples" / c.file).string());
+    EXPECT_EQ(result.status, 0) << result.err;
+    EXPECT_EQ(result.out, std::string(c.json) + "\n");
+  }
+}
+
+TEST(InspectCli, TextFormIsForPeople) {
+  const CommandResult result = run(kCli + " inspect " + (kSource / "examples" / "genus2.obj").string());
+  EXPECT_EQ(result.status, 0);
+  EXPECT_NE(result.out.find("genus           2"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("50 4-gons"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("usable for `rotafab make`"), std::string::npos);
+}
+
+TEST(InspectCli, BrokenButReadableMeshIsReportedWithExitZero) {
+  TempDir dir;
+  const auto mesh = dir.write("fin.off", "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n3 0 1 2\n3 1 0 3\n3 0 1 4\n");
+  const CommandResult json = run(kCli + " inspect --json " + mesh.string());
+  EXPECT_EQ(json.status, 0);
+  const auto object = nlohmann::json::parse(json.out);
+  EXPECT_EQ(object["manifold"], false);
+  EXPECT_TRUE(object["genus"].is_null());
+  const CommandResult text = run(kCli + " inspect " + mesh.string());
+  EXPECT_EQ(text.status, 0);
+  EXPECT_NE(text.out.find("edge (0, 1) is shared by 3 faces (0, 1, 2)"), std::string::npos) << text.out;
+}
+
+TEST(InspectCli, UnreadableMeshIsOneLineAndExitOne) {
+  TempDir dir;
+  const auto mesh = dir.write("cut.off", "OFF\n4 2 0\n0 0 0\n1 0 0\n");
+  const CommandResult result = run(kCli + " inspect " + mesh.string());
+  EXPECT_EQ(result.status, 1);
+  EXPECT_EQ(result.out, "");
+  EXPECT_EQ(result.err,
+            "error: " + mesh.string() + ": truncated: the header states 4 vertices, the file ends after 2\n");
+}
+
+TEST(InspectCli, UsageErrorsExitTwo) {
+  for (const char* args : {"", " inspect", " inspect a.obj --bogus", " frobnicate"}) {
+    SCOPED_TRACE(args);
+    const CommandResult result = run(kCli + args);
+    EXPECT_EQ(result.status, 2) << result.err;
+    EXPECT_NE(result.err.find("error: "), std::string::npos);
+  }
+  const CommandResult help = run(kCli + " inspect --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_NE(help.out.find("rotafab inspect examples/bunny.obj"), std::string::npos) << "help shows a working example";
+}
+
+TEST(InspectCli, WarningsGoToStandardErrorAndJsonStaysClean) {
+  TempDir dir;
+  const auto mesh = dir.write("extra.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n5 5 5\n3 0 1 2\n");
+  const CommandResult result = run(kCli + " inspect --json " + mesh.string());
+  EXPECT_EQ(result.status, 0);
+  EXPECT_EQ(nlohmann::json::parse(result.out)["vertices"], 3);
+  EXPECT_EQ(result.err, "warning: " + mesh.string() +
+                            ": dropped 0 faces with fewer than 3 distinct vertices and 1 unreferenced vertex\n");
+}
+
+// Meshes from other public sources (tests/data/external/README.md): the
+// counts an independent checker (tools/meshcheck.py) computed. Where rotafab
+// deliberately differs, the entry says which keys and why.
+void expectMatchesChecker(const nlohmann::json& entry, const std::filesystem::path& path) {
+  SCOPED_TRACE(path.string());
+  ASSERT_TRUE(std::filesystem::exists(path)) << "install it with scripts/setup.sh (package " << entry["package"] << ")";
+  std::set<std::string> skipped;
+  if (entry.contains("rotafab_differs"))
+    for (const auto& key : entry["rotafab_differs"]["keys"]) skipped.insert(key.get<std::string>());
+  const auto actual = inspectJson(path);
+  for (const auto& [key, value] : entry["expected"].items()) {
+    if (!skipped.contains(key)) {
+      EXPECT_EQ(actual[key], value) << key;
+    }
+  }
+}
+
+TEST(InspectCli, ExternalMeshesMatchTheIndependentChecker) {
+  const auto meshes = nlohmann::json::parse(readFile(kSource / "tests/data/external/meshes.json"));
+  ASSERT_GE(meshes.size(), 20u);
+  for (const auto& entry : meshes) {
+    std::filesystem::path path = entry["path"].get<std::string>();
+    expectMatchesChecker(entry, path.is_relative() ? kSource / path : path);
+  }
+}
+
+// CGAL's data sets (OFF files CGAL wrote, with comment lines) come inside a tarball.
+TEST(InspectCli, CgalMeshesMatchTheIndependentChecker) {
+  const auto meshes = nlohmann::json::parse(readFile(kSource / "tests/data/external/meshes-cgal.json"));
+  ASSERT_GE(meshes.size(), 10u);
+  TempDir dir;
+  for (const auto& entry : meshes) {
+    const std::string member = entry["member"];
+    const CommandResult untar =
+        run("tar -xzf '" + entry["archive"].get<std::string>() + "' -C '" + dir.path().string() + "' '" + member + "'");
+    ASSERT_EQ(untar.status, 0) << untar.err << " (install package " << entry["package"] << " with scripts/setup.sh)";
+    expectMatchesChecker(entry, dir.path() / member);
+  }
+}
+
+}  // namespace
+}  // namespace rotafab::test

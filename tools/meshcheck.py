@@ -3,9 +3,12 @@
 
     python3 tools/meshcheck.py MESH [--details]
 
-Reads OBJ, OFF (OFF/COFF/NOFF/CNOFF/STOFF..., '#' comments, extra per-vertex
-and per-face values), PLY (ascii, binary little/big endian) and STL (ascii and
-binary), cleans the mesh the way SPEC.md says `rotafab inspect` does, and
+Reads OBJ (v/f, `f a/b/c` forms, negative indices, groups ignored), OFF
+(OFF/COFF/NOFF/CNOFF/STOFF... or no keyword at all, '#' comments anywhere,
+extra per-vertex and per-face values ignored; not 4OFF or binary OFF), PLY
+(ascii, binary little/big endian; `vertex` x/y/z and the `face`
+`vertex_indices`/`vertex_index` list, other elements skipped) and STL (ascii,
+and binary even when its header starts with "solid"), cleans the mesh the way SPEC.md says `rotafab inspect` does, and
 prints the `inspect --json` object:
 
     {"vertices":V,"edges":E,"faces":F,"boundary_loops":B,"components":C,
@@ -30,7 +33,8 @@ Definitions:
                   boundary edges. On a manifold mesh this is the ordinary
                   number of boundary cycles; a bow-tie vertex (two fans) splits
                   loops, as a half-edge walk around the boundary would.
-  components      connected components of the vertex/edge graph.
+  components      connected components of the vertex/edge graph (two pieces
+                  touching at a single vertex are one component).
   euler           V - E + F of the cleaned mesh (no capping).
   manifold        every edge used by 1 or 2 face sides, and the face corners
                   at every vertex form a single fan (joined through the edges at
@@ -47,6 +51,10 @@ Definitions:
 
 --details prints more facts (consistent orientation as stored, counts of
 non-manifold edges/vertices, what cleaning removed) to stderr.
+--selftest checks the checker on small hand-made meshes (tetrahedron, quad
+cube, open square, Moebius strips, tori, keyhole polygon, bow-ties, an edge
+of three faces) and on one solid written in every format; it prints
+"N passed, N failed" and exits 1 on a failure.
 """
 
 import json
@@ -623,6 +631,142 @@ def analyse(nv, faces, info):
     }
 
 
+# --------------------------------------------------------------------- self test
+
+def _torus_obj(n, m, dx=0.0, skip=()):
+    import math
+    lines = []
+    for i in range(n):
+        for j in range(m):
+            u = 2 * math.pi * i / n
+            w = 2 * math.pi * j / m
+            lines.append("v %r %r %r" % ((2 + math.cos(w)) * math.cos(u) + dx,
+                                         (2 + math.cos(w)) * math.sin(u), math.sin(w)))
+    for i in range(n):
+        for j in range(m):
+            if (i, j) in skip:
+                continue
+            q = (i * m + j, ((i + 1) % n) * m + j, ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m)
+            lines.append("f %d %d %d %d" % tuple(k + 1 for k in q))
+    return "\n".join(lines) + "\n"
+
+
+def _mobius_obj(n=6):
+    import math
+    lines = []
+    for i in range(n):
+        t = 2 * math.pi * i / n
+        for s in (-0.3, 0.3):
+            r = 1 + s * math.cos(t / 2)
+            lines.append("v %r %r %r" % (r * math.cos(t), r * math.sin(t), s * math.sin(t / 2)))
+    for i in range(n):
+        j = (i + 1) % n
+        b0, b1 = 2 * j, 2 * j + 1
+        if j == 0:
+            b0, b1 = b1, b0  # the half twist
+        lines.append("f %d %d %d %d" % (2 * i + 1, b0 + 1, b1 + 1, 2 * i + 2))
+    return "\n".join(lines) + "\n"
+
+
+TET = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+SELFTEST = [
+    # name, reader, text, expected (V, E, F, B, C, euler, genus, orientable, manifold)
+    ("tetrahedron", read_obj, TET + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+     (4, 6, 4, 0, 1, 2, 0, True, True)),
+    ("tetrahedron, one face flipped", read_obj, TET + "f 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n",
+     (4, 6, 4, 0, 1, 2, 0, True, True)),
+    ("cube of quads, COFF, comments, colours", read_off,
+     "# c\nCOFF\n# counts\n8 6 12\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n1 1 0 1 0 0 1\n0 1 0 1 0 0 1\n"
+     "0 0 1 1 0 0 1\n1 0 1 1 0 0 1\n1 1 1 1 0 0 1\n0 1 1 1 0 0 1\n4 0 3 2 1 1 0 0\n4 4 5 6 7 # top\n"
+     "4 0 1 5 4 255 255 0 255\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n",
+     (8, 12, 6, 0, 1, 2, 0, True, True)),
+    ("open square, v/vt/vn and negative indices, degenerate faces, unused vertex", read_obj,
+     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1/1 2/2/1 3/3/1\nf -4//1 -2//1 -1//1\n"
+     "v 5 5 5\nf 1 1 2 2 1\nf 2 2 2\n",
+     (4, 5, 2, 1, 1, 1, 0, True, True)),
+    ("weld at equal 32-bit floats", read_obj,
+     "v 0.1 0 0\nv 0 1 0\nv 0 0 1\nv 0.1000000001 0 0\nv 0 0 -1\nv 0 1.0 0\nf 1 2 3\nf 4 5 6\n",
+     (4, 5, 2, 1, 1, 1, 0, True, True)),
+    ("Moebius strip", read_obj, _mobius_obj(), (12, 18, 6, 1, 1, 0, None, False, True)),
+    ("Moebius band from one self-glued face", read_obj,
+     "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 1 2 4\n", (4, 5, 1, 1, 1, 0, None, False, True)),
+    ("torus of quads", read_obj, _torus_obj(8, 6), (48, 96, 48, 0, 1, 0, 1, True, True)),
+    ("torus with two holes", read_obj, _torus_obj(8, 6, skip=((0, 0), (4, 3))),
+     (48, 96, 46, 2, 1, -2, 1, True, True)),
+    ("two tori", read_obj, _torus_obj(8, 6) + "".join(
+        l + "\n" if l.startswith("v") else "f " + " ".join(str(int(k) + 48) for k in l.split()[1:]) + "\n"
+        for l in _torus_obj(8, 6, dx=10).splitlines()),
+     (96, 192, 96, 0, 2, 0, 2, True, True)),
+    ("keyhole polygon (annulus as one face)", read_obj,
+     "v 0 0 0\nv 3 0 0\nv 3 3 0\nv 0 3 0\nv 1 1 0\nv 1 2 0\nv 2 2 0\nv 2 1 0\nf 1 2 3 4 1 5 6 7 8 5\n",
+     (8, 9, 1, 2, 1, 0, 0, True, True)),
+    ("two tetrahedra sharing a vertex (bow-tie)", read_obj,
+     TET + "v -1 0 0\nv 0 -1 0\nv 0 0 -1\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n"
+     "f 1 5 6\nf 1 6 7\nf 1 7 5\nf 5 7 6\n",
+     (7, 12, 8, 0, 1, 3, None, True, False)),
+    ("two triangles sharing a vertex", read_obj,
+     "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n",
+     (5, 6, 2, 2, 1, 1, None, True, False)),
+    ("three triangles on one edge", read_obj,
+     "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 -1 0\nv 0 0 1\nf 1 2 3\nf 2 1 4\nf 1 2 5\n",
+     (5, 7, 3, 1, 1, 1, None, True, False)),
+]
+
+
+def selftest():
+    keys = ("vertices", "edges", "faces", "boundary_loops", "components", "euler", "genus",
+            "orientable", "manifold")
+    passed = failed = 0
+    for name, reader, text, want in SELFTEST:
+        verts, faces = reader(text.encode())
+        nv, faces = clean(verts, faces, {})
+        got = analyse(nv, faces, {})
+        want = dict(zip(keys, want))
+        if got == want:
+            passed += 1
+        else:
+            failed += 1
+            print("FAIL %s\n  want %s\n  got  %s" % (name, json.dumps(want), json.dumps(got)))
+    # the same solid through every reader
+    tet = (TET + "f 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n").encode()
+    verts, faces = read_obj(tet)
+    ref = analyse(*clean(verts, faces, {}), {})
+    tris = [[verts[i] for i in f] for f in faces]
+    ply_head = ("ply\nformat %s 1.0\ncomment c\nelement vertex 4\nproperty double x\nproperty double y\n"
+                "property double z\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n")
+    variants = {
+        "ascii PLY": (ply_head % "ascii").encode()
+        + "".join("%r %r %r\n" % v for v in verts).encode()
+        + "".join("3 %d %d %d\n" % tuple(f) for f in faces).encode(),
+        "binary little-endian PLY": (ply_head % "binary_little_endian").encode()
+        + b"".join(struct.pack("<3d", *v) for v in verts)
+        + b"".join(struct.pack("<B3i", 3, *f) for f in faces),
+        "binary big-endian PLY": (ply_head % "binary_big_endian").encode()
+        + b"".join(struct.pack(">3d", *v) for v in verts)
+        + b"".join(struct.pack(">B3i", 3, *f) for f in faces),
+        "ascii STL": ("solid t\n" + "".join(
+            "facet normal 0 0 0\nouter loop\n" + "".join("vertex %r %r %r\n" % p for p in t)
+            + "endloop\nendfacet\n" for t in tris) + "endsolid t\n").encode(),
+        "binary STL, header starting with solid": b"solid".ljust(80, b" ") + struct.pack("<I", len(tris))
+        + b"".join(struct.pack("<12fH", 0, 0, 0, *[c for p in t for c in p], 0) for t in tris),
+        "OFF without keyword": ("4 4 0\n" + "".join("%r %r %r\n" % v for v in verts)
+                                + "".join("3 %d %d %d\n" % tuple(f) for f in faces)).encode(),
+        "UTF-16 OBJ": "\ufeff".encode("utf-16-be") + tet.decode().encode("utf-16-be"),
+    }
+    readers = {"PLY": read_ply, "STL": read_stl, "OFF": read_off, "OBJ": read_obj}
+    for name, data in variants.items():
+        reader = next(r for k, r in readers.items() if k in name)
+        verts2, faces2 = reader(data)
+        got = analyse(*clean(verts2, faces2, {}), {})
+        if got == ref:
+            passed += 1
+        else:
+            failed += 1
+            print("FAIL %s\n  want %s\n  got  %s" % (name, json.dumps(ref), json.dumps(got)))
+    print("%d passed, %d failed" % (passed, failed))
+    return 1 if failed else 0
+
+
 # --------------------------------------------------------------------- main
 
 READERS = {".obj": read_obj, ".off": read_off, ".ply": read_ply, ".stl": read_stl}
@@ -649,10 +793,12 @@ def check(path, info=None):
 
 
 def main(argv):
+    if argv[1:] == ["--selftest"]:
+        return selftest()
     args = [a for a in argv[1:] if not a.startswith("--")]
     details = "--details" in argv[1:]
     if len(args) != 1:
-        sys.stderr.write("usage: meshcheck.py MESH [--details]\n")
+        sys.stderr.write("usage: meshcheck.py MESH [--details] | meshcheck.py --selftest\n")
         return 2
     info = {}
     try:
