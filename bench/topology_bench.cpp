@@ -1,2 +1,121 @@
+// Import + analysis + rotation system + face tracing on meshes from 1k to 200k
+// faces (issue 2's target: linear growth, 2x faces at most 2.2x time).
+//
+//   build/rotafab_bench                         run the benchmarks
+//   build/rotafab_bench write-mesh FACES FILE   write the benchmark's mesh of
+//                                               about FACES triangles as OBJ
+//
+// The meshes are triangulated tori (closed, genus 1, every vertex of valence 6),
+// written to OBJ so that the real import path, Assimp included, is measured.
+
 #include <benchmark/benchmark.h>
-BENCHMARK_MAIN();
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <string>
+
+#include "geometry/FaceTracing.h"
+#include "geometry/MeshAnalysis.h"
+#include "geometry/MeshImport.h"
+#include "geometry/ObjWriter.h"
+#include "geometry/Primitives.h"
+
+namespace geo = rotafab::geometry;
+
+namespace {
+
+// A torus of about `faces` triangles: each quad of a torus grid split in two.
+geo::PolygonMesh triangulatedTorus(long faces) {
+  const int across = std::max(3, static_cast<int>(std::sqrt(faces / 2.0 / 4.0)));
+  const int around = std::max(3, static_cast<int>(faces / 2 / across));
+  geo::PolygonMesh quads = geo::torus(around, across);
+  geo::PolygonMesh mesh;
+  mesh.positions = quads.positions;
+  for (const auto& q : quads.faces) {
+    mesh.faces.push_back({q[0], q[1], q[2]});
+    mesh.faces.push_back({q[0], q[2], q[3]});
+  }
+  return mesh;
+}
+
+// One OBJ file per size, written once and kept for the run.
+const std::filesystem::path& meshFile(long faces) {
+  static std::map<long, std::filesystem::path> files;
+  auto& path = files[faces];
+  if (path.empty()) {
+    path = std::filesystem::temp_directory_path() / ("rotafab-bench-" + std::to_string(faces) + ".obj");
+    std::ofstream out(path, std::ios::binary);
+    geo::writeObj(out, triangulatedTorus(faces));
+  }
+  return path;
+}
+
+void sizes(benchmark::internal::Benchmark* b) {
+  for (long faces : {1000L, 2000L, 4000L, 8000L, 16000L, 32000L, 64000L, 128000L, 200000L}) b->Arg(faces);
+}
+
+void BM_ImportAnalyzeTrace(benchmark::State& state) {
+  const auto& path = meshFile(state.range(0));
+  long faces = 0;
+  for (auto _ : state) {
+    geo::ImportedMesh imported = geo::importMesh(path);
+    geo::requireUsable(geo::analyzeMesh(imported.mesh));
+    const geo::RotationSystem rs = geo::RotationSystem::fromMesh(imported.mesh);
+    const auto walks = geo::traceAllFaces(rs);
+    benchmark::DoNotOptimize(walks.data());
+    faces = imported.mesh.faceCount();
+  }
+  state.SetComplexityN(faces);
+  state.counters["faces"] = static_cast<double>(faces);
+  state.counters["faces/s"] = benchmark::Counter(static_cast<double>(faces), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_ImportAnalyzeTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// The stages alone, to see where the time goes.
+void BM_Import(benchmark::State& state) {
+  const auto& path = meshFile(state.range(0));
+  for (auto _ : state) benchmark::DoNotOptimize(geo::importMesh(path).mesh.faces.data());
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_Import)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+void BM_Analyze(benchmark::State& state) {
+  const geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
+  for (auto _ : state) {
+    geo::PolygonMesh copy = mesh;
+    benchmark::DoNotOptimize(geo::analyzeMesh(copy).topology.genus);
+  }
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_Analyze)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+void BM_RotationSystemAndTrace(benchmark::State& state) {
+  const geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
+  for (auto _ : state) {
+    const geo::RotationSystem rs = geo::RotationSystem::fromMesh(mesh);
+    benchmark::DoNotOptimize(geo::traceAllFaces(rs).size());
+  }
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_RotationSystemAndTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc == 4 && std::string(argv[1]) == "write-mesh") {
+    std::ofstream out(argv[3], std::ios::binary);
+    geo::writeObj(out, triangulatedTorus(std::stol(argv[2])), "rotafab benchmark mesh: triangulated torus");
+    return out ? 0 : 1;
+  }
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::temp_directory_path())) {
+    if (entry.path().filename().string().starts_with("rotafab-bench-")) std::filesystem::remove(entry.path());
+  }
+  return 0;
+}

@@ -3,59 +3,83 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <unordered_map>
 
 namespace rotafab::geometry {
 
 RotationSystem RotationSystem::fromMesh(const PolygonMesh& mesh) {
   RotationSystem rs;
   rs.vertexCount_ = mesh.vertexCount();
-  std::unordered_map<unsigned long long, Dart> dartOf;  // directed (u, v) -> dart
-  size_t corners = 0;
-  for (const auto& face : mesh.faces) corners += face.size();
-  dartOf.reserve(corners);
-  auto key = [](int u, int v) { return (static_cast<unsigned long long>(u) << 32) | static_cast<unsigned>(v); };
-  rs.origin_.reserve(corners + corners / 8);
-  rs.face_.reserve(corners + corners / 8);
-
-  // Edge e gets darts 2e and 2e+1; the first face to use an edge decides which is which.
-  std::vector<std::vector<Dart>> faceDarts(mesh.faces.size());
+  // Corners in face order; corner c runs from cornerFrom[c] to cornerTo[c].
+  std::vector<int> faceStart(mesh.faces.size() + 1, 0);
+  for (size_t f = 0; f < mesh.faces.size(); ++f)
+    faceStart[f + 1] = faceStart[f] + static_cast<int>(mesh.faces[f].size());
+  const int corners = faceStart.back();
+  std::vector<int> cornerFrom(corners), cornerTo(corners);
   for (int f = 0; f < mesh.faceCount(); ++f) {
     const auto& face = mesh.faces[f];
     for (size_t i = 0; i < face.size(); ++i) {
-      const int u = face[i], v = face[(i + 1) % face.size()];
-      if (dartOf.contains(key(u, v))) {
-        throw InvalidMeshError(
-            fmt::format("edge ({}, {}) is run in the same direction by two faces: the mesh is not "
-                        "consistently oriented",
-                        std::min(u, v), std::max(u, v)));
-      }
-      Dart d;
-      if (auto twin = dartOf.find(key(v, u)); twin != dartOf.end()) {
-        d = reverse(twin->second);
-        if (rs.face_[d] >= 0) {
-          throw InvalidMeshError(
-              fmt::format("edge ({}, {}) is shared by more than two faces", std::min(u, v), std::max(u, v)));
-        }
-      } else {
-        d = static_cast<Dart>(rs.origin_.size());
-        rs.origin_.insert(rs.origin_.end(), {u, v});
-        rs.face_.insert(rs.face_.end(), {-1, -1});
-      }
-      rs.face_[d] = f;
-      dartOf.emplace(key(u, v), d);
-      faceDarts[f].push_back(d);
+      cornerFrom[faceStart[f] + i] = face[i];
+      cornerTo[faceStart[f] + i] = face[(i + 1) % face.size()];
     }
+  }
+  // The corners leaving each vertex (compressed rows): finding the twin of
+  // u -> v scans v's few outgoing corners, so building stays linear and cache-friendly.
+  std::vector<int> outStart(mesh.positions.size() + 1, 0);
+  for (int c = 0; c < corners; ++c) ++outStart[cornerFrom[c] + 1];
+  for (size_t v = 0; v < mesh.positions.size(); ++v) outStart[v + 1] += outStart[v];
+  std::vector<int> outCorners(corners);
+  {
+    std::vector<int> fill(outStart.begin(), outStart.end() - 1);
+    for (int c = 0; c < corners; ++c) outCorners[fill[cornerFrom[c]]++] = c;
+  }
+  auto cornersFromTo = [&](int u, int v, int& found, int& count) {
+    count = 0;
+    for (int k = outStart[u]; k < outStart[u + 1]; ++k) {
+      if (cornerTo[outCorners[k]] == v) {
+        found = outCorners[k];
+        ++count;
+      }
+    }
+  };
+
+  rs.origin_.reserve(corners + corners / 8);
+  rs.face_.reserve(corners + corners / 8);
+  // Edge e gets darts 2e and 2e+1; the first face to use an edge decides which is which.
+  std::vector<Dart> dartOfCorner(corners, -1);
+  std::vector<int> faceOfCorner(corners);
+  for (int f = 0; f < mesh.faceCount(); ++f)
+    for (int c = faceStart[f]; c < faceStart[f + 1]; ++c) faceOfCorner[c] = f;
+  for (int c = 0; c < corners; ++c) {
+    if (dartOfCorner[c] >= 0) continue;
+    const int u = cornerFrom[c], v = cornerTo[c];
+    int same = -1, sameCount = 0, twin = -1, twinCount = 0;
+    cornersFromTo(u, v, same, sameCount);
+    cornersFromTo(v, u, twin, twinCount);
+    if (sameCount > 1) {
+      throw InvalidMeshError(
+          fmt::format("edge ({}, {}) is run in the same direction by two faces: the mesh is not consistently oriented",
+                      std::min(u, v), std::max(u, v)));
+    }
+    if (twinCount > 1) {
+      throw InvalidMeshError(
+          fmt::format("edge ({}, {}) is shared by more than two faces", std::min(u, v), std::max(u, v)));
+    }
+    const Dart d = static_cast<Dart>(rs.origin_.size());
+    rs.origin_.insert(rs.origin_.end(), {u, v});
+    rs.face_.insert(rs.face_.end(), {faceOfCorner[c], twin >= 0 ? faceOfCorner[twin] : -1});
+    dartOfCorner[c] = d;
+    if (twin >= 0) dartOfCorner[twin] = reverse(d);
   }
   const int darts = static_cast<int>(rs.origin_.size());
   rs.faceNext_.assign(darts, -1);
   rs.facePrev_.assign(darts, -1);
   rs.twist_.assign(darts / 2, 0);
   rs.outgoing_.assign(mesh.positions.size(), -1);
-  for (const auto& walk : faceDarts) {
-    for (size_t i = 0; i < walk.size(); ++i) {
-      rs.faceNext_[walk[i]] = walk[(i + 1) % walk.size()];
-      rs.facePrev_[walk[(i + 1) % walk.size()]] = walk[i];
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    for (int c = faceStart[f]; c < faceStart[f + 1]; ++c) {
+      const Dart next = dartOfCorner[c + 1 < faceStart[f + 1] ? c + 1 : faceStart[f]];
+      rs.faceNext_[dartOfCorner[c]] = next;
+      rs.facePrev_[next] = dartOfCorner[c];
     }
   }
   // Boundary darts: at a manifold boundary vertex exactly one boundary dart

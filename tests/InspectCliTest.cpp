@@ -49,7 +49,7 @@ TEST(InspectCli, TextFormIsForPeople) {
   const CommandResult result = run(kCli + " inspect " + (kSource / "examples" / "genus2.obj").string());
   EXPECT_EQ(result.status, 0);
   EXPECT_NE(result.out.find("genus           2"), std::string::npos) << result.out;
-  EXPECT_NE(result.out.find("50 4-gons"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("50 quads"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("usable for `rotafab make`"), std::string::npos);
 }
 

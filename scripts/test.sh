@@ -1,0 +1,27 @@
+#!/usr/bin/env bash
+# The whole test suite, as CI runs it (.ci/run):
+#   1. scripts/setup.sh (install the Debian packages, build Release), then every test;
+#   2. fuzz the mesh importer for a bounded time (libFuzzer, clang);
+#   3. build and run every test again under AddressSanitizer + UBSan.
+# Environment: ROTAFAB_FUZZ_SECONDS (default 60; 0 skips fuzzing),
+#              ROTAFAB_SKIP_SANITIZERS=1 skips step 3.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+jobs=$(nproc)
+
+scripts/setup.sh
+ctest --test-dir build --output-on-failure -j"$jobs"
+
+if [[ "${ROTAFAB_FUZZ_SECONDS:-60}" != 0 ]]; then
+  scripts/fuzz.sh "${ROTAFAB_FUZZ_SECONDS:-60}"
+fi
+
+if [[ -z "${ROTAFAB_SKIP_SANITIZERS:-}" ]]; then
+  cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DROTAFAB_SANITIZE=ON -DROTAFAB_BENCH=OFF
+  cmake --build build-asan
+  # Assimp (Debian's build) leaks on some inputs; our own code is still leak-checked.
+  export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0"
+  export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0"
+  export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+  ctest --test-dir build-asan --output-on-failure -j"$jobs"
+fi
