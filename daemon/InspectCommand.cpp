@@ -36,8 +36,10 @@ void printText(const std::string& name, const geometry::PolygonMesh& mesh, const
   std::map<size_t, int> sides;
   for (const auto& face : mesh.faces) ++sides[face.size()];
   std::string histogram;
-  for (auto [n, count] : sides)
-    histogram += fmt::format("{}{} {}-gon{}", histogram.empty() ? "" : ", ", count, n, count == 1 ? "" : "s");
+  for (auto [n, count] : sides) {
+    const std::string kind = n == 3 ? "triangle" : n == 4 ? "quad" : fmt::format("{}-gon", n);
+    histogram += fmt::format("{}{} {}{}", histogram.empty() ? "" : ", ", count, kind, count == 1 ? "" : "s");
+  }
   fmt::print("{}\n", name);
   fmt::print("  vertices        {}\n", t.vertices);
   fmt::print("  edges           {}\n", t.edges);
