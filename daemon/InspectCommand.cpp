@@ -69,6 +69,7 @@ int runInspect(const InspectOptions& options) {
     for (const auto& warning : imported.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
     const geometry::MeshAnalysis analysis = geometry::analyzeMesh(imported.mesh);
     if (options.json) {
+      for (const auto& note : analysis.notes) fmt::print(stderr, "note: {}: {}\n", options.mesh, note);
       std::cout << topologyJson(analysis.topology).dump() << '\n';
     } else {
       printText(options.mesh, imported.mesh, analysis);
@@ -79,6 +80,9 @@ int runInspect(const InspectOptions& options) {
     return kUserError;
   } catch (const std::bad_alloc&) {
     fmt::print(stderr, "error: {}: the mesh does not fit in memory\n", options.mesh);
+    return kUserError;
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "error: {}: {}\n", options.mesh, error.what());
     return kUserError;
   }
 }

@@ -1,7 +1,9 @@
 // rotafab: the command line (SPEC, "Command line"). Wiring only.
 
 #include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
+#include <cstdio>
 
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
@@ -27,6 +29,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& error) {
     fmt::print(stderr, "error: {}\nRun `rotafab --help` for usage.\n", error.what());
     return kUsageError;
+  } catch (const std::exception& error) {
+    // Last resort (e.g. standard output closed): one line, never an abort.
+    std::fprintf(stderr, "error: %s\n", error.what());
+    return kUserError;
   }
   return status;
 }

@@ -36,12 +36,13 @@ CornerCutMesh cornerCut(const PolygonMesh& mesh, const RotationSystem& rs, std::
     const int sides = static_cast<int>(face.size());
     const Eigen::MatrixXd weights = cornerCuttingWeights(sides, tension.value_or(dooSabinTension(sides)));
     std::vector<int> shrunk;
-    for (int n = 0; n < sides; ++n) {
+    Dart corner = rs.faceDart(f);  // leaves face[0]; faceNext follows the face's corners
+    for (int n = 0; n < sides; ++n, corner = rs.faceNext(corner)) {
       Point3 p = Point3::Zero();
       for (int m = 0; m < sides; ++m) p += weights(n, m) * mesh.positions[face[m]];
       const int vertex = result.mesh.vertexCount();
       result.mesh.positions.push_back(p);
-      result.vertexOfDart[rs.findDart(face[n], face[(n + 1) % sides])] = vertex;
+      result.vertexOfDart[corner] = vertex;
       shrunk.push_back(vertex);
     }
     // Step 2: the shrunken copy of the face.
@@ -62,12 +63,7 @@ CornerCutMesh cornerCut(const PolygonMesh& mesh, const RotationSystem& rs, std::
   for (int v = 0; v < mesh.vertexCount(); ++v) {
     if (rs.isBoundaryVertex(v)) continue;
     std::vector<int> face;
-    const Dart first = rs.dartFrom(v);
-    Dart d = first;
-    do {
-      face.push_back(result.vertexOfDart[d]);
-      d = rs.rotateBack(d);
-    } while (d != first);
+    for (Dart d : rs.dartsAround(v)) face.push_back(result.vertexOfDart[d]);
     result.faceOfVertex[v] = result.mesh.faceCount();
     result.mesh.faces.push_back(std::move(face));
   }

@@ -36,18 +36,20 @@ double angleAtDart(const PolygonMesh& mesh, const RotationSystem& rs, Dart d) {
 
 double vertexDefect(const PolygonMesh& mesh, const RotationSystem& rs, int vertex) {
   double sum = 0.0;
-  const Dart first = rs.dartFrom(vertex);
-  Dart d = first;
-  do {
+  for (Dart d : rs.dartsAround(vertex))
     if (!rs.isBoundary(d)) sum += angleAtDart(mesh, rs, d);
-    d = rs.rotate(d);
-  } while (d != first);
   return (rs.isBoundaryVertex(vertex) ? std::numbers::pi : 2.0 * std::numbers::pi) - sum;
 }
 
 double totalVertexDefect(const PolygonMesh& mesh, const RotationSystem& rs) {
   double total = 0.0;
   for (int v = 0; v < mesh.vertexCount(); ++v) total += vertexDefect(mesh, rs, v);
+  return total;
+}
+
+double totalFaceDefect(const PolygonMesh& mesh) {
+  double total = 0.0;
+  for (int f = 0; f < mesh.faceCount(); ++f) total += faceDefect(mesh, f);
   return total;
 }
 

@@ -25,9 +25,12 @@ double faceDefect(const PolygonMesh& mesh, int face);
 // vertex (its geodesic curvature).
 double vertexDefect(const PolygonMesh& mesh, const RotationSystem& rs, int vertex);
 
-// Sum of all vertex defects; equals 2 pi (V - E + F) on any orientable
-// manifold mesh, closed or with boundary (discrete Gauss-Bonnet).
+// Discrete Gauss-Bonnet (Akleman et al., III.2.2): the vertex defects plus the
+// face defects of eq. 3.3 add up to 2 pi (V - E + F) on any oriented manifold
+// mesh, closed or with boundary. With planar faces the face defects vanish and
+// the vertex defects alone give 2 pi chi.
 double totalVertexDefect(const PolygonMesh& mesh, const RotationSystem& rs);
+double totalFaceDefect(const PolygonMesh& mesh);
 
 // The curvature of a structure whose material is the faces with isHole[f]
 // false: a hole's corner angle is what the material leaves of 2 pi at that

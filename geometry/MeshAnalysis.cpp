@@ -50,6 +50,15 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     firstCorner[f + 1] = firstCorner[f] + static_cast<int>(mesh.faces[f].size());
   const int cornerCount = firstCorner.back();
 
+  // Messages name elements as the file numbers them.
+  auto vertexName = [&](int v) { return mesh.sourceVertexIndex(v); };
+  auto faceName = [&](int f) { return mesh.sourceFaceIndex(f); };
+  auto vertexNames = [&](const std::vector<int>& vertices) {
+    std::vector<int> names;
+    for (int v : vertices) names.push_back(vertexName(v));
+    return formatIndexList(names);
+  };
+
   std::vector<EdgeUse> uses;
   uses.reserve(cornerCount);
   std::vector<char> faceHasRepeat(mesh.faces.size(), 0);
@@ -60,12 +69,13 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     if (auto repeat = std::adjacent_find(sorted.begin(), sorted.end()); repeat != sorted.end()) {
       faceHasRepeat[f] = 1;
       analysis.problems.push_back(
-          {MeshProblemKind::RepeatedCorner, fmt::format("face {} visits vertex {} more than once", f, *repeat)});
+          {MeshProblemKind::RepeatedCorner,
+           fmt::format("face {} visits vertex {} more than once", faceName(f), vertexName(*repeat))});
     }
     if (fanArea(mesh, f) <= 1e-12 * diagonal * diagonal) {
       analysis.problems.push_back(
           {MeshProblemKind::ZeroAreaFace,
-           fmt::format("face {} has zero area (its corners {} are collinear)", f, formatIndexList(face))});
+           fmt::format("face {} has zero area (its corners {} are collinear)", faceName(f), vertexNames(face))});
     }
     for (size_t i = 0; i < face.size(); ++i) {
       const int from = face[i], to = face[(i + 1) % face.size()];
@@ -116,14 +126,16 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
       std::vector<int> faces;
       bool explainedByRepeat = false;  // a face running the edge twice is reported as such
       for (size_t i = begin; i < end; ++i) {
-        faces.push_back(uses[i].face);
+        faces.push_back(faceName(uses[i].face));
         explainedByRepeat = explainedByRepeat || faceHasRepeat[uses[i].face];
       }
       onBadEdge[first.low] = onBadEdge[first.high] = 1;
       if (!explainedByRepeat) {
         analysis.problems.push_back(
-            {MeshProblemKind::NonManifoldEdge, fmt::format("edge ({}, {}) is shared by {} faces {}", first.low,
-                                                           first.high, count, formatIndexList(faces))});
+            {MeshProblemKind::NonManifoldEdge,
+             fmt::format("edge ({}, {}) is shared by {} faces {}",
+                         std::min(vertexName(first.low), vertexName(first.high)),
+                         std::max(vertexName(first.low), vertexName(first.high)), count, formatIndexList(faces))});
       }
     }
     begin = end;
@@ -148,7 +160,7 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
       if (fanCount[v] > 1 && !onBadEdge[v]) {
         analysis.problems.push_back(
             {MeshProblemKind::BowTieVertex, fmt::format("vertex {} at {} is a bow-tie: its faces form {} separate fans",
-                                                        v, formatPoint(mesh.positions[v]), fanCount[v])});
+                                                        vertexName(v), formatPoint(mesh.positions[v]), fanCount[v])});
       }
     }
   }
@@ -185,7 +197,8 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
               {MeshProblemKind::NonOrientable,
                fmt::format("the surface is not orientable (a Moebius-like band): faces {} and {} cannot be oriented "
                            "consistently across edge ({}, {})",
-                           f, a.neighbour, a.low, a.high)});
+                           faceName(f), faceName(a.neighbour), std::min(vertexName(a.low), vertexName(a.high)),
+                           std::max(vertexName(a.low), vertexName(a.high)))});
         }
       }
     }
@@ -198,14 +211,9 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     if (2 * flipped > static_cast<long>(members.size()))
       for (int f : members) flip[f] = 1 - flip[f];
   }
-  for (int f = 0; f < mesh.faceCount(); ++f) {
-    if (flip[f] == 1) {
-      std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
-      ++analysis.flippedFaces;
-    }
-  }
-  // A closed orientable component faces outwards: its enclosed volume is positive.
-  int reversedComponents = 0;
+  // A closed orientable component faces outwards: its enclosed volume, with
+  // the consistent orientation applied, is positive.
+  std::vector<char> reverseComponent(componentCount, 0);
   if (topology.manifold && topology.orientable) {
     std::vector<double> volume(componentCount, 0.0);
     std::vector<char> closed(componentCount, 1);
@@ -214,20 +222,29 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
       for (int v : face)
         if (onBoundary[v]) closed[faceComponent[f]] = 0;
       const Point3& p0 = mesh.positions[face[0]];
+      double sixVolume = 0.0;
       for (size_t i = 1; i + 1 < face.size(); ++i) {
-        volume[faceComponent[f]] += p0.dot(mesh.positions[face[i]].cross(mesh.positions[face[i + 1]])) / 6.0;
+        sixVolume += p0.dot(mesh.positions[face[i]].cross(mesh.positions[face[i + 1]]));
       }
+      volume[faceComponent[f]] += flip[f] ? -sixVolume : sixVolume;
     }
-    for (int f = 0; f < mesh.faceCount(); ++f) {
-      if (closed[faceComponent[f]] && volume[faceComponent[f]] < 0.0) {
-        std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
-      }
-    }
-    for (int c = 0; c < componentCount; ++c) reversedComponents += closed[c] && volume[c] < 0.0;
+    for (int c = 0; c < componentCount; ++c) reverseComponent[c] = closed[c] && volume[c] < 0.0;
   }
-  if (analysis.flippedFaces > 0) {
-    analysis.notes.push_back(fmt::format("flipped {} face{} to make the orientation consistent", analysis.flippedFaces,
-                                         analysis.flippedFaces == 1 ? "" : "s"));
+  // Apply, and say what changed against the input, face by face.
+  int consistencyFlips = 0, reversedComponents = 0;
+  std::vector<char> hadRelativeFlips(componentCount, 0);
+  for (int f = 0; f < mesh.faceCount(); ++f) hadRelativeFlips[faceComponent[f]] |= flip[f];
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (flip[f] != reverseComponent[faceComponent[f]]) {
+      std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
+      ++analysis.flippedFaces;
+      if (hadRelativeFlips[faceComponent[f]]) ++consistencyFlips;
+    }
+  }
+  for (int c = 0; c < componentCount; ++c) reversedComponents += reverseComponent[c] && !hadRelativeFlips[c];
+  if (consistencyFlips > 0) {
+    analysis.notes.push_back(fmt::format("flipped {} face{} to make the orientation consistent", consistencyFlips,
+                                         consistencyFlips == 1 ? "" : "s"));
   }
   if (reversedComponents > 0) {
     analysis.notes.push_back(fmt::format("reversed all faces of {} closed component{} so that they face outwards",

@@ -3,6 +3,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <assimp/Importer.hpp>
 
 #include <algorithm>
@@ -28,6 +29,19 @@ bool startsWithWord(std::string_view line, std::string_view word) {
   line.remove_prefix(i);
   return line.size() > word.size() && line.substr(0, word.size()) == word &&
          (line[word.size()] == ' ' || line[word.size()] == '\t');
+}
+
+// Lines whose first word is `word`.
+long long countLinesStartingWith(std::string_view bytes, std::string_view word) {
+  long long count = 0;
+  size_t position = 0;
+  while (position < bytes.size()) {
+    size_t end = bytes.find('\n', position);
+    if (end == std::string_view::npos) end = bytes.size();
+    if (startsWithWord(bytes.substr(position, end - position), word)) ++count;
+    position = end + 1;
+  }
+  return count;
 }
 
 // The faces a file states, where that can be counted cheaply; Assimp's result
@@ -61,63 +75,73 @@ StatedFaces statedFaceCount(std::string_view bytes, const std::string& extension
       if (references >= 3) ++stated.count;
     }
   } else if (extension == "stl") {
-    const bool ascii = bytes.substr(0, 5) == "solid" && bytes.find("facet") != std::string_view::npos;
-    if (!ascii && bytes.size() >= 84) {
-      uint32_t triangles = 0;
-      std::memcpy(&triangles, bytes.data() + 80, 4);
+    // Binary when the size is exactly what the header's triangle count makes it
+    // (some binary headers start with "solid"), or when it does not start, after
+    // white space, with "solid" (as Assimp decides).
+    uint32_t triangles = 0;
+    if (bytes.size() >= 84) std::memcpy(&triangles, bytes.data() + 80, 4);
+    const bool exactBinary = bytes.size() >= 84 && bytes.size() == 84 + 50ull * triangles;
+    const size_t text = bytes.find_first_not_of(" \t\r\n");
+    const bool looksAscii = text != std::string_view::npos && bytes.substr(text, 5) == "solid";
+    if (exactBinary || (!looksAscii && bytes.size() >= 84)) {
       stated.count = triangles;
       if (bytes.size() < 84 + 50ull * triangles) {
         throw InvalidMeshError(fmt::format("truncated: the binary STL header states {} triangles, the file holds {}",
                                            triangles, (bytes.size() - 84) / 50));
       }
-    } else if (ascii) {
-      stated.count = 0;
-      size_t position = 0;
-      while ((position = bytes.find("facet", position)) != std::string_view::npos) {
-        const bool isEndFacet = position >= 3 && bytes.substr(position - 3, 3) == "end";
-        if (!isEndFacet) ++stated.count;
-        position += 5;
-      }
+    } else if (looksAscii) {
+      stated.count = countLinesStartingWith(bytes, "facet");
     }
   }
   return stated;
 }
 
-void appendScene(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parentTransform, PolygonMesh& mesh,
-                 long long& polygonCount, long long& faceCount) {
-  const aiMatrix4x4 transform = parentTransform * node.mTransformation;
-  for (unsigned n = 0; n < node.mNumMeshes; ++n) {
-    if (node.mMeshes[n] >= scene.mNumMeshes) continue;
-    const aiMesh& source = *scene.mMeshes[node.mMeshes[n]];
-    const int base = mesh.vertexCount();
-    for (unsigned v = 0; v < source.mNumVertices; ++v) {
-      // Checked before the transform, which would spread a NaN to all three coordinates.
-      const Point3 raw(source.mVertices[v].x, source.mVertices[v].y, source.mVertices[v].z);
-      if (!raw.allFinite()) {
-        throw InvalidMeshError(fmt::format("vertex {} has a non-finite coordinate {}", base + v, formatPoint(raw)));
-      }
-      const aiVector3D p = transform * source.mVertices[v];
-      mesh.positions.emplace_back(p.x, p.y, p.z);
-    }
-    for (unsigned f = 0; f < source.mNumFaces; ++f) {
-      const aiFace& face = source.mFaces[f];
-      ++faceCount;
-      if (face.mNumIndices < 3) continue;  // points and lines are not surface
-      ++polygonCount;
-      std::vector<int> corners;
-      corners.reserve(face.mNumIndices);
-      for (unsigned i = 0; i < face.mNumIndices; ++i) {
-        if (face.mIndices[i] >= source.mNumVertices) {
-          throw InvalidMeshError(fmt::format("face {} refers to vertex {}, but its mesh has {} vertices", faceCount - 1,
-                                             face.mIndices[i], source.mNumVertices));
+// Appends every mesh instance of the scene with its node transform (an explicit
+// stack: a deep node tree in a hostile file must not overflow ours).
+void appendScene(const aiScene& scene, PolygonMesh& mesh, long long& polygonCount, long long& faceCount) {
+  std::vector<std::pair<const aiNode*, aiMatrix4x4>> pending{{scene.mRootNode, aiMatrix4x4()}};
+  while (!pending.empty()) {
+    auto [node, parentTransform] = pending.back();
+    pending.pop_back();
+    const aiMatrix4x4 transform = parentTransform * node->mTransformation;
+    for (unsigned n = 0; n < node->mNumMeshes; ++n) {
+      if (!scene.mMeshes || node->mMeshes[n] >= scene.mNumMeshes || !scene.mMeshes[node->mMeshes[n]]) continue;
+      const aiMesh& source = *scene.mMeshes[node->mMeshes[n]];
+      if (!source.mVertices || !source.mFaces) continue;
+      const int base = mesh.vertexCount();
+      for (unsigned v = 0; v < source.mNumVertices; ++v) {
+        // Checked before the transform, which would spread a NaN to all three coordinates.
+        const Point3 raw(source.mVertices[v].x, source.mVertices[v].y, source.mVertices[v].z);
+        if (!raw.allFinite()) {
+          throw InvalidMeshError(fmt::format("vertex {} has a non-finite coordinate {}", base + v, formatPoint(raw)));
         }
-        corners.push_back(base + static_cast<int>(face.mIndices[i]));
+        const aiVector3D p = transform * source.mVertices[v];
+        mesh.positions.emplace_back(p.x, p.y, p.z);
+        if (!mesh.positions.back().allFinite()) {
+          throw InvalidMeshError(fmt::format("vertex {} at {}: the scene's node transform makes it non-finite {}",
+                                             base + v, formatPoint(raw), formatPoint(mesh.positions.back())));
+        }
       }
-      mesh.faces.push_back(std::move(corners));
+      for (unsigned f = 0; f < source.mNumFaces; ++f) {
+        const aiFace& face = source.mFaces[f];
+        ++faceCount;
+        if (face.mNumIndices < 3 || !face.mIndices) continue;  // points and lines are not surface
+        ++polygonCount;
+        std::vector<int> corners;
+        corners.reserve(face.mNumIndices);
+        for (unsigned i = 0; i < face.mNumIndices; ++i) {
+          if (face.mIndices[i] >= source.mNumVertices) {
+            throw InvalidMeshError(fmt::format("face {} refers to vertex {}, but its mesh has {} vertices",
+                                               faceCount - 1, face.mIndices[i], source.mNumVertices));
+          }
+          corners.push_back(base + static_cast<int>(face.mIndices[i]));
+        }
+        mesh.faces.push_back(std::move(corners));
+      }
     }
-  }
-  for (unsigned c = 0; c < node.mNumChildren; ++c) {
-    appendScene(scene, *node.mChildren[c], transform, mesh, polygonCount, faceCount);
+    for (unsigned c = 0; c < node->mNumChildren; ++c) {
+      if (node->mChildren && node->mChildren[c]) pending.emplace_back(node->mChildren[c], transform);
+    }
   }
 }
 
@@ -130,13 +154,15 @@ std::string firstLine(const char* text) {
 PolygonMesh readWithAssimp(std::string_view bytes, const std::string& extension, const std::filesystem::path* path) {
   const StatedFaces stated = statedFaceCount(bytes, extension);
   Assimp::Importer importer;
-  // No post-processing: polygons stay polygons; we weld and validate ourselves.
-  const aiScene* scene = path ? importer.ReadFile(path->string(), 0)
-                              : importer.ReadFileFromMemory(bytes.data(), bytes.size(), 0, extension.c_str());
+  // No post-processing that changes the mesh: polygons stay polygons, we weld
+  // ourselves; Assimp's own validation refuses broken scene structures.
+  constexpr unsigned kFlags = aiProcess_ValidateDataStructure;
+  const aiScene* scene = path ? importer.ReadFile(path->string(), kFlags)
+                              : importer.ReadFileFromMemory(bytes.data(), bytes.size(), kFlags, extension.c_str());
   if (!scene || !scene->mRootNode) throw InvalidMeshError(firstLine(importer.GetErrorString()));
   PolygonMesh mesh;
   long long polygons = 0, faces = 0;
-  appendScene(*scene, *scene->mRootNode, aiMatrix4x4(), mesh, polygons, faces);
+  appendScene(*scene, mesh, polygons, faces);
   const long long read = stated.polygonsOnly ? polygons : faces;
   if (stated.count >= 0 && read < stated.count) {
     throw InvalidMeshError(fmt::format(
@@ -155,20 +181,27 @@ PolygonMesh readAny(std::string_view bytes, const std::string& extension, const 
 ImportedMesh finishImport(PolygonMesh mesh) {
   ImportedMesh result;
   const CleaningReport report = cleanMesh(mesh);
-  if (report.droppedFaces > 0 || report.droppedVertices > 0) {
-    result.warnings.push_back(fmt::format(
-        "dropped {} face{} with fewer than 3 distinct vertices and {} unreferenced vertex{}", report.droppedFaces,
-        report.droppedFaces == 1 ? "" : "s", report.droppedVertices, report.droppedVertices == 1 ? "" : "es"));
+  std::vector<std::string> dropped;
+  if (report.droppedFaces > 0) {
+    dropped.push_back(fmt::format("{} face{} with fewer than 3 distinct vertices", report.droppedFaces,
+                                  report.droppedFaces == 1 ? "" : "s"));
   }
+  if (report.droppedVertices > 0) {
+    dropped.push_back(
+        fmt::format("{} unreferenced vert{}", report.droppedVertices, report.droppedVertices == 1 ? "ex" : "ices"));
+  }
+  if (!dropped.empty()) result.warnings.push_back(fmt::format("dropped {}", fmt::join(dropped, " and ")));
   if (mesh.faces.empty()) throw InvalidMeshError("the file holds no polygon faces");
   result.mesh = std::move(mesh);
   return result;
 }
 
-ImportedMesh importBytes(std::string_view bytes, std::string_view extension, std::string_view displayName,
-                         const std::filesystem::path* path) {
+// Runs `read` and turns every failure into one InvalidMeshError line that
+// starts with the file's name: nothing else escapes an import.
+template <typename Read>
+ImportedMesh withFileName(std::string_view displayName, Read read) {
   try {
-    return finishImport(readAny(bytes, lowercase(extension), path));
+    return read();
   } catch (const InvalidMeshError& error) {
     throw InvalidMeshError(fmt::format("{}: {}", displayName, error.what()));
   } catch (const std::bad_alloc&) {
@@ -179,25 +212,45 @@ ImportedMesh importBytes(std::string_view bytes, std::string_view extension, std
   }
 }
 
+// Reads a whole regular file; refuses FIFOs and devices (which could block or
+// never end) and says why a file cannot be opened.
+std::string readRegularFile(const std::filesystem::path& path) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (status.type() == std::filesystem::file_type::not_found) throw InvalidMeshError("no such file");
+  if (error) throw InvalidMeshError(fmt::format("cannot read the file: {}", error.message()));
+  if (status.type() == std::filesystem::file_type::directory) throw InvalidMeshError("is a directory, not a mesh file");
+  if (status.type() != std::filesystem::file_type::regular) {
+    throw InvalidMeshError("is not a regular file (a pipe, device or socket); save the mesh to a file first");
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (!file) throw InvalidMeshError(fmt::format("cannot open the file: {}", std::strerror(errno)));
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(file, &std::fclose);
+  std::string bytes;
+  char buffer[1 << 16];
+  size_t got;
+  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) bytes.append(buffer, got);
+  if (std::ferror(file)) throw InvalidMeshError(fmt::format("cannot read the file: {}", std::strerror(errno)));
+  return bytes;
+}
+
+std::string extensionOf(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  return lowercase(extension);
+}
+
 }  // namespace
 
 ImportedMesh importMesh(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  std::error_code error;
-  if (!std::filesystem::exists(path, error)) throw InvalidMeshError(fmt::format("{}: no such file", name));
-  if (std::filesystem::is_directory(path, error))
-    throw InvalidMeshError(fmt::format("{}: is a directory, not a mesh file", name));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InvalidMeshError(fmt::format("{}: cannot open the file: {}", name, std::strerror(errno)));
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InvalidMeshError(fmt::format("{}: cannot read the file: {}", name, std::strerror(errno)));
-  std::string extension = path.extension().string();
-  if (!extension.empty()) extension.erase(0, 1);
-  return importBytes(bytes, extension, name, &path);
+  return withFileName(path.string(), [&] {
+    const std::string bytes = readRegularFile(path);
+    return finishImport(readAny(bytes, extensionOf(path), &path));
+  });
 }
 
 ImportedMesh importMeshFromMemory(std::string_view bytes, std::string_view extension, std::string_view displayName) {
-  return importBytes(bytes, extension, displayName, nullptr);
+  return withFileName(displayName, [&] { return finishImport(readAny(bytes, lowercase(extension), nullptr)); });
 }
 
 CleaningReport cleanMesh(PolygonMesh& mesh) {
@@ -206,7 +259,7 @@ CleaningReport cleanMesh(PolygonMesh& mesh) {
   struct PositionHash {
     size_t operator()(const Point3& p) const {
       size_t h = 0;
-      for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>{}(p[i] == 0.0 ? 0.0 : p[i]);
+      for (int i = 0; i < 3; ++i) h = h * 1000003u ^ std::hash<double>{}(p[i]);
       return h;
     }
   };
@@ -220,15 +273,15 @@ CleaningReport cleanMesh(PolygonMesh& mesh) {
     Point3 key = mesh.positions[v];
     for (int i = 0; i < 3; ++i)
       if (key[i] == 0.0) key[i] = 0.0;  // -0 welds with +0
-    auto [it, inserted] = firstAt.emplace(key, v);
-    weldedTo[v] = it->second;
-    if (!inserted) ++report.weldedVertices;
+    weldedTo[v] = firstAt.emplace(key, v).first->second;
   }
 
   std::vector<std::vector<int>> kept;
+  std::vector<int> keptSource;
   kept.reserve(mesh.faces.size());
   std::vector<char> referenced(mesh.positions.size(), 0);
-  for (auto& face : mesh.faces) {
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    const auto& face = mesh.faces[f];
     std::vector<int> corners;
     corners.reserve(face.size());
     for (int v : face) {
@@ -244,10 +297,12 @@ CleaningReport cleanMesh(PolygonMesh& mesh) {
     }
     for (int v : corners) referenced[v] = 1;
     kept.push_back(std::move(corners));
+    keptSource.push_back(mesh.sourceFaceIndex(f));
   }
 
   std::vector<int> newIndex(mesh.positions.size(), -1);
   std::vector<Point3> positions;
+  std::vector<int> positionSource;
   for (int v = 0; v < mesh.vertexCount(); ++v) {
     if (weldedTo[v] != v) continue;
     if (!referenced[v]) {
@@ -256,11 +311,14 @@ CleaningReport cleanMesh(PolygonMesh& mesh) {
     }
     newIndex[v] = static_cast<int>(positions.size());
     positions.push_back(mesh.positions[v]);
+    positionSource.push_back(mesh.sourceVertexIndex(v));
   }
   for (auto& face : kept)
     for (int& v : face) v = newIndex[v];
   mesh.positions = std::move(positions);
   mesh.faces = std::move(kept);
+  mesh.sourceVertex = std::move(positionSource);
+  mesh.sourceFace = std::move(keptSource);
   return report;
 }
 

@@ -15,21 +15,17 @@
 namespace rotafab::geometry {
 namespace {
 
-std::optional<double> parseReal(std::string_view token) {
+// The whole token as a number (from_chars, plus an optional leading '+').
+template <typename Number>
+std::optional<Number> parseNumber(std::string_view token) {
   if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  double value = 0;
+  Number value{};
   auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
   if (error != std::errc() || end != token.data() + token.size()) return std::nullopt;
   return value;
 }
-
-std::optional<long long> parseInteger(std::string_view token) {
-  if (!token.empty() && token.front() == '+') token.remove_prefix(1);
-  long long value = 0;
-  auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (error != std::errc() || end != token.data() + token.size()) return std::nullopt;
-  return value;
-}
+std::optional<double> parseReal(std::string_view token) { return parseNumber<double>(token); }
+std::optional<long long> parseInteger(std::string_view token) { return parseNumber<long long>(token); }
 
 bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; }
 
@@ -91,11 +87,7 @@ long long countFrom(std::string_view token, int line, const char* what) {
 }
 
 void checkFinite(const Point3& p, long long vertex, int line) {
-  if (!p.allFinite()) {
-    throw InvalidMeshError(
-        line > 0 ? fmt::format("line {}: vertex {} has a non-finite coordinate {}", line, vertex, formatPoint(p))
-                 : fmt::format("vertex {} has a non-finite coordinate {}", vertex, formatPoint(p)));
-  }
+  if (!p.allFinite()) failAtLine(line, fmt::format("vertex {} has a non-finite coordinate {}", vertex, formatPoint(p)));
 }
 
 }  // namespace
@@ -295,6 +287,10 @@ class PlyValues {
   }
 
   [[nodiscard]] size_t remainingBytes() const { return body_.size() - position_; }
+  // "line N: " in an ASCII body (the line of the value read last), "" in a binary one.
+  [[nodiscard]] std::string where() const {
+    return format_ == PlyFormat::Ascii ? fmt::format("line {}: ", line_) : std::string();
+  }
 
  private:
   template <typename T>
@@ -314,7 +310,8 @@ class PlyValues {
 
 PolygonMesh readPly(std::string_view bytes) {
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
-  const size_t headerEnd = bytes.find("end_header");
+  size_t headerEnd = bytes.find("\nend_header");  // at the start of a line, not inside a comment
+  if (headerEnd != std::string_view::npos) ++headerEnd;
   if (bytes.substr(0, 3) != "ply") throw InvalidMeshError("line 1: expected 'ply'");
   if (headerEnd == std::string_view::npos) throw InvalidMeshError("truncated: the header has no end_header line");
   size_t bodyStart = bytes.find('\n', headerEnd);
@@ -346,7 +343,8 @@ PolygonMesh readPly(std::string_view bytes) {
       if (w.size() >= 5 && w[1] == "list") {
         auto countType = plyTypeNamed(w[2]);
         auto type = plyTypeNamed(w[3]);
-        if (!countType || !type) failAtLine(line, fmt::format("unknown property type in list {}", quoted(w[4])));
+        if (!countType) failAtLine(line, fmt::format("unknown list count type {}", quoted(w[2])));
+        if (!type) failAtLine(line, fmt::format("unknown list value type {}", quoted(w[3])));
         property = {std::string(w[4]), *type, true, *countType};
       } else if (w.size() >= 3 && w[1] != "list") {
         auto type = plyTypeNamed(w[1]);
@@ -380,6 +378,7 @@ PolygonMesh readPly(std::string_view bytes) {
   const int bodyLine = 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + bodyStart, '\n'));
   PlyValues values(bytes.substr(bodyStart), *format, bodyLine);
   PolygonMesh mesh;
+  std::vector<std::string> faceWhere;  // where each face was read, for the index check below
   long long vertexCount = 0;
   for (const auto& element : elements) {
     const bool isVertex = &element == vertexElement;
@@ -399,11 +398,11 @@ PolygonMesh readPly(std::string_view bytes) {
     if (element.count > static_cast<long long>(values.remainingBytes())) {
       throw InvalidMeshError(
           fmt::format("truncated: the header states {} {} elements, more than the {} bytes left can hold",
-                      element.count, element.name, values.remainingBytes()));
+                      element.count, quoted(element.name), values.remainingBytes()));
     }
     auto truncated = [&](long long read) {
       return InvalidMeshError(fmt::format("truncated: the header states {} {} elements, the file ends after {}",
-                                          element.count, element.name, read));
+                                          element.count, quoted(element.name), read));
     };
     for (long long i = 0; i < element.count; ++i) {
       Point3 p = Point3::Zero();
@@ -414,14 +413,15 @@ PolygonMesh readPly(std::string_view bytes) {
           auto size = values.next(property.countType);
           if (!size) throw truncated(i);
           if (*size < 0 || *size != std::floor(*size) || *size > 1e6) {
-            throw InvalidMeshError(fmt::format("{} {}: {} is not a list length", element.name, i, *size));
+            throw InvalidMeshError(
+                fmt::format("{}{} {}: {} is not a list length", values.where(), quoted(element.name), i, *size));
           }
           for (long long k = 0; k < static_cast<long long>(*size); ++k) {
             auto value = values.next(property.type);
             if (!value) throw truncated(i);
             if (static_cast<int>(pi) == faceList) {
               if (*value != std::floor(*value) || *value < 0 || *value > 2147483647.0) {
-                throw InvalidMeshError(fmt::format("face {}: {} is not a vertex index", i, *value));
+                throw InvalidMeshError(fmt::format("{}face {}: {} is not a vertex index", values.where(), i, *value));
               }
               face.push_back(static_cast<int>(*value));
             }
@@ -436,18 +436,24 @@ PolygonMesh readPly(std::string_view bytes) {
         }
       }
       if (isVertex) {
-        checkFinite(p, i, 0);
+        if (!p.allFinite()) {
+          throw InvalidMeshError(
+              fmt::format("{}vertex {} has a non-finite coordinate {}", values.where(), i, formatPoint(p)));
+        }
         mesh.positions.push_back(p);
       }
-      if (isFace) mesh.faces.push_back(std::move(face));
+      if (isFace) {
+        mesh.faces.push_back(std::move(face));
+        faceWhere.push_back(values.where());
+      }
     }
     if (isVertex) vertexCount = element.count;
   }
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int index : mesh.faces[f]) {
       if (index >= vertexCount) {
-        throw InvalidMeshError(fmt::format("face {} refers to vertex {}, but the file has {} vertices (0 to {})", f,
-                                           index, vertexCount, vertexCount - 1));
+        throw InvalidMeshError(fmt::format("{}face {} refers to vertex {}, but the file has {} vertices (0 to {})",
+                                           faceWhere[f], f, index, vertexCount, vertexCount - 1));
       }
     }
   }

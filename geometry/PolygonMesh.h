@@ -17,9 +17,16 @@ using Point3 = Eigen::Vector3d;
 struct PolygonMesh {
   std::vector<Point3> positions;
   std::vector<std::vector<int>> faces;
+  // Where each vertex and face was read from (its index in the file for OFF
+  // and PLY, in the importer's order otherwise), so that messages name what a
+  // user can find; empty when the mesh was not cleaned from a file.
+  std::vector<int> sourceVertex;
+  std::vector<int> sourceFace;
 
   [[nodiscard]] int vertexCount() const { return static_cast<int>(positions.size()); }
   [[nodiscard]] int faceCount() const { return static_cast<int>(faces.size()); }
+  [[nodiscard]] int sourceVertexIndex(int v) const { return sourceVertex.empty() ? v : sourceVertex[v]; }
+  [[nodiscard]] int sourceFaceIndex(int f) const { return sourceFace.empty() ? f : sourceFace[f]; }
 };
 
 // Thrown when an input mesh cannot be used. The message is one line naming the

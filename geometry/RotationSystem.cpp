@@ -55,14 +55,14 @@ RotationSystem RotationSystem::fromMesh(const PolygonMesh& mesh) {
     int same = -1, sameCount = 0, twin = -1, twinCount = 0;
     cornersFromTo(u, v, same, sameCount);
     cornersFromTo(v, u, twin, twinCount);
+    if (sameCount + twinCount > 2) {
+      throw InvalidMeshError(
+          fmt::format("edge ({}, {}) is shared by more than two faces", std::min(u, v), std::max(u, v)));
+    }
     if (sameCount > 1) {
       throw InvalidMeshError(
           fmt::format("edge ({}, {}) is run in the same direction by two faces: the mesh is not consistently oriented",
                       std::min(u, v), std::max(u, v)));
-    }
-    if (twinCount > 1) {
-      throw InvalidMeshError(
-          fmt::format("edge ({}, {}) is shared by more than two faces", std::min(u, v), std::max(u, v)));
     }
     const Dart d = static_cast<Dart>(rs.origin_.size());
     rs.origin_.insert(rs.origin_.end(), {u, v});
@@ -75,6 +75,8 @@ RotationSystem RotationSystem::fromMesh(const PolygonMesh& mesh) {
   rs.facePrev_.assign(darts, -1);
   rs.twist_.assign(darts / 2, 0);
   rs.outgoing_.assign(mesh.positions.size(), -1);
+  rs.faceDart_.resize(mesh.faces.size());
+  for (int f = 0; f < mesh.faceCount(); ++f) rs.faceDart_[f] = dartOfCorner[faceStart[f]];
   for (int f = 0; f < mesh.faceCount(); ++f) {
     for (int c = faceStart[f]; c < faceStart[f + 1]; ++c) {
       const Dart next = dartOfCorner[c + 1 < faceStart[f + 1] ? c + 1 : faceStart[f]];
@@ -118,6 +120,17 @@ RotationSystem RotationSystem::fromMesh(const PolygonMesh& mesh) {
   return rs;
 }
 
+std::vector<Dart> RotationSystem::dartsAround(int v) const {
+  std::vector<Dart> darts;
+  const Dart first = outgoing_[v];
+  Dart d = first;
+  do {
+    darts.push_back(d);
+    d = rotateBack(d);
+  } while (d != first);
+  return darts;
+}
+
 int RotationSystem::valence(int v) const {
   int count = 0;
   Dart d = outgoing_[v];
@@ -129,14 +142,5 @@ int RotationSystem::valence(int v) const {
 }
 
 bool RotationSystem::isBoundaryVertex(int v) const { return face_[outgoing_[v]] < 0; }
-
-Dart RotationSystem::findDart(int u, int v) const {
-  Dart d = outgoing_[u];
-  do {
-    if (target(d) == v) return d;
-    d = rotate(d);
-  } while (d != outgoing_[u]);
-  return -1;
-}
 
 }  // namespace rotafab::geometry

@@ -46,12 +46,15 @@ class RotationSystem {
   [[nodiscard]] Dart faceNext(Dart d) const { return faceNext_[d]; }
   [[nodiscard]] Dart facePrev(Dart d) const { return facePrev_[d]; }
 
-  // Some dart leaving v.
+  // Some dart leaving v; on a boundary vertex, the one on the open side.
   [[nodiscard]] Dart dartFrom(int v) const { return outgoing_[v]; }
+  // The darts leaving v, counter-clockwise seen from outside (rotateBack order),
+  // starting with dartFrom(v).
+  [[nodiscard]] std::vector<Dart> dartsAround(int v) const;
+  // The dart of face f's first corner (it leaves faces[f][0]); faceNext walks the rest in order.
+  [[nodiscard]] Dart faceDart(int f) const { return faceDart_[f]; }
   [[nodiscard]] int valence(int v) const;
   [[nodiscard]] bool isBoundaryVertex(int v) const;
-  // The dart of edge (u, v) leaving u, or -1.
-  [[nodiscard]] Dart findDart(int u, int v) const;
 
   // Extended twist (III.1.2): k > 0 for a k+-twisted edge, k < 0 for k-.
   // Face tracing uses its parity as the edge type.
@@ -66,6 +69,7 @@ class RotationSystem {
   std::vector<Dart> faceNext_;
   std::vector<Dart> facePrev_;
   std::vector<Dart> outgoing_;
+  std::vector<Dart> faceDart_;
   std::vector<int> twist_;
 };
 

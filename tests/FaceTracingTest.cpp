@@ -27,11 +27,22 @@ std::vector<size_t> lengths(const std::vector<TracedWalk>& walks) {
   return out;
 }
 
-// Each corner (and so each dart position) belongs to exactly one walk.
+// Recomputes, from each walk's darts and trace types alone, the corner it
+// turns at between consecutive darts, checks that step is Next(reverse, t) of
+// FaceTrace, and that every corner of the rotation system is turned exactly once.
 void expectEveryCornerOnce(const RotationSystem& rs, const std::vector<TracedWalk>& walks) {
-  size_t total = 0;
-  for (const auto& w : walks) total += w.darts.size();
-  EXPECT_EQ(total, static_cast<size_t>(rs.dartCount()));
+  std::vector<int> turns(rs.dartCount(), 0);
+  for (const auto& walk : walks) {
+    const size_t n = walk.darts.size();
+    for (size_t i = 0; i < n; ++i) {
+      const Dart arriving = RotationSystem::reverse(walk.darts[i]);
+      const Dart next = walk.darts[(i + 1) % n];
+      const int t = walk.traceTypes[(i + 1) % n];  // the type after crossing darts[i]'s edge
+      ASSERT_EQ(next, t == 0 ? rs.rotate(arriving) : rs.rotateBack(arriving)) << "not a FaceTrace step";
+      ++turns[t == 0 ? arriving : next];  // corner (x, rotate(x)) is numbered x
+    }
+  }
+  for (Dart corner = 0; corner < rs.dartCount(); ++corner) EXPECT_EQ(turns[corner], 1) << "corner " << corner;
 }
 
 TEST(FaceTracing, WithoutTwistsTheWalksAreTheFacesAndTheBoundaries) {

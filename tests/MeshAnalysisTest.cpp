@@ -58,6 +58,18 @@ TEST(MeshAnalysis, BowTieVertexIsNamed) {
   EXPECT_FALSE(analysis.topology.manifold);
 }
 
+TEST(MeshAnalysis, HolesTouchingAtABowTieAreTwoLoops) {
+  // Two triangles sharing only vertex 0: a walk along the boundary finds two loops.
+  PolygonMesh mesh;
+  mesh.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}};
+  mesh.faces = {{0, 1, 2}, {0, 3, 4}};
+  const MeshAnalysis analysis = analyzeMesh(mesh);
+  EXPECT_EQ(analysis.topology.boundaryLoops, 2);
+  EXPECT_EQ(analysis.topology.components, 1);
+  ASSERT_EQ(analysis.problems.size(), 1u);
+  EXPECT_EQ(analysis.problems[0].kind, MeshProblemKind::BowTieVertex);
+}
+
 TEST(MeshAnalysis, InconsistentOrientationIsRepairedAndSaid) {
   PolygonMesh mesh = cube();
   std::reverse(mesh.faces[1].begin(), mesh.faces[1].end());

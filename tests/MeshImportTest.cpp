@@ -10,7 +10,9 @@
 #include <assimp/Importer.hpp>
 
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <cmath>
+
 #include <cstring>
 
 #include "TestSupport.h"
@@ -166,8 +168,9 @@ TEST(MeshImport, PlyAsciiAndBinaryInBothByteOrders) {
     EXPECT_EQ(imported.mesh.positions[2], Point3(1, 1, 0));
   }
   const std::string truncated = "ply\nformat binary_little_endian 1.0\n" + header + binaryBody(false);
-  EXPECT_EQ(refusal(dir.write("t.ply", truncated.substr(0, truncated.size() - 5))),
-            (dir.path() / "t.ply").string() + ": truncated: the header states 2 face elements, the file ends after 1");
+  EXPECT_EQ(
+      refusal(dir.write("t.ply", truncated.substr(0, truncated.size() - 5))),
+      (dir.path() / "t.ply").string() + ": truncated: the header states 2 'face' elements, the file ends after 1");
 }
 
 // Formats Assimp writes as well as reads: a round trip through its exporter.
@@ -232,7 +235,7 @@ TEST(MeshImport, EveryUnreadableInputIsRefusedWithOneLine) {
       {"range.ply",
        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
        "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n",
-       "face 0 refers to vertex 3, but the file has 3 vertices (0 to 2)"},
+       "line 13: face 0 refers to vertex 3, but the file has 3 vertices (0 to 2)"},
       {"noheader.ply", "ply\nformat ascii 1.0\nelement vertex 3\n", "truncated: the header has no end_header line"},
       {"mesh.xyz", "1 2 3\n", "No suitable reader found for the file format of file \"" + d + "mesh.xyz\"."},
   };
@@ -242,6 +245,91 @@ TEST(MeshImport, EveryUnreadableInputIsRefusedWithOneLine) {
   }
   EXPECT_EQ(refusal(dir.path() / "missing.obj"), d + "missing.obj: no such file");
   EXPECT_EQ(refusal(dir.path()), dir.path().string() + ": is a directory, not a mesh file");
+}
+
+TEST(MeshImport, PipesAndDevicesAreRefusedNotWaitedOn) {
+  TempDir dir;
+  const auto fifo = dir.path() / "mesh.obj";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_EQ(refusal(fifo),
+            fifo.string() + ": is not a regular file (a pipe, device or socket); save the mesh to a file first");
+  EXPECT_EQ(refusal("/dev/zero"),
+            "/dev/zero: is not a regular file (a pipe, device or socket); save the mesh to a file first");
+}
+
+// After welding and dropping, messages still name vertices and faces as the file numbers them.
+TEST(MeshImport, MessagesUseTheFilesNumberingAfterCleaning) {
+  TempDir dir;
+  // Vertex 0 is unused, vertex 6 duplicates vertex 1, face 0 is degenerate:
+  // cleaning renumbers everything, yet the fin edge is (1, 2) in faces 1, 2, 3.
+  const auto path = dir.write("fin.off",
+                              "OFF\n7 4 0\n9 9 9\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 0\n"
+                              "3 1 1 2\n3 1 2 3\n3 2 6 4\n3 1 2 5\n");
+  ImportedMesh imported = importMesh(path);
+  const MeshAnalysis analysis = analyzeMesh(imported.mesh);
+  ASSERT_EQ(analysis.problems.size(), 1u);
+  EXPECT_EQ(analysis.problems[0].message, "edge (1, 2) is shared by 3 faces (1, 2, 3)");
+}
+
+// A base64 data URI for a glTF buffer.
+std::string base64(const std::string& bytes) {
+  static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    const size_t n = std::min<size_t>(3, bytes.size() - i);
+    uint32_t chunk = 0;
+    for (size_t k = 0; k < 3; ++k) chunk = chunk << 8 | (k < n ? static_cast<uint8_t>(bytes[i + k]) : 0u);
+    for (size_t k = 0; k < 4; ++k) out += k <= n ? kAlphabet[(chunk >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+// A glTF 2.0 scene of one tetrahedron mesh placed by two nodes.
+std::string gltfWithTwoInstances(const std::string& firstNode, const std::string& secondNode) {
+  const PolygonMesh tet = tetrahedron();
+  std::string buffer;
+  for (const auto& p : tet.positions) {
+    for (int a = 0; a < 3; ++a) {
+      const float c = static_cast<float>(p[a]);
+      buffer.append(reinterpret_cast<const char*>(&c), 4);
+    }
+  }
+  for (const auto& face : tet.faces) {
+    for (int v : face) {
+      const uint16_t index = static_cast<uint16_t>(v);
+      buffer.append(reinterpret_cast<const char*>(&index), 2);
+    }
+  }
+  return fmt::format(
+      R"({{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],)"
+      R"("nodes":[{},{}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],)"
+      R"("buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}],)"
+      R"("bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":48}},{{"buffer":0,"byteOffset":48,"byteLength":24}}],)"
+      R"("accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-1,-1,-1],"max":[1,1,1]}},)"
+      R"({{"bufferView":1,"componentType":5123,"count":12,"type":"SCALAR"}}]}})",
+      firstNode, secondNode, buffer.size(), base64(buffer));
+}
+
+TEST(MeshImport, GltfNodeTransformsPlaceEveryInstance) {
+  TempDir dir;
+  const auto path = dir.write("two.gltf", gltfWithTwoInstances(R"({"mesh":0,"translation":[10,0,0]})",
+                                                               R"({"mesh":0,"translation":[-10,0,0]})"));
+  const ImportedMesh imported = importMesh(path);
+  const MeshTopology t = test::topologyOf(imported.mesh);
+  EXPECT_EQ(t.components, 2);
+  EXPECT_EQ(t.vertices, 8);
+  EXPECT_EQ(t.genus, 0);
+  double minX = 1e9, maxX = -1e9;
+  for (const auto& p : imported.mesh.positions) {
+    minX = std::min(minX, p.x());
+    maxX = std::max(maxX, p.x());
+  }
+  EXPECT_DOUBLE_EQ(minX, -11.0);
+  EXPECT_DOUBLE_EQ(maxX, 11.0);
+  // A transform that overflows single precision is refused, not passed on as infinities.
+  const auto huge =
+      dir.write("huge.gltf", gltfWithTwoInstances(R"({"mesh":0,"scale":[3e38,3e38,3e38],"translation":[3e38,0,0]})", R"({"mesh":0})"));
+  EXPECT_NE(refusal(huge).find("the scene's node transform makes it non-finite"), std::string::npos) << refusal(huge);
 }
 
 // Whatever the bytes, import ends in a mesh or an InvalidMeshError: never a
