@@ -12,6 +12,7 @@
 #include <fstream>
 #include <unordered_map>
 
+#include "geometry/IsolatedCall.h"
 #include "geometry/MeshReaders.h"
 
 namespace rotafab::geometry {
@@ -171,11 +172,93 @@ PolygonMesh readWithAssimp(std::string_view bytes, const std::string& extension,
   return mesh;
 }
 
+// The mesh as bytes, to come back from the child process that read it.
+std::string serialize(const PolygonMesh& mesh) {
+  std::string out;
+  auto put = [&](const auto& value) { out.append(reinterpret_cast<const char*>(&value), sizeof value); };
+  put(static_cast<uint64_t>(mesh.positions.size()));
+  for (const Point3& p : mesh.positions) {
+    for (int axis = 0; axis < 3; ++axis) put(p[axis]);
+  }
+  put(static_cast<uint64_t>(mesh.faces.size()));
+  for (const auto& face : mesh.faces) {
+    put(static_cast<uint32_t>(face.size()));
+    out.append(reinterpret_cast<const char*>(face.data()), face.size() * sizeof(int));
+  }
+  return out;
+}
+
+PolygonMesh deserialize(std::string_view bytes) {
+  size_t at = 0;
+  auto get = [&](auto& value) {
+    if (bytes.size() - at < sizeof value) throw InvalidMeshError("the reader's result was cut short");
+    std::memcpy(&value, bytes.data() + at, sizeof value);
+    at += sizeof value;
+  };
+  PolygonMesh mesh;
+  uint64_t vertices = 0, faces = 0;
+  get(vertices);
+  mesh.positions.resize(std::min<uint64_t>(vertices, bytes.size() / (3 * sizeof(double))));
+  for (auto& p : mesh.positions) {
+    for (int axis = 0; axis < 3; ++axis) get(p[axis]);
+  }
+  get(faces);
+  mesh.faces.reserve(std::min<uint64_t>(faces, bytes.size() / 4));
+  for (uint64_t f = 0; f < faces; ++f) {
+    uint32_t size = 0;
+    get(size);
+    if (bytes.size() - at < size * sizeof(int)) throw InvalidMeshError("the reader's result was cut short");
+    std::vector<int> face(size);
+    std::memcpy(face.data(), bytes.data() + at, size * sizeof(int));
+    at += size * sizeof(int);
+    mesh.faces.push_back(std::move(face));
+  }
+  return mesh;
+}
+
+// Assimp in a child process (IsolatedCall.h): Debian's Assimp 5.2 aborts on
+// some malformed files (its assertions are on) and may crash or hang on others;
+// any of that becomes one clear error here instead of taking rotafab down.
+PolygonMesh readWithAssimpIsolated(std::string_view bytes, const std::string& extension,
+                                   const std::filesystem::path* path) {
+  // Generous: Assimp reads 200k faces of OBJ in about 0.15 s.
+  const auto timeout = std::chrono::seconds(120 + bytes.size() / 1'000'000);
+  const IsolatedResult result = runIsolated(
+      [&]() -> std::string {
+        // A tag byte, then the mesh ('M') or the one-line error ('E').
+        std::string reply;
+        try {
+          const std::string mesh = serialize(readWithAssimp(bytes, extension, path));
+          reply.append("M").append(mesh);
+        } catch (const InvalidMeshError& error) {
+          reply.assign("E").append(error.what());
+        } catch (const std::bad_alloc&) {
+          reply.assign("Ethe mesh does not fit in memory");
+        } catch (const std::exception& error) {
+          reply.assign("E").append(firstLine(error.what()));
+        }
+        return reply;
+      },
+      timeout);
+  std::string format = extension;
+  std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::toupper(c); });
+  if (result.status == IsolatedResult::Status::TimedOut) {
+    throw InvalidMeshError(fmt::format("the {} reader (Assimp) did not finish within {} s", format,
+                                       std::chrono::duration_cast<std::chrono::seconds>(timeout).count()));
+  }
+  if (result.status == IsolatedResult::Status::Crashed || result.output.empty()) {
+    throw InvalidMeshError(fmt::format("the {} reader (Assimp) crashed on this file{}: the file is malformed", format,
+                                       result.signal ? fmt::format(" ({})", ::strsignal(result.signal)) : ""));
+  }
+  if (result.output[0] == 'E') throw InvalidMeshError(result.output.substr(1));
+  return deserialize(std::string_view(result.output).substr(1));
+}
+
 PolygonMesh readAny(std::string_view bytes, const std::string& extension, const std::filesystem::path* path) {
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
   if (extension == "off") return readOff(bytes);
   if (extension == "ply") return readPly(bytes);
-  return readWithAssimp(bytes, extension, path);
+  return readWithAssimpIsolated(bytes, extension, path);
 }
 
 ImportedMesh finishImport(PolygonMesh mesh) {

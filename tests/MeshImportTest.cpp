@@ -247,6 +247,13 @@ TEST(MeshImport, EveryUnreadableInputIsRefusedWithOneLine) {
   EXPECT_EQ(refusal(dir.path()), dir.path().string() + ": is a directory, not a mesh file");
 }
 
+// Assimp aborts on this file; the import runs it in a child process and says so.
+TEST(MeshImport, ReaderThatAbortsIsRefusedNotFatal) {
+  const auto path = std::filesystem::path(ROTAFAB_SOURCE_DIR) / "tests/data/regressions/assimp-3mf-abort.3mf";
+  EXPECT_EQ(refusal(path),
+            path.string() + ": the 3MF reader (Assimp) crashed on this file (Aborted): the file is malformed");
+}
+
 TEST(MeshImport, PipesAndDevicesAreRefusedNotWaitedOn) {
   TempDir dir;
   const auto fifo = dir.path() / "mesh.obj";
@@ -327,8 +334,9 @@ TEST(MeshImport, GltfNodeTransformsPlaceEveryInstance) {
   EXPECT_DOUBLE_EQ(minX, -11.0);
   EXPECT_DOUBLE_EQ(maxX, 11.0);
   // A transform that overflows single precision is refused, not passed on as infinities.
-  const auto huge =
-      dir.write("huge.gltf", gltfWithTwoInstances(R"({"mesh":0,"scale":[3e38,3e38,3e38],"translation":[3e38,0,0]})", R"({"mesh":0})"));
+  const auto huge = dir.write(
+      "huge.gltf",
+      gltfWithTwoInstances(R"({"mesh":0,"scale":[3e38,3e38,3e38],"translation":[3e38,0,0]})", R"({"mesh":0})"));
   EXPECT_NE(refusal(huge).find("the scene's node transform makes it non-finite"), std::string::npos) << refusal(huge);
 }
 
