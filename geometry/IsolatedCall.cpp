@@ -38,6 +38,9 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
   if (child == 0) {
     ::close(fds[0]);
     if (const int devNull = ::open("/dev/null", O_WRONLY); devNull >= 0) ::dup2(devNull, STDERR_FILENO);
+    // Die plainly on a fault: handlers inherited from the parent (a sanitizer's,
+    // a fuzzer's) would report the child's crash as the parent's.
+    for (int fault : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP}) ::signal(fault, SIG_DFL);
     std::string output;
     try {
       output = work();

@@ -11,9 +11,10 @@ CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo 
 cmake --build build-fuzz --target fuzz_mesh_import
 
 # Seeds: our examples and a few real-world files; the first byte picks the
-# reader (0 off, 1 ply, 2 obj, 3 stl).
+# reader (0 off, 1 ply, 2 obj, 3 stl, 4 glb, 5 gltf, 6 3mf, 7 dae).
 corpus=build-fuzz/corpus
 mkdir -p "$corpus" build-fuzz/artifacts
+rm -f build-fuzz/artifacts/*
 seed() { [[ -f "$2" ]] && { printf "\\x$1"; cat "$2"; } > "$corpus/seed-$(basename "$2")" || true; }
 seed 02 examples/cube.obj
 seed 02 examples/soccer-ball.obj
@@ -23,6 +24,10 @@ seed 01 /usr/share/assimp/models/PLY/cube_binary.ply
 seed 01 /usr/share/assimp/models/PLY/cube_uv.ply
 seed 03 /usr/share/openscad/testdata/scad/3D/features/import.stl
 seed 03 /usr/share/openscad/testdata/scad/3D/features/import_bin_solid.stl
+seed 04 /usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb
+seed 05 /usr/share/assimp/models/glTF2/BoxTextured-glTF-Embedded/BoxTextured.gltf
+seed 06 /usr/share/assimp/models/3MF/box.3mf
+seed 07 /usr/share/assimp/models/Collada/cube_triangulate.dae
 
 log=build-fuzz/fuzz.log
 status=0

@@ -254,6 +254,13 @@ TEST(MeshImport, ReaderThatAbortsIsRefusedNotFatal) {
             path.string() + ": the 3MF reader (Assimp) crashed on this file (Aborted): the file is malformed");
 }
 
+// Assimp's own test model with infinite coordinates (package assimp-testmodels).
+TEST(MeshImport, GltfWithInfinitiesIsRefused) {
+  const std::filesystem::path path = "/usr/share/assimp/models/glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb";
+  ASSERT_TRUE(std::filesystem::exists(path)) << "install assimp-testmodels with scripts/setup.sh";
+  EXPECT_EQ(refusal(path), path.string() + ": vertex 0 has a non-finite coordinate (-inf, -0.5, 0.5)");
+}
+
 TEST(MeshImport, PipesAndDevicesAreRefusedNotWaitedOn) {
   TempDir dir;
   const auto fifo = dir.path() / "mesh.obj";
