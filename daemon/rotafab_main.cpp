@@ -7,6 +7,7 @@
 
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
+#include "daemon/ProfilesCommand.h"
 
 int main(int argc, char** argv) {
   using namespace rotafab::cli;
@@ -18,6 +19,7 @@ int main(int argc, char** argv) {
       "examples/bunny.obj");
   int status = kSuccess;
   addInspectCommand(app, status);
+  addProfilesCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <stdexcept>
 #include <system_error>
+#include <vector>
 
 namespace rotafab::geometry {
 namespace {
@@ -29,6 +30,7 @@ bool writeAll(int fd, const std::string& bytes) {
 IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono::milliseconds timeout) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+  ::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);  // fewer round trips for a large result; best effort
   const pid_t child = ::fork();
   if (child < 0) {
     ::close(fds[0]);
@@ -55,7 +57,7 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
   IsolatedResult result;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   bool timedOut = false;
-  char buffer[1 << 16];
+  std::vector<char> buffer(1 << 20);
   for (;;) {
     const auto left =
         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
@@ -67,10 +69,10 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
     const int ready = ::poll(&waiting, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
     if (ready < 0 && errno == EINTR) continue;
     if (ready <= 0) continue;
-    const ssize_t n = ::read(fds[0], buffer, sizeof buffer);
+    const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) break;  // end of output: the child closed its end
-    result.output.append(buffer, static_cast<size_t>(n));
+    result.output.append(buffer.data(), static_cast<size_t>(n));
   }
   ::close(fds[0]);
   if (timedOut) ::kill(child, SIGKILL);

@@ -172,46 +172,50 @@ PolygonMesh readWithAssimp(std::string_view bytes, const std::string& extension,
   return mesh;
 }
 
-// The mesh as bytes, to come back from the child process that read it.
+// The mesh as bytes, to come back from the child process that read it:
+// counts, the coordinates as one block, then each face's size and corners.
+static_assert(sizeof(Point3) == 3 * sizeof(double), "Point3 is three packed doubles");
+
 std::string serialize(const PolygonMesh& mesh) {
+  size_t corners = 0;
+  for (const auto& face : mesh.faces) corners += face.size();
   std::string out;
-  auto put = [&](const auto& value) { out.append(reinterpret_cast<const char*>(&value), sizeof value); };
-  put(static_cast<uint64_t>(mesh.positions.size()));
-  for (const Point3& p : mesh.positions) {
-    for (int axis = 0; axis < 3; ++axis) put(p[axis]);
-  }
-  put(static_cast<uint64_t>(mesh.faces.size()));
+  out.reserve(16 + mesh.positions.size() * sizeof(Point3) + mesh.faces.size() * 4 + corners * sizeof(int));
+  auto put = [&](const void* data, size_t size) { out.append(static_cast<const char*>(data), size); };
+  const uint64_t vertices = mesh.positions.size(), faces = mesh.faces.size();
+  put(&vertices, sizeof vertices);
+  put(mesh.positions.data(), mesh.positions.size() * sizeof(Point3));
+  put(&faces, sizeof faces);
   for (const auto& face : mesh.faces) {
-    put(static_cast<uint32_t>(face.size()));
-    out.append(reinterpret_cast<const char*>(face.data()), face.size() * sizeof(int));
+    const uint32_t size = static_cast<uint32_t>(face.size());
+    put(&size, sizeof size);
+    put(face.data(), face.size() * sizeof(int));
   }
   return out;
 }
 
 PolygonMesh deserialize(std::string_view bytes) {
   size_t at = 0;
-  auto get = [&](auto& value) {
-    if (bytes.size() - at < sizeof value) throw InvalidMeshError("the reader's result was cut short");
-    std::memcpy(&value, bytes.data() + at, sizeof value);
-    at += sizeof value;
+  auto take = [&](void* into, uint64_t size) {
+    if (size > bytes.size() - at) throw InvalidMeshError("the reader's result was cut short");
+    std::memcpy(into, bytes.data() + at, size);
+    at += size;
   };
   PolygonMesh mesh;
   uint64_t vertices = 0, faces = 0;
-  get(vertices);
-  mesh.positions.resize(std::min<uint64_t>(vertices, bytes.size() / (3 * sizeof(double))));
-  for (auto& p : mesh.positions) {
-    for (int axis = 0; axis < 3; ++axis) get(p[axis]);
-  }
-  get(faces);
-  mesh.faces.reserve(std::min<uint64_t>(faces, bytes.size() / 4));
-  for (uint64_t f = 0; f < faces; ++f) {
+  take(&vertices, sizeof vertices);
+  if (vertices > bytes.size() / sizeof(Point3)) throw InvalidMeshError("the reader's result was cut short");
+  mesh.positions.resize(vertices);
+  take(mesh.positions.data(), vertices * sizeof(Point3));
+  take(&faces, sizeof faces);
+  if (faces > bytes.size() / sizeof(uint32_t)) throw InvalidMeshError("the reader's result was cut short");
+  mesh.faces.resize(faces);
+  for (auto& face : mesh.faces) {
     uint32_t size = 0;
-    get(size);
-    if (bytes.size() - at < size * sizeof(int)) throw InvalidMeshError("the reader's result was cut short");
-    std::vector<int> face(size);
-    std::memcpy(face.data(), bytes.data() + at, size * sizeof(int));
-    at += size * sizeof(int);
-    mesh.faces.push_back(std::move(face));
+    take(&size, sizeof size);
+    if (size > bytes.size() / sizeof(int)) throw InvalidMeshError("the reader's result was cut short");
+    face.resize(size);
+    take(face.data(), size * sizeof(int));
   }
   return mesh;
 }

@@ -1,0 +1,40 @@
+#pragma once
+// One laser sheet as it is to be drawn: the bed and the paths on it, in sheet
+// coordinates (inches, origin at the bottom-left corner of the bed, y up),
+// each path tagged with its operation and listed in cutting order. The EPS,
+// SVG and DXF writers turn a SheetDrawing into files that describe exactly the
+// same geometry. The planner (nesting, kerf, ordering) produces it; labels
+// arrive already turned into single-stroke polylines (HersheyFont.h).
+
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "profiles/Operation.h"
+
+namespace rotafab::jobs {
+
+using Point2 = Eigen::Vector2d;
+
+using profiles::Operation;
+using profiles::Rgb;
+
+struct DrawnPath {
+  Operation operation = Operation::Cut;
+  std::vector<Point2> points;  // at least 2
+  bool closed = false;         // the last point joins the first (not repeated)
+};
+
+struct SheetDrawing {
+  int index = 1;        // 1-based sheet number
+  int sheetCount = 1;   // of how many, for the title
+  double width = 32.0;  // the bed, inches
+  double height = 18.0;
+  double margin = 0.25;              // no path may come nearer the bed's edge
+  std::string title;                 // e.g. "bunny (band) - sheet 1 of 12"
+  std::map<Operation, Rgb> colours;  // the machine profile's colour for each operation
+  std::vector<DrawnPath> paths;      // in cutting order
+};
+
+}  // namespace rotafab::jobs

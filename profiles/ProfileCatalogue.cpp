@@ -1,0 +1,94 @@
+// Finding profiles: the search path and the catalogue of what it holds.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "profiles/Profiles.h"
+
+namespace rotafab::profiles {
+namespace {
+
+std::vector<std::filesystem::path> yamlFilesIn(const std::filesystem::path& folder) {
+  std::vector<std::filesystem::path> files;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const auto extension = entry.path().extension();
+    if (entry.is_regular_file(error) && (extension == ".yaml" || extension == ".yml")) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());  // deterministic
+  return files;
+}
+
+template <typename Profile>
+void addUnlessShadowed(std::vector<Profile>& into, Profile profile) {
+  const bool known = std::any_of(into.begin(), into.end(), [&](const Profile& p) { return p.name == profile.name; });
+  if (!known) into.push_back(std::move(profile));
+}
+
+template <typename Profile>
+std::string namesOf(const std::vector<Profile>& profiles) {
+  std::vector<std::string> names;
+  for (const auto& p : profiles) names.push_back(p.name);
+  return names.empty() ? "none" : fmt::format("{}", fmt::join(names, ", "));
+}
+
+}  // namespace
+
+std::vector<std::filesystem::path> profileSearchPath() {
+  std::vector<std::filesystem::path> path{std::filesystem::path("profiles")};
+  if (const char* config = std::getenv("XDG_CONFIG_HOME"); config && *config) {
+    path.push_back(std::filesystem::path(config) / "rotafab" / "profiles");
+  } else if (const char* home = std::getenv("HOME"); home && *home) {
+    path.push_back(std::filesystem::path(home) / ".config" / "rotafab" / "profiles");
+  }
+  path.push_back("/usr/share/rotafab/profiles");
+#ifdef ROTAFAB_PROFILES_DIR
+  path.push_back(ROTAFAB_PROFILES_DIR);  // the shipped profiles, when run from a build tree
+#endif
+  return path;
+}
+
+ProfileCatalogue loadProfiles(const std::vector<std::filesystem::path>& searchPath) {
+  ProfileCatalogue catalogue;
+  std::vector<std::filesystem::path> seen;
+  for (const auto& folder : searchPath) {
+    std::error_code error;
+    const auto canonical = std::filesystem::weakly_canonical(folder, error);
+    if (std::find(seen.begin(), seen.end(), canonical) != seen.end()) continue;  // ./profiles may be the shipped folder
+    seen.push_back(canonical);
+    for (const auto& file : yamlFilesIn(folder / "machines")) {
+      try {
+        addUnlessShadowed(catalogue.machines, loadMachineProfile(file));
+      } catch (const ProfileError& e) {
+        catalogue.errors.push_back(e.what());
+      }
+    }
+    for (const auto& file : yamlFilesIn(folder / "materials")) {
+      try {
+        addUnlessShadowed(catalogue.materials, loadMaterialProfile(file));
+      } catch (const ProfileError& e) {
+        catalogue.errors.push_back(e.what());
+      }
+    }
+  }
+  return catalogue;
+}
+
+MachineProfile findMachine(const ProfileCatalogue& catalogue, const std::string& name) {
+  for (const auto& machine : catalogue.machines)
+    if (machine.name == name) return machine;
+  throw ProfileError(fmt::format("no machine profile named '{}' (there are: {}; `rotafab profiles` lists them)", name,
+                                 namesOf(catalogue.machines)));
+}
+
+MaterialProfile findMaterial(const ProfileCatalogue& catalogue, const std::string& name) {
+  for (const auto& material : catalogue.materials)
+    if (material.name == name) return material;
+  throw ProfileError(fmt::format("no material profile named '{}' (there are: {}; `rotafab profiles` lists them)", name,
+                                 namesOf(catalogue.materials)));
+}
+
+}  // namespace rotafab::profiles

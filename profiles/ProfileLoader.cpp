@@ -1,0 +1,296 @@
+// Reading and validating profile files. Every refusal is one line,
+// "FILE:LINE:COL: key: what is wrong", pointing at the key or value at fault.
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <set>
+
+#include "profiles/Length.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::profiles {
+namespace {
+
+// Walks one YAML document and refuses what is wrong with file:line:col.
+class ProfileReader {
+ public:
+  explicit ProfileReader(std::filesystem::path file) : file_(std::move(file)) {}
+
+  [[noreturn]] void fail(const YAML::Node& at, const std::string& key, const std::string& what) const {
+    const YAML::Mark mark = at.Mark();
+    const int line = mark.line >= 0 ? mark.line + 1 : 1, column = mark.column >= 0 ? mark.column + 1 : 1;
+    throw ProfileError(fmt::format("{}:{}:{}: {}: {}", file_.string(), line, column, key, what));
+  }
+
+  YAML::Node load() const {
+    try {
+      YAML::Node root = YAML::LoadFile(file_.string());
+      if (!root.IsMap()) fail(root, "profile", "expected a map of keys (kind, name, ...)");
+      return root;
+    } catch (const YAML::BadFile&) {
+      throw ProfileError(fmt::format("{}: cannot read the file", file_.string()));
+    } catch (const YAML::ParserException& error) {
+      throw ProfileError(
+          fmt::format("{}:{}:{}: syntax: {}", file_.string(), error.mark.line + 1, error.mark.column + 1, error.msg));
+    }
+  }
+
+  // Refuses unknown and repeated keys, and missing required ones; returns the
+  // key node of each key present, for messages.
+  std::map<std::string, YAML::Node> keys(const YAML::Node& map, const std::string& path,
+                                         const std::vector<std::string>& allowed,
+                                         const std::vector<std::string>& required) const {
+    if (!map.IsMap()) fail(map, path, "expected a map");
+    std::map<std::string, YAML::Node> present;
+    for (const auto& entry : map) {
+      const std::string key = entry.first.as<std::string>("");
+      const std::string where = path.empty() ? key : path + "." + key;
+      if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
+        fail(entry.first, where, fmt::format("unknown key (expected one of: {})", fmt::join(allowed, ", ")));
+      }
+      if (!present.emplace(key, entry.first).second) fail(entry.first, where, "given twice");
+    }
+    for (const auto& key : required) {
+      if (!present.contains(key)) fail(map, path.empty() ? key : path + "." + key, "missing");
+    }
+    return present;
+  }
+
+  std::string text(const YAML::Node& node, const std::string& key) const {
+    if (!node.IsScalar()) fail(node, key, "expected text");
+    return node.Scalar();
+  }
+
+  double number(const YAML::Node& node, const std::string& key, double low, double high) const {
+    double value = 0;
+    if (!node.IsScalar() || !YAML::convert<double>::decode(node, value) || !std::isfinite(value)) {
+      fail(node, key, fmt::format("expected a number, found '{}'", node.IsScalar() ? node.Scalar() : "a list or map"));
+    }
+    if (value < low || value > high)
+      fail(node, key, fmt::format("must be between {} and {}, not {}", low, high, value));
+    return value;
+  }
+
+  int integer(const YAML::Node& node, const std::string& key, int low, int high) const {
+    int value = 0;
+    if (!node.IsScalar() || !YAML::convert<int>::decode(node, value)) {
+      fail(node, key,
+           fmt::format("expected a whole number, found '{}'", node.IsScalar() ? node.Scalar() : "a list or map"));
+    }
+    if (value < low || value > high)
+      fail(node, key, fmt::format("must be between {} and {}, not {}", low, high, value));
+    return value;
+  }
+
+  bool boolean(const YAML::Node& node, const std::string& key) const {
+    bool value = false;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
+      fail(node, key,
+           fmt::format("expected on/off (true/false), found '{}'", node.IsScalar() ? node.Scalar() : "a list or map"));
+    }
+    return value;
+  }
+
+  // A length: 0.25in, 6.35mm, 0.635cm or a bare number of inches; must exceed `low`.
+  double length(const YAML::Node& node, const std::string& key, double low, bool inclusive) const {
+    const auto value = node.IsScalar() ? parseLength(node.Scalar()) : std::nullopt;
+    if (!value) {
+      fail(node, key,
+           fmt::format("expected a length such as 0.25in, 6.35mm or 0.635cm, found '{}'",
+                       node.IsScalar() ? node.Scalar() : "a list or map"));
+    }
+    if (inclusive ? *value < low : *value <= low) {
+      fail(node, key, fmt::format("must be {} {}in, not {}", inclusive ? "at least" : "more than", low, node.Scalar()));
+    }
+    return *value;
+  }
+
+  Rgb rgb(const YAML::Node& node, const std::string& key) const {
+    if (node.IsScalar() && node.Scalar().size() == 7 && node.Scalar()[0] == '#') {
+      char* end = nullptr;
+      const long value = std::strtol(node.Scalar().c_str() + 1, &end, 16);
+      if (end == node.Scalar().c_str() + 7) {
+        return {static_cast<uint8_t>(value >> 16), static_cast<uint8_t>(value >> 8 & 255),
+                static_cast<uint8_t>(value & 255)};
+      }
+    }
+    if (node.IsSequence() && node.size() == 3) {
+      return {static_cast<uint8_t>(integer(node[0], key + "[0]", 0, 255)),
+              static_cast<uint8_t>(integer(node[1], key + "[1]", 0, 255)),
+              static_cast<uint8_t>(integer(node[2], key + "[2]", 0, 255))};
+    }
+    fail(node, key, "expected a colour as [red, green, blue] from 0 to 255, or \"#rrggbb\"");
+  }
+
+  const std::filesystem::path& file() const { return file_; }
+
+ private:
+  std::filesystem::path file_;
+};
+
+void requireKind(const ProfileReader& reader, const YAML::Node& root, const std::string& kind) {
+  if (!root["kind"]) reader.fail(root, "kind", fmt::format("missing (this should be 'kind: {}')", kind));
+  const std::string found = reader.text(root["kind"], "kind");
+  if (found != kind) reader.fail(root["kind"], "kind", fmt::format("expected '{}', found '{}'", kind, found));
+}
+
+LaserMode laserMode(const ProfileReader& reader, const YAML::Node& node, const std::string& key) {
+  const std::string mode = reader.text(node, key);
+  if (mode == "vector") return LaserMode::Vector;
+  if (mode == "raster") return LaserMode::Raster;
+  if (mode == "raster+vector") return LaserMode::RasterAndVector;
+  reader.fail(node, key, fmt::format("expected vector, raster or raster+vector, found '{}'", mode));
+}
+
+// The URI schemes each driver accepts (SPEC, "Devices").
+void checkConnection(const ProfileReader& reader, const YAML::Node& node, const std::string& driver,
+                     const std::string& uri) {
+  const std::map<std::string, std::vector<std::string>> schemes{
+      {"spool", {"spool:"}}, {"grbl", {"grbl://", "grbl+tcp://", "sim:grbl"}}, {"m2nano", {"m2nano://", "sim:m2nano"}}};
+  for (const auto& scheme : schemes.at(driver))
+    if (uri.starts_with(scheme)) return;
+  reader.fail(
+      node, "connection",
+      fmt::format("'{}' is not a {} device URI (expected {})", uri, driver, fmt::join(schemes.at(driver), " or ")));
+}
+
+}  // namespace
+
+const ColourSetting& MachineProfile::settingFor(Operation operation) const {
+  const std::string& colour = operationColour.at(operation);
+  return *std::find_if(colours.begin(), colours.end(), [&](const ColourSetting& c) { return c.name == colour; });
+}
+
+MachineProfile loadMachineProfile(const std::filesystem::path& file) {
+  const ProfileReader reader(file);
+  const YAML::Node root = reader.load();
+  requireKind(reader, root, "machine");
+  reader.keys(root, "", {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations"},
+              {"name", "bed", "driver", "connection", "colours"});
+  MachineProfile machine;
+  machine.source = file;
+  machine.name = reader.text(root["name"], "name");
+  if (root["description"]) machine.description = reader.text(root["description"], "description");
+
+  const YAML::Node bed = root["bed"];
+  reader.keys(bed, "bed", {"width", "height", "margin"}, {"width", "height"});
+  machine.bed.width = reader.length(bed["width"], "bed.width", 0.0, false);
+  machine.bed.height = reader.length(bed["height"], "bed.height", 0.0, false);
+  if (bed["margin"]) machine.bed.margin = reader.length(bed["margin"], "bed.margin", 0.0, true);
+  if (2 * machine.bed.margin >= std::min(machine.bed.width, machine.bed.height)) {
+    reader.fail(bed, "bed",
+                fmt::format("margins of {}in on every side leave no usable area on a {} x {} in bed",
+                            machine.bed.margin, machine.bed.width, machine.bed.height));
+  }
+
+  machine.driver = reader.text(root["driver"], "driver");
+  if (machine.driver != "spool" && machine.driver != "grbl" && machine.driver != "m2nano") {
+    reader.fail(root["driver"], "driver", fmt::format("expected spool, grbl or m2nano, found '{}'", machine.driver));
+  }
+  machine.connection = reader.text(root["connection"], "connection");
+  checkConnection(reader, root["connection"], machine.driver, machine.connection);
+
+  const YAML::Node colours = root["colours"];
+  if (!colours.IsMap() || colours.size() == 0) reader.fail(colours, "colours", "expected a table of colours (fig. 65)");
+  std::vector<std::string> colourKeys;
+  for (const auto& entry : colours) colourKeys.push_back(entry.first.as<std::string>(""));
+  reader.keys(colours, "colours", colourKeys, {});  // refuses a colour given twice
+  for (const auto& entry : colours) {
+    ColourSetting setting;
+    setting.name = entry.first.as<std::string>("");
+    const std::string at = "colours." + setting.name;
+    const YAML::Node row = entry.second;
+    reader.keys(row, at, {"rgb", "mode", "power", "speed", "ppi", "passes", "z_axis"}, {"rgb"});
+    setting.rgb = reader.rgb(row["rgb"], at + ".rgb");
+    if (row["mode"]) setting.mode = laserMode(reader, row["mode"], at + ".mode");
+    if (row["power"]) setting.power = reader.number(row["power"], at + ".power", 0.0, 100.0);
+    if (row["speed"]) setting.speed = reader.number(row["speed"], at + ".speed", 0.1, 100.0);
+    if (row["ppi"]) setting.ppi = reader.integer(row["ppi"], at + ".ppi", 1, 10000);
+    if (row["passes"]) setting.passes = reader.integer(row["passes"], at + ".passes", 1, 100);
+    if (row["z_axis"]) setting.zAxis = reader.boolean(row["z_axis"], at + ".z_axis");
+    for (const auto& earlier : machine.colours) {
+      if (earlier.rgb == setting.rgb) {
+        reader.fail(row["rgb"], at + ".rgb",
+                    fmt::format("the same RGB as colours.{}: the cutter could not tell them apart", earlier.name));
+      }
+    }
+    machine.colours.push_back(std::move(setting));
+  }
+
+  // Operation -> colour; the dissertation's defaults where not given.
+  const std::map<Operation, std::string> defaults{
+      {Operation::Cut, "blue"}, {Operation::Score, "red"}, {Operation::Etch, "yellow"}, {Operation::Outline, "green"}};
+  const YAML::Node operations = root["operations"];
+  if (operations) reader.keys(operations, "operations", {"cut", "score", "etch", "outline"}, {});
+  auto hasColour = [&](const std::string& name) {
+    return std::any_of(machine.colours.begin(), machine.colours.end(),
+                       [&](const ColourSetting& c) { return c.name == name; });
+  };
+  for (Operation operation : kAllOperations) {
+    const std::string key = "operations." + std::string(operationName(operation));
+    const YAML::Node given = operations ? operations[std::string(operationName(operation))] : YAML::Node();
+    const std::string colour = given ? reader.text(given, key) : defaults.at(operation);
+    const YAML::Node at = given ? given : (operations ? operations : root);
+    if (!hasColour(colour)) {
+      reader.fail(at, key,
+                  fmt::format("{}colour '{}' is not in the colour table", given ? "" : "the default ", colour));
+    }
+    for (const auto& [other, otherColour] : machine.operationColour) {
+      if (otherColour == colour) {
+        reader.fail(at, key,
+                    fmt::format("colour '{}' is already used by operations.{}: each operation needs its own colour",
+                                colour, operationName(other)));
+      }
+    }
+    machine.operationColour[operation] = colour;
+  }
+  return machine;
+}
+
+MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
+  const ProfileReader reader(file);
+  const YAML::Node root = reader.load();
+  requireKind(reader, root, "material");
+  reader.keys(root, "", {"kind", "name", "description", "thickness", "kerf", "fastener", "machines"},
+              {"name", "thickness", "kerf"});
+  MaterialProfile material;
+  material.source = file;
+  material.name = reader.text(root["name"], "name");
+  if (root["description"]) material.description = reader.text(root["description"], "description");
+  material.thickness = reader.length(root["thickness"], "thickness", 0.0, false);
+  material.kerf = reader.length(root["kerf"], "kerf", 0.0, true);
+  if (material.kerf >= 0.25)
+    reader.fail(root["kerf"], "kerf", "must be under 0.25in: a laser cut is a few thousandths wide");
+  if (root["fastener"]) material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false);
+  if (const YAML::Node machines = root["machines"]) {
+    if (!machines.IsMap()) reader.fail(machines, "machines", "expected a map from machine name to settings");
+    std::vector<std::string> names;
+    for (const auto& entry : machines) names.push_back(entry.first.as<std::string>(""));
+    reader.keys(machines, "machines", names, {});
+    for (const auto& entry : machines) {
+      const std::string machineName = entry.first.as<std::string>("");
+      const std::string at = "machines." + machineName;
+      reader.keys(entry.second, at, {"cut", "score", "etch", "outline"}, {});
+      auto& overrides = material.machines[machineName];
+      for (const auto& operationEntry : entry.second) {
+        const std::string operation = operationEntry.first.as<std::string>("");
+        const std::string key = at + "." + operation;
+        const YAML::Node row = operationEntry.second;
+        reader.keys(row, key, {"power", "speed", "passes"}, {});
+        PowerSpeed setting;
+        if (row["power"]) setting.power = reader.number(row["power"], key + ".power", 0.0, 100.0);
+        if (row["speed"]) setting.speed = reader.number(row["speed"], key + ".speed", 0.1, 100.0);
+        if (row["passes"]) setting.passes = reader.integer(row["passes"], key + ".passes", 1, 100);
+        overrides[*operationNamed(operation)] = setting;
+      }
+    }
+  }
+  return material;
+}
+
+}  // namespace rotafab::profiles

@@ -1,0 +1,97 @@
+#pragma once
+// Machine and material profiles (SPEC, "Profiles"): what a cutter is (bed,
+// driver, connection, the colour table of the dissertation's fig. 65 and which
+// colour each operation is drawn in) and what a material needs (thickness,
+// kerf, fastener hole, power and speed per machine). Lengths in inches.
+
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "profiles/Operation.h"
+
+namespace rotafab::profiles {
+
+struct Bed {
+  double width = 32.0;  // inches
+  double height = 18.0;
+  double margin = 0.25;  // on every side; nothing is drawn nearer the edge
+};
+
+enum class LaserMode { Vector, Raster, RasterAndVector };
+
+// One row of fig. 65: a colour and what the cutter does with lines drawn in it.
+struct ColourSetting {
+  std::string name;  // "blue"
+  Rgb rgb;
+  LaserMode mode = LaserMode::Vector;
+  double power = 50.0;   // percent
+  double speed = 100.0;  // percent of the machine's maximum
+  int ppi = 500;         // pulses per inch
+  int passes = 1;
+  bool zAxis = false;
+};
+
+struct MachineProfile {
+  std::string name;
+  std::string description;
+  Bed bed;
+  std::string driver;      // "spool", "grbl" or "m2nano"
+  std::string connection;  // the default device URI (SPEC, "Devices")
+  std::vector<ColourSetting> colours;
+  std::map<Operation, std::string> operationColour;  // every operation has one
+  std::filesystem::path source;
+
+  // The colour table row that `operation` is drawn in.
+  [[nodiscard]] const ColourSetting& settingFor(Operation operation) const;
+};
+
+struct PowerSpeed {
+  std::optional<double> power;  // percent; unset: the machine's colour table
+  std::optional<double> speed;
+  std::optional<int> passes;
+};
+
+struct MaterialProfile {
+  std::string name;
+  std::string description;
+  double thickness = 0.0;  // inches
+  double kerf = 0.0;       // width of the cut, inches
+  double fastenerDiameter = 0.125;
+  std::map<std::string, std::map<Operation, PowerSpeed>> machines;  // machine name -> overrides
+  std::filesystem::path source;
+};
+
+// Thrown for an invalid profile: "FILE:LINE:COL: key: what is wrong".
+class ProfileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Read and validate one profile file. A file holds one profile, `kind:
+// machine` or `kind: material`. Throws ProfileError.
+MachineProfile loadMachineProfile(const std::filesystem::path& file);
+MaterialProfile loadMaterialProfile(const std::filesystem::path& file);
+
+// The folders searched for profiles, first match wins: ./profiles (the project),
+// $XDG_CONFIG_HOME/rotafab/profiles (else ~/.config/rotafab/profiles), then the
+// system folder (/usr/share/rotafab/profiles, or this source tree's profiles/
+// when it exists). Each holds machines/*.yaml and materials/*.yaml.
+std::vector<std::filesystem::path> profileSearchPath();
+
+struct ProfileCatalogue {
+  std::vector<MachineProfile> machines;  // by name; an earlier folder shadows a later one
+  std::vector<MaterialProfile> materials;
+  std::vector<std::string> errors;  // one line per invalid file
+};
+
+ProfileCatalogue loadProfiles(const std::vector<std::filesystem::path>& searchPath);
+
+// The named profile from the search path; ProfileError naming the ones there are.
+MachineProfile findMachine(const ProfileCatalogue& catalogue, const std::string& name);
+MaterialProfile findMaterial(const ProfileCatalogue& catalogue, const std::string& name);
+
+}  // namespace rotafab::profiles

@@ -1,0 +1,201 @@
+// Machine and material profiles: the shipped ones load, lengths take units,
+// and every invalid profile is refused with FILE:LINE:COL: key: what is wrong.
+
+#include <gtest/gtest.h>
+
+#include "TestSupport.h"
+#include "profiles/Length.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::profiles {
+namespace {
+
+const std::filesystem::path kShipped = std::filesystem::path(ROTAFAB_SOURCE_DIR) / "profiles";
+
+TEST(Length, UnitsAndBareInches) {
+  EXPECT_DOUBLE_EQ(*parseLength("0.25in"), 0.25);
+  EXPECT_DOUBLE_EQ(*parseLength("6.35mm"), 0.25);
+  EXPECT_DOUBLE_EQ(*parseLength("0.635cm"), 0.25);
+  EXPECT_DOUBLE_EQ(*parseLength("0.25"), 0.25);
+  EXPECT_DOUBLE_EQ(*parseLength(" 3 mm "), 3 / 25.4);
+  EXPECT_DOUBLE_EQ(*parseLength("-1in"), -1.0);
+  for (const char* bad : {"", "in", "wide", "3ft", "1e999in", "nan", "3 in in", "0x10"}) {
+    EXPECT_FALSE(parseLength(bad).has_value()) << bad;
+  }
+}
+
+TEST(Profiles, ShippedProfilesLoad) {
+  const ProfileCatalogue catalogue = loadProfiles({kShipped});
+  EXPECT_TRUE(catalogue.errors.empty()) << catalogue.errors.front();
+  ASSERT_GE(catalogue.machines.size(), 3u);
+  ASSERT_GE(catalogue.materials.size(), 3u);
+  const MachineProfile workshop = findMachine(catalogue, "workshop-32x18");
+  EXPECT_EQ(workshop.bed.width, 32.0);
+  EXPECT_EQ(workshop.bed.height, 18.0);
+  EXPECT_EQ(workshop.bed.margin, 0.25);
+  EXPECT_EQ(workshop.driver, "spool");
+  EXPECT_EQ(workshop.colours.size(), 8u);  // fig. 65's eight rows
+  // The dissertation's colours: cut blue, score red, etch yellow, outline green.
+  EXPECT_EQ(workshop.settingFor(Operation::Cut).rgb, (Rgb{0, 0, 255}));
+  EXPECT_EQ(workshop.settingFor(Operation::Score).rgb, (Rgb{255, 0, 0}));
+  EXPECT_EQ(workshop.settingFor(Operation::Etch).rgb, (Rgb{255, 255, 0}));
+  EXPECT_EQ(workshop.settingFor(Operation::Outline).rgb, (Rgb{0, 255, 0}));
+  EXPECT_EQ(workshop.settingFor(Operation::Cut).power, 50.0);
+  EXPECT_EQ(findMachine(catalogue, "grbl-diode-400").driver, "grbl");
+  EXPECT_NEAR(findMachine(catalogue, "k40-m2nano").bed.width, 300 / 25.4, 1e-12);
+  const MaterialProfile plywood = findMaterial(catalogue, "plywood-3mm");
+  EXPECT_NEAR(plywood.kerf, 0.15 / 25.4, 1e-12);
+  EXPECT_EQ(plywood.machines.at("grbl-diode-400").at(Operation::Cut).passes, 4);
+  EXPECT_THROW(findMachine(catalogue, "nope"), ProfileError);
+}
+
+TEST(Profiles, EarlierFolderShadowsLater) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.path() / "machines");
+  std::string text = test::readFile(kShipped / "machines/workshop-32x18.yaml");
+  text.replace(text.find("margin: 0.25in"), 14, "margin: 0.5in");
+  dir.write("machines/workshop.yaml", text);
+  const ProfileCatalogue catalogue = loadProfiles({dir.path(), kShipped});
+  EXPECT_EQ(findMachine(catalogue, "workshop-32x18").bed.margin, 0.5);
+}
+
+constexpr const char* kGoodMachine =
+    "kind: machine\n"                                                       // 1
+    "name: test\n"                                                          // 2
+    "bed: {width: 32in, height: 18in, margin: 0.25in}\n"                    // 3
+    "driver: spool\n"                                                       // 4
+    "connection: spool:out\n"                                               // 5
+    "colours:\n"                                                            // 6
+    "  blue: {rgb: [0, 0, 255], power: 50}\n"                               // 7
+    "  red: {rgb: [255, 0, 0]}\n"                                           // 8
+    "  yellow: {rgb: '#ffff00'}\n"                                          // 9
+    "  green: {rgb: [0, 255, 0]}\n"                                         // 10
+    "operations: {cut: blue, score: red, etch: yellow, outline: green}\n";  // 11
+
+// Loads `text` as a machine (or material) profile file and returns the error.
+std::string refusal(const std::string& text, bool material = false) {
+  test::TempDir dir;
+  const auto file = dir.write("p.yaml", text);
+  try {
+    if (material) {
+      loadMaterialProfile(file);
+    } else {
+      loadMachineProfile(file);
+    }
+  } catch (const ProfileError& error) {
+    std::string message = error.what();
+    const std::string prefix = file.string();
+    return message.starts_with(prefix) ? "p.yaml" + message.substr(prefix.size()) : message;
+  }
+  return "(accepted)";
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return text.replace(at, from.size(), to);
+}
+
+TEST(Profiles, GoodMachineLoads) { EXPECT_EQ(refusal(kGoodMachine), "(accepted)"); }
+
+TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
+  const std::string good = kGoodMachine;
+  struct Case {
+    const char* what;
+    std::string text;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {"unknown key", replaced(good, "driver: spool", "drivr: spool"),
+       "p.yaml:4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, connection, colours, "
+       "operations)"},
+      {"wrong type", replaced(good, "width: 32in", "width: wide"),
+       "p.yaml:3:14: bed.width: expected a length such as 0.25in, 6.35mm or 0.635cm, found 'wide'"},
+      {"negative power", replaced(good, "power: 50", "power: -5"),
+       "p.yaml:7:35: colours.blue.power: must be between 0 and 100, not -5"},
+      {"power not a number", replaced(good, "power: 50", "power: lots"),
+       "p.yaml:7:35: colours.blue.power: expected a number, found 'lots'"},
+      {"bed smaller than margins", replaced(good, "margin: 0.25in", "margin: 9in"),
+       "p.yaml:3:6: bed: margins of 9in on every side leave no usable area on a 32 x 18 in bed"},
+      {"colour used twice", replaced(good, "score: red", "score: blue"),
+       "p.yaml:11:32: operations.score: colour 'blue' is already used by operations.cut: each operation needs its own "
+       "colour"},
+      {"same rgb twice", replaced(good, "rgb: [255, 0, 0]", "rgb: [0, 0, 255]"),
+       "p.yaml:8:14: colours.red.rgb: the same RGB as colours.blue: the cutter could not tell them apart"},
+      {"colour defined twice", replaced(good, "  red: {rgb: [255, 0, 0]}", "  blue: {rgb: [255, 0, 0]}"),
+       "p.yaml:8:3: colours.blue: given twice"},
+      {"unknown colour", replaced(good, "etch: yellow", "etch: purple"),
+       "p.yaml:11:43: operations.etch: colour 'purple' is not in the colour table"},
+      {"rgb out of range", replaced(good, "rgb: [255, 0, 0]", "rgb: [256, 0, 0]"),
+       "p.yaml:8:15: colours.red.rgb[0]: must be between 0 and 255, not 256"},
+      {"missing bed", replaced(good, "bed: {width: 32in, height: 18in, margin: 0.25in}\n", ""),
+       "p.yaml:1:1: bed: missing"},
+      {"wrong kind", replaced(good, "kind: machine", "kind: material"),
+       "p.yaml:1:7: kind: expected 'machine', found 'material'"},
+      {"unknown driver", replaced(good, "driver: spool", "driver: lasersaur"),
+       "p.yaml:4:9: driver: expected spool, grbl or m2nano, found 'lasersaur'"},
+      {"connection for another driver", replaced(good, "connection: spool:out", "connection: grbl:///dev/ttyUSB0"),
+       "p.yaml:5:13: connection: 'grbl:///dev/ttyUSB0' is not a spool device URI (expected spool:)"},
+      {"syntax error", replaced(good, "colours:\n", "colours: [\n"), ""},
+      {"not a map", "- just\n- a list\n", "p.yaml:1:1: profile: expected a map of keys (kind, name, ...)"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.what);
+    const std::string message = refusal(c.text);
+    if (c.message.empty()) {
+      EXPECT_TRUE(message.starts_with("p.yaml:") && message.find(": syntax: ") != std::string::npos) << message;
+    } else {
+      EXPECT_EQ(message, c.message);
+    }
+    EXPECT_EQ(message.find('\n'), std::string::npos);
+  }
+}
+
+TEST(Profiles, EveryInvalidMaterialIsRefusedWithItsPlace) {
+  const std::string good =
+      "kind: material\n"
+      "name: card\n"
+      "thickness: 1.5mm\n"
+      "kerf: 0.1mm\n"
+      "machines:\n"
+      "  workshop-32x18: {cut: {power: 60, speed: 40}}\n";
+  EXPECT_EQ(refusal(good, true), "(accepted)");
+  EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm", "kerf: -0.1mm"), true),
+            "p.yaml:4:7: kerf: must be at least 0in, not -0.1mm");
+  EXPECT_EQ(refusal(replaced(good, "thickness: 1.5mm", "thickness: 0"), true),
+            "p.yaml:3:12: thickness: must be more than 0in, not 0");
+  EXPECT_EQ(refusal(replaced(good, "{cut: {power", "{slice: {power"), true),
+            "p.yaml:6:20: machines.workshop-32x18.slice: unknown key (expected one of: cut, score, etch, outline)");
+  EXPECT_EQ(refusal(replaced(good, "speed: 40", "speed: 0"), true),
+            "p.yaml:6:44: machines.workshop-32x18.cut.speed: must be between 0.1 and 100, not 0");
+  EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", ""), true), "p.yaml:1:1: kerf: missing");
+}
+
+}  // namespace
+}  // namespace rotafab::profiles
+
+namespace rotafab::profiles {
+namespace {
+
+TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
+  test::TempDir dir;
+  const auto bad = dir.write("bad.yaml", replaced(kGoodMachine, "driver: spool", "drivr: spool"));
+  const auto good = dir.write("good.yaml", kGoodMachine);
+  const test::CommandResult refused = test::run(std::string(ROTAFAB_CLI) + " profiles " + bad.string());
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_EQ(refused.err, "error: " + bad.string() +
+                             ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
+                             "connection, colours, operations)\n");
+  const test::CommandResult accepted = test::run(std::string(ROTAFAB_CLI) + " profiles --json " + good.string());
+  EXPECT_EQ(accepted.status, 0) << accepted.err;
+  EXPECT_NE(accepted.out.find(R"("name":"test")"), std::string::npos) << accepted.out;
+  // From the source tree, the shipped profiles are on the search path.
+  const test::CommandResult listed =
+      test::run("cd " + std::string(ROTAFAB_SOURCE_DIR) + " && " + ROTAFAB_CLI + " profiles");
+  EXPECT_EQ(listed.status, 0) << listed.err;
+  EXPECT_NE(listed.out.find("workshop-32x18"), std::string::npos);
+  EXPECT_NE(listed.out.find("posterboard"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rotafab::profiles
