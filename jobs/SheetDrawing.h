@@ -37,4 +37,9 @@ struct SheetDrawing {
   std::vector<DrawnPath> paths;      // in cutting order
 };
 
+// What every writer requires before it writes a byte: a bed of positive size,
+// a colour for each operation drawn, paths of two or more finite points on
+// the bed. Throws std::invalid_argument naming the sheet, the path and what is wrong.
+void checkDrawable(const SheetDrawing& sheet);
+
 }  // namespace rotafab::jobs

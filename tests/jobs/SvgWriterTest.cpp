@@ -1,0 +1,199 @@
+// The SVG that LightBurn and Inkscape import: the bed in inches, one group per
+// operation in the profile's colour, and exactly the drawn geometry (read back
+// here by a small reader, and rendered by librsvg, whose output Ghostscript
+// measures in points as it does the EPS).
+
+#include "jobs/SvgWriter.h"
+
+#include <gtest/gtest.h>
+
+#include "SheetFixture.h"
+
+namespace rotafab::jobs::test {
+namespace {
+
+std::string svgOf(const SheetDrawing& sheet) {
+  std::ostringstream out;
+  writeSvg(sheet, out);
+  return out.str();
+}
+
+std::map<std::string, std::string> attributesOf(const std::string& tag) {
+  std::map<std::string, std::string> attributes;
+  const std::regex attribute(R"re(([A-Za-z_:][-A-Za-z0-9_:.]*)="([^"]*)")re");
+  for (auto it = std::sregex_iterator(tag.begin(), tag.end(), attribute); it != std::sregex_iterator(); ++it)
+    attributes[(*it)[1]] = (*it)[2];
+  return attributes;
+}
+
+// What the test reads back: the document's size and every path, with the
+// attributes of its group.
+struct SvgContent {
+  std::map<std::string, std::string> root;
+  std::map<Operation, std::map<std::string, std::string>> groups;
+  std::vector<ReadPath> paths;  // in sheet coordinates (y flipped back)
+};
+
+// A reader for the subset of SVG the writer uses: <g> elements directly in
+// <svg>, each holding <path d> elements of absolute M, L and Z commands.
+SvgContent readSvg(const std::string& svg) {
+  SvgContent content;
+  std::smatch match;
+  if (!std::regex_search(svg, match, std::regex(R"(<svg\b[^>]*>)"))) {
+    ADD_FAILURE() << "no <svg> element";
+    return content;
+  }
+  content.root = attributesOf(match[0]);
+  double viewHeight = 0;
+  {
+    std::istringstream box(content.root["viewBox"]);
+    double x, y, w;
+    box >> x >> y >> w >> viewHeight;
+  }
+  const std::regex group(R"(<g\b([^>]*)>([\s\S]*?)</g>)");
+  const std::regex path(R"(<path\b([^>]*)/>)");
+  for (auto g = std::sregex_iterator(svg.begin(), svg.end(), group); g != std::sregex_iterator(); ++g) {
+    const auto attributes = attributesOf((*g)[1]);
+    const auto operation = profiles::operationNamed(attributes.count("id") ? attributes.at("id") : "");
+    if (!operation) {
+      ADD_FAILURE() << "group without an operation id: " << (*g)[1];
+      continue;
+    }
+    EXPECT_FALSE(content.groups.contains(*operation)) << "two groups for one operation";
+    content.groups[*operation] = attributes;
+    const std::string body = (*g)[2];
+    for (auto p = std::sregex_iterator(body.begin(), body.end(), path); p != std::sregex_iterator(); ++p) {
+      const auto d = attributesOf((*p)[1])["d"];
+      ReadPath read;
+      read.operation = *operation;
+      // Command letters may touch their numbers ("M1 2L3 4"), as SVG allows.
+      const std::regex token(R"([MLZ]|[-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?|\S)");
+      std::vector<std::string> tokens;
+      for (auto t = std::sregex_iterator(d.begin(), d.end(), token); t != std::sregex_iterator(); ++t)
+        tokens.push_back((*t)[0]);
+      char command = 0;
+      for (size_t t = 0; t < tokens.size(); ++t) {
+        if (tokens[t] == "M" || tokens[t] == "L" || tokens[t] == "Z") {
+          command = tokens[t][0];
+          if (command == 'M') {
+            EXPECT_TRUE(read.points.empty()) << "a second M in one path: " << d;
+          }
+          if (command == 'Z') read.closed = true;
+          continue;
+        }
+        if (!(command == 'M' || command == 'L') || read.closed || t + 1 >= tokens.size() ||
+            !std::isdigit(static_cast<unsigned char>(tokens[t].back())) ||
+            !std::isdigit(static_cast<unsigned char>(tokens[t + 1].back()))) {
+          ADD_FAILURE() << "unexpected \"" << tokens[t] << "\" in " << d;
+          break;
+        }
+        read.points.emplace_back(std::stod(tokens[t]), viewHeight - std::stod(tokens[t + 1]));
+        ++t;
+      }
+      content.paths.push_back(read);
+    }
+  }
+  return content;
+}
+
+std::string hex(Rgb rgb) {
+  char text[8];
+  std::snprintf(text, sizeof text, "#%02x%02x%02x", rgb.r, rgb.g, rgb.b);
+  return text;
+}
+
+TEST(SvgWriter, DocumentIsTheBedInInches) {
+  const SvgContent svg = readSvg(svgOf(sampleSheet()));
+  EXPECT_EQ(svg.root.at("width"), "32in");
+  EXPECT_EQ(svg.root.at("height"), "18in");
+  EXPECT_EQ(svg.root.at("viewBox"), "0 0 32 18");
+  EXPECT_EQ(svg.root.at("xmlns"), "http://www.w3.org/2000/svg");
+  EXPECT_EQ(svg.root.at("version"), "1.1");
+}
+
+TEST(SvgWriter, PathsReadBackAsDrawn) {
+  const SheetDrawing sheet = sampleSheet();
+  const SvgContent svg = readSvg(svgOf(sheet));
+  expectSamePaths(sheet, svg.paths);
+  ASSERT_EQ(svg.groups.size(), 4u);
+  for (const auto& [operation, attributes] : svg.groups) {
+    SCOPED_TRACE(std::string(profiles::operationName(operation)));
+    EXPECT_EQ(attributes.at("stroke"), hex(sheet.colours.at(operation)));
+    EXPECT_EQ(attributes.at("fill"), "none");
+    EXPECT_EQ(attributes.at("stroke-width"), "0.001");
+  }
+}
+
+TEST(SvgWriter, GroupsOnlyTheOperationsDrawnInTheirFirstOrder) {
+  SheetDrawing sheet = sampleSheet();
+  sheet.paths = {{Operation::Etch, {{1, 1}, {2, 2}}, false},
+                 {Operation::Cut, {{3, 3}, {4, 3}, {4, 4}}, true},
+                 {Operation::Etch, {{5, 5}, {6, 6}}, false}};
+  const std::string text = svgOf(sheet);
+  EXPECT_LT(text.find("<g id=\"etch\""), text.find("<g id=\"cut\""));
+  EXPECT_EQ(text.find("<g id=\"score\""), std::string::npos);
+  EXPECT_EQ(text.find("<g id=\"outline\""), std::string::npos);
+  expectSamePaths(sheet, readSvg(text).paths);
+}
+
+TEST(SvgWriter, TitleIsEscaped) {
+  SheetDrawing sheet = sampleSheet();
+  sheet.title = "a<b & \"c\"\x01 \xc3\xa9 \xff";
+  const std::string text = svgOf(sheet);
+  EXPECT_NE(text.find("<title>a&lt;b &amp; &quot;c&quot;? \xc3\xa9 ?</title>"), std::string::npos) << text;
+}
+
+TEST(SvgWriter, XmllintAcceptsIt) {
+  TempDir dir;
+  SheetDrawing sheet = sampleSheet();
+  sheet.title = "a<b & \"c\"\x01 \xc3\xa9 \xff";
+  const auto file = dir.write("sheet.svg", svgOf(sheet));
+  const CommandResult result = run("xmllint --noout " + shellQuote(file));
+  EXPECT_EQ(result.status, 0) << result.err << " (xmllint is in Debian's libxml2-utils)";
+}
+
+TEST(SvgWriter, LibrsvgDrawsTheSameSheetAsTheEps) {
+  TempDir dir;
+  const SheetDrawing sheet = sampleSheet();
+  const auto file = dir.write("sheet.svg", svgOf(sheet));
+
+  // A PNG at 36 dpi is the bed at 36 dpi: the size in inches is understood.
+  const auto png = dir.path() / "sheet.png";
+  CommandResult result = run("rsvg-convert -f png -d 36 -p 36 -o " + shellQuote(png) + " " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err << " (rsvg-convert is in Debian's librsvg2-bin)";
+  EXPECT_EQ(pngSize(png), std::make_pair(1152, 648));
+
+  // As PostScript, librsvg's drawing can be measured and rasterized without
+  // anti-aliasing by Ghostscript, exactly as the EPS is.
+  const auto ps = dir.path() / "sheet.ps";
+  result = run("rsvg-convert -f ps -o " + shellQuote(ps) + " " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err;
+  const Box painted = ghostscriptBoundingBox(ps);
+  const Box drawn = extentOf(sheet);
+  EXPECT_NEAR(painted.x0, drawn.x0 * 72, 1.0);
+  EXPECT_NEAR(painted.y0, drawn.y0 * 72, 1.0);
+  EXPECT_NEAR(painted.x1, drawn.x1 * 72, 1.0);
+  EXPECT_NEAR(painted.y1, drawn.y1 * 72, 1.0);
+
+  const auto ppm = dir.path() / "sheet.ppm";
+  result = run("gs -q -dNOPAUSE -dBATCH -dSAFER -sDEVICE=ppmraw -r36 -sOutputFile=" + shellQuote(ppm) + " " +
+               shellQuote(ps));
+  ASSERT_EQ(result.status, 0) << result.err;
+  const Image image = readPpm(ppm);
+  ASSERT_EQ(image.width, 1152);
+  ASSERT_EQ(image.height, 648);
+  for (Operation operation : profiles::kAllOperations) {
+    SCOPED_TRACE(std::string(profiles::operationName(operation)));
+    int count = 0;
+    const Box pixels = pixelBox(image, sheet.colours.at(operation), 36, sheet.height, &count);
+    const Box mine = extentOf(sheet, operation);
+    ASSERT_GT(count, 20) << "no pixels of the profile colour";
+    EXPECT_NEAR(pixels.x0, mine.x0, 2 / 36.0);
+    EXPECT_NEAR(pixels.y0, mine.y0, 2 / 36.0);
+    EXPECT_NEAR(pixels.x1, mine.x1, 2 / 36.0);
+    EXPECT_NEAR(pixels.y1, mine.y1, 2 / 36.0);
+  }
+}
+
+}  // namespace
+}  // namespace rotafab::jobs::test
