@@ -7,6 +7,7 @@
 
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
+#include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
 
 int main(int argc, char** argv) {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
       "examples/bunny.obj");
   int status = kSuccess;
   addInspectCommand(app, status);
+  addNestCommand(app, status);
   addProfilesCommand(app, status);
   try {
     app.parse(argc, argv);

@@ -1,0 +1,417 @@
+#include "jobs/Nesting.h"
+
+#include <fmt/format.h>
+#include <clipper.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <random>
+#include <stdexcept>
+#include <tuple>
+
+namespace rotafab::jobs {
+namespace {
+
+using ClipperLib::cInt;
+using ClipperLib::IntPoint;
+using ClipperLib::Path;
+using ClipperLib::Paths;
+
+// Clipper works on integers: 1/10000 in (2.5 um) is far below a laser's kerf.
+constexpr double kScale = 1e4;
+// Outlines are simplified for nesting after being grown by this much, so the
+// simplified shape still contains the true one.
+constexpr double kSimplifyTolerance = 0.002;
+
+cInt toInt(double value) { return static_cast<cInt>(std::llround(value * kScale)); }
+
+Path toPath(const Polygon2& polygon) {
+  Path path;
+  path.reserve(polygon.size());
+  for (const Point2& p : polygon) path.push_back({toInt(p.x()), toInt(p.y())});
+  return path;
+}
+
+Polygon2 rotated(const Polygon2& polygon, double degrees) {
+  // Quarter turns exactly, so that 90-degree layouts stay on the grid.
+  double c = std::cos(degrees * std::numbers::pi / 180.0), s = std::sin(degrees * std::numbers::pi / 180.0);
+  const double quarter = degrees / 90.0;
+  if (std::abs(quarter - std::round(quarter)) < 1e-12) {
+    static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
+    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
+    c = kCos[k];
+    s = kSin[k];
+  }
+  Polygon2 out;
+  out.reserve(polygon.size());
+  for (const Point2& p : polygon) out.emplace_back(c * p.x() - s * p.y(), s * p.x() + c * p.y());
+  return out;
+}
+
+// The largest path of an offset; an outward offset of a simple polygon has one.
+Path grown(const Path& path, double by, ClipperLib::JoinType join) {
+  ClipperLib::ClipperOffset offset(2.0, 0.25 * kScale * 0.001);
+  offset.AddPath(path, join, ClipperLib::etClosedPolygon);
+  Paths out;
+  offset.Execute(out, by * kScale);
+  if (out.empty()) return path;
+  return *std::max_element(out.begin(), out.end(), [](const Path& a, const Path& b) {
+    return std::abs(ClipperLib::Area(a)) < std::abs(ClipperLib::Area(b));
+  });
+}
+
+// One part in one rotation: its outline grown by half the spacing (for no-fit
+// polygons) and the extent of its true outline (for the bed's inner-fit rectangle).
+struct Shape {
+  Path grown;
+  Path negated;  // -grown, the pattern of the Minkowski sums
+  cInt minX = 0, minY = 0, maxX = 0, maxY = 0;
+  double rotation = 0;
+};
+
+Shape makeShape(const Polygon2& outline, double rotation, double spacing) {
+  Shape shape;
+  shape.rotation = rotation;
+  Path path = toPath(rotated(outline, rotation));
+  if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
+  shape.minX = shape.minY = std::numeric_limits<cInt>::max();
+  shape.maxX = shape.maxY = std::numeric_limits<cInt>::min();
+  for (const IntPoint& p : path) {
+    shape.minX = std::min(shape.minX, p.X);
+    shape.minY = std::min(shape.minY, p.Y);
+    shape.maxX = std::max(shape.maxX, p.X);
+    shape.maxY = std::max(shape.maxY, p.Y);
+  }
+  shape.grown = grown(path, spacing / 2 + kSimplifyTolerance, ClipperLib::jtMiter);
+  ClipperLib::CleanPolygon(shape.grown, kSimplifyTolerance * kScale);
+  if (ClipperLib::Area(shape.grown) < 0) std::reverse(shape.grown.begin(), shape.grown.end());
+  for (const IntPoint& p : shape.grown) shape.negated.push_back({-p.X, -p.Y});
+  return shape;
+}
+
+Path translatedPath(const Path& path, IntPoint by) {
+  Path out;
+  out.reserve(path.size());
+  for (const IntPoint& p : path) out.push_back({p.X + by.X, p.Y + by.Y});
+  return out;
+}
+
+struct PlacedShape {
+  int part;
+  int shape;  // index into the part's shapes
+  IntPoint at;
+};
+
+// Places parts one by one, bottom-left on the vertices of the feasible region.
+class Packer {
+ public:
+  Packer(const std::vector<NestingPart>& parts, const NestingOptions& options) : parts_(parts), options_(options) {
+    shapes_.resize(parts.size());
+    for (size_t i = 0; i < parts.size(); ++i) {
+      for (double rotation : parts[i].rotations)
+        shapes_[i].push_back(makeShape(parts[i].outline, rotation, options.spacing));
+    }
+    width_ = options.strip ? stripBound() : toInt(options.width);
+    height_ = toInt(options.height);
+    for (size_t i = 0; i < parts.size(); ++i) {
+      const bool fits = std::any_of(shapes_[i].begin(), shapes_[i].end(), [&](const Shape& s) {
+        return s.maxX - s.minX <= width_ && s.maxY - s.minY <= height_;
+      });
+      if (!fits) {
+        throw std::invalid_argument(fmt::format(
+            "{} ({:.4g} x {:.4g}) does not fit the usable area of {:.4g} x {:.4g} in any allowed rotation",
+            parts[i].name, extentOf(i).x(), extentOf(i).y(), options.strip ? 0.0 : options.width, options.height));
+      }
+    }
+  }
+
+  // Lays out the parts in `sequence`; returns placements in cutting order.
+  NestingResult pack(const std::vector<int>& sequence) {
+    std::vector<std::vector<PlacedShape>> sheets;
+    std::vector<std::pair<int, PlacedShape>> placed;  // (sheet, shape) in placing order
+    for (int part : sequence) {
+      bool done = false;
+      const int firstSheet = options_.order == OrderMode::Strict ? std::max(0, static_cast<int>(sheets.size()) - 1) : 0;
+      for (int s = firstSheet; s < static_cast<int>(sheets.size()) && !done; ++s) {
+        if (options_.order == OrderMode::Window && s + 1 < static_cast<int>(sheets.size())) {
+          // Placed on sheet s, the part is cut after every part on sheets 0..s.
+          int cutBefore = 0;
+          for (int k = 0; k <= s; ++k) cutBefore += static_cast<int>(sheets[k].size());
+          if (parts_[part].order - cutBefore > options_.window) continue;
+        }
+        if (auto spot = bestSpot(part, sheets[s])) {
+          sheets[s].push_back(*spot);
+          placed.emplace_back(s, *spot);
+          done = true;
+        }
+      }
+      if (!done) {
+        if (options_.strip && !sheets.empty()) {
+          throw std::invalid_argument(fmt::format("{} does not fit the strip", parts_[part].name));
+        }
+        sheets.emplace_back();
+        const auto spot = bestSpot(part, sheets.back());
+        if (!spot) throw std::invalid_argument(fmt::format("{} does not fit an empty sheet", parts_[part].name));
+        sheets.back().push_back(*spot);
+        placed.emplace_back(static_cast<int>(sheets.size()) - 1, *spot);
+      }
+    }
+    NestingResult result;
+    result.sheets = static_cast<int>(sheets.size());
+    // Cutting order: sheet by sheet, each in the order its parts were placed.
+    std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    cInt right = 0;
+    for (const auto& [sheet, spot] : placed) {
+      const Shape& shape = shapes_[spot.part][spot.shape];
+      result.placements.push_back({spot.part, sheet + 1, spot.at.X / kScale, spot.at.Y / kScale, shape.rotation});
+      right = std::max(right, spot.at.X + shape.maxX);
+    }
+    result.stripLength = right / kScale;
+    return result;
+  }
+
+ private:
+  Point2 extentOf(size_t part) const {
+    const Shape& s = shapes_[part].front();
+    return {(s.maxX - s.minX) / kScale, (s.maxY - s.minY) / kScale};
+  }
+
+  // A strip long enough for every part side by side.
+  cInt stripBound() const {
+    cInt total = 0;
+    for (const auto& shapes : shapes_) {
+      cInt longest = 0;
+      for (const Shape& s : shapes) longest = std::max({longest, s.maxX - s.minX, s.maxY - s.minY});
+      total += longest + toInt(options_.spacing) + 1;
+    }
+    return total;
+  }
+
+  // The no-fit polygon of moving shape `m` against placed shape `q` (at q.at):
+  // the reference positions where the two grown shapes overlap. The Minkowski
+  // sum of the boundaries, plus the two cases where one shape holds the other.
+  const Paths& boundarySum(int movingPart, int movingShape, int placedPart, int placedShape) {
+    const auto key = std::make_tuple(movingPart, movingShape, placedPart, placedShape);
+    auto it = sums_.find(key);
+    if (it == sums_.end()) {
+      Paths sum;
+      ClipperLib::MinkowskiSum(shapes_[movingPart][movingShape].negated, shapes_[placedPart][placedShape].grown, sum,
+                               true);
+      it = sums_.emplace(key, std::move(sum)).first;
+    }
+    return it->second;
+  }
+
+  std::optional<PlacedShape> bestSpot(int part, const std::vector<PlacedShape>& sheet) {
+    std::optional<PlacedShape> best;
+    for (int k = 0; k < static_cast<int>(shapes_[part].size()); ++k) {
+      const Shape& moving = shapes_[part][k];
+      // Inner-fit rectangle: reference positions keeping the true outline on the area.
+      const cInt x0 = -moving.minX, y0 = -moving.minY;
+      cInt x1 = width_ - moving.maxX, y1 = height_ - moving.maxY;
+      if (x1 < x0 || y1 < y0) continue;
+      // A part exactly as wide (or high) as the area has a one-line inner-fit
+      // region, which Clipper would drop: give it one grid unit (1e-4 in).
+      x1 = std::max(x1, x0 + 1);
+      y1 = std::max(y1, y0 + 1);
+      ClipperLib::Clipper clipper;
+      clipper.AddPath(Path{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, ClipperLib::ptSubject, true);
+      for (const PlacedShape& q : sheet) {
+        const Shape& fixed = shapes_[q.part][q.shape];
+        clipper.AddPaths(translatedPathsOf(boundarySum(part, k, q.part, q.shape), q.at), ClipperLib::ptClip, true);
+        clipper.AddPath(translatedPath(fixed.grown, {q.at.X - moving.grown[0].X, q.at.Y - moving.grown[0].Y}),
+                        ClipperLib::ptClip, true);
+        clipper.AddPath(translatedPath(moving.negated, {q.at.X + fixed.grown[0].X, q.at.Y + fixed.grown[0].Y}),
+                        ClipperLib::ptClip, true);
+      }
+      Paths feasible;
+      clipper.Execute(ClipperLib::ctDifference, feasible, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      std::vector<IntPoint> candidates;
+      for (const Path& region : feasible) candidates.insert(candidates.end(), region.begin(), region.end());
+      // Bottom-left: leftmost, then lowest; the first that an exact check
+      // confirms, so that no rounding in the no-fit polygons can let parts overlap.
+      std::sort(candidates.begin(), candidates.end(),
+                [](const IntPoint& a, const IntPoint& b) { return a.X < b.X || (a.X == b.X && a.Y < b.Y); });
+      for (const IntPoint& p : candidates) {
+        if (best && (p.X > best->at.X || (p.X == best->at.X && p.Y >= best->at.Y))) break;
+        if (clear(moving, p, sheet)) {
+          best = PlacedShape{part, k, p};
+          break;
+        }
+      }
+    }
+    return best;
+  }
+
+  // Whether the grown shape at `at` keeps off every placed grown shape (touching allowed).
+  bool clear(const Shape& moving, IntPoint at, const std::vector<PlacedShape>& sheet) const {
+    const Path candidate = translatedPath(moving.grown, at);
+    cInt minX = std::numeric_limits<cInt>::max(), minY = minX, maxX = std::numeric_limits<cInt>::min(), maxY = maxX;
+    for (const IntPoint& p : candidate) {
+      minX = std::min(minX, p.X), minY = std::min(minY, p.Y), maxX = std::max(maxX, p.X), maxY = std::max(maxY, p.Y);
+    }
+    for (const PlacedShape& q : sheet) {
+      const Shape& fixed = shapes_[q.part][q.shape];
+      const cInt grow = toInt(options_.spacing / 2 + 2 * kSimplifyTolerance);
+      if (q.at.X + fixed.maxX + grow < minX || q.at.X + fixed.minX - grow > maxX || q.at.Y + fixed.maxY + grow < minY ||
+          q.at.Y + fixed.minY - grow > maxY) {
+        continue;
+      }
+      ClipperLib::Clipper clipper;
+      clipper.AddPath(candidate, ClipperLib::ptSubject, true);
+      clipper.AddPath(translatedPath(fixed.grown, q.at), ClipperLib::ptClip, true);
+      Paths common;
+      clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+      double area = 0;
+      for (const Path& c : common) area += std::abs(ClipperLib::Area(c));
+      if (area > 4.0 * static_cast<double>(candidate.size())) return false;  // beyond rounding along the edges
+    }
+    return true;
+  }
+
+  static Paths translatedPathsOf(const Paths& paths, IntPoint by) {
+    Paths out;
+    out.reserve(paths.size());
+    for (const Path& path : paths) out.push_back(translatedPath(path, by));
+    return out;
+  }
+
+  const std::vector<NestingPart>& parts_;
+  const NestingOptions& options_;
+  std::vector<std::vector<Shape>> shapes_;
+  std::map<std::tuple<int, int, int, int>, Paths> sums_;
+  cInt width_ = 0, height_ = 0;
+};
+
+// Smaller is better: fewer sheets, then less used of the last sheet (or a shorter strip).
+std::pair<int, double> cost(const NestingResult& result, const std::vector<NestingPart>& parts) {
+  if (result.sheets == 0) return {0, 0.0};
+  double lastExtent = 0;
+  for (const auto& p : result.placements) {
+    if (p.sheet != result.sheets) continue;
+    for (const Point2& v : placedOutline(parts[p.part], p)) lastExtent = std::max(lastExtent, v.x());
+  }
+  return {result.sheets, lastExtent};
+}
+
+}  // namespace
+
+double polygonArea(const Polygon2& polygon) {
+  double twice = 0;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[(i + 1) % polygon.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return twice / 2;
+}
+
+Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement) {
+  Polygon2 out = rotated(part.outline, placement.rotation);
+  for (Point2& p : out) p += Point2(placement.x, placement.y);
+  return out;
+}
+
+NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options) {
+  for (const auto& part : parts) {
+    if (part.outline.size() < 3 || std::abs(polygonArea(part.outline)) <= 0) {
+      throw std::invalid_argument(fmt::format("{}: the outline is not a polygon with area", part.name));
+    }
+    if (part.rotations.empty()) throw std::invalid_argument(fmt::format("{}: no allowed rotation", part.name));
+  }
+  Packer packer(parts, options);
+  // The first layout: assembly order, or for free order the largest parts first.
+  std::vector<int> sequence(parts.size());
+  std::iota(sequence.begin(), sequence.end(), 0);
+  std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) { return parts[a].order < parts[b].order; });
+  if (options.order == OrderMode::Free) {
+    std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) {
+      return std::abs(polygonArea(parts[a].outline)) > std::abs(polygonArea(parts[b].outline));
+    });
+  }
+  NestingResult best = packer.pack(sequence);
+  auto bestCost = cost(best, parts);
+  int evaluations = 1;
+  // Improvement: swap two parts of the sequence (within the window when the
+  // order is bounded) and keep the swap when the layout is no worse.
+  if (options.order != OrderMode::Strict && parts.size() > 1) {
+    std::mt19937 random(options.seed);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.seconds);
+    while (std::chrono::steady_clock::now() < deadline) {
+      std::vector<int> trial = sequence;
+      const size_t i = random() % trial.size();
+      size_t j = random() % trial.size();
+      if (options.order == OrderMode::Window) {
+        const long span = std::max(1, options.window);
+        j = std::clamp<long>(static_cast<long>(i) + static_cast<long>(random() % (2 * span + 1)) - span, 0,
+                             static_cast<long>(trial.size()) - 1);
+      }
+      if (i == j) continue;
+      std::swap(trial[i], trial[j]);
+      NestingResult result = packer.pack(trial);
+      ++evaluations;
+      const auto trialCost = cost(result, parts);
+      if (trialCost <= bestCost) {
+        if (trialCost < bestCost && options.progress) {
+          options.progress(fmt::format("{} sheet{}, last sheet {:.2f} in long", trialCost.first,
+                                       trialCost.first == 1 ? "" : "s", trialCost.second));
+        }
+        best = std::move(result);
+        bestCost = trialCost;
+        sequence = std::move(trial);
+      }
+    }
+  }
+  best.evaluations = evaluations;
+  for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));
+  return best;
+}
+
+std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,
+                                        const NestingOptions& options, double tolerance) {
+  std::vector<std::string> problems;
+  std::map<int, std::vector<std::pair<int, Path>>> bySheet;
+  const double reach = std::max(0.0, (options.spacing - tolerance) / 2);
+  for (const auto& placement : result.placements) {
+    const Polygon2 outline = placedOutline(parts[placement.part], placement);
+    for (const Point2& p : outline) {
+      const bool inside = p.x() >= -tolerance && p.y() >= -tolerance && p.y() <= options.height + tolerance &&
+                          (options.strip || p.x() <= options.width + tolerance);
+      if (!inside) {
+        problems.push_back(fmt::format("sheet {}: {} leaves the usable area at ({:.4f}, {:.4f})", placement.sheet,
+                                       parts[placement.part].name, p.x(), p.y()));
+        break;
+      }
+    }
+    Path path = toPath(outline);
+    if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
+    bySheet[placement.sheet].emplace_back(placement.part, reach > 0 ? grown(path, reach, ClipperLib::jtRound) : path);
+  }
+  for (const auto& [sheet, shapes] : bySheet) {
+    for (size_t a = 0; a < shapes.size(); ++a) {
+      for (size_t b = a + 1; b < shapes.size(); ++b) {
+        ClipperLib::Clipper clipper;
+        clipper.AddPath(shapes[a].second, ClipperLib::ptSubject, true);
+        clipper.AddPath(shapes[b].second, ClipperLib::ptClip, true);
+        Paths common;
+        clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+        double area = 0;
+        for (const Path& p : common) area += std::abs(ClipperLib::Area(p));
+        if (area > 1.0) {  // more than 1e-8 square inches
+          problems.push_back(fmt::format("sheet {}: {} and {} overlap or are nearer than {} ({:.3g} sq in in common)",
+                                         sheet, parts[shapes[a].first].name, parts[shapes[b].first].name,
+                                         options.spacing, area / (kScale * kScale)));
+        }
+      }
+    }
+  }
+  return problems;
+}
+
+}  // namespace rotafab::jobs

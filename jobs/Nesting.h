@@ -1,0 +1,79 @@
+#pragma once
+// True-shape nesting of parts onto beds or into a strip (issue 3): no-fit
+// polygons from Clipper's Minkowski sums, bottom-left placement on the
+// vertices of the feasible region, then an improvement phase that tries other
+// orders and rotations within a time budget. Parts are concave and interlock;
+// bounding boxes and hulls are never used for collisions. Deterministic for a
+// given seed and budget... of evaluations: the time budget only stops the
+// search early, the sequence of candidates tried is fixed by the seed.
+//
+// Coordinates in inches; a placement rotates the part's outline about its own
+// origin by `rotation` degrees (counter-clockwise), then translates it by
+// (x, y) in the usable area (origin at its bottom-left corner).
+
+#include <Eigen/Core>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rotafab::jobs {
+
+using Point2 = Eigen::Vector2d;
+using Polygon2 = std::vector<Point2>;  // a simple polygon, not closed (first point not repeated)
+
+struct NestingPart {
+  std::string name;                                        // for messages: "item 3 copy 2", "panel 17"
+  Polygon2 outline;                                        // outer contour, kerf already applied
+  std::vector<double> rotations{0.0, 90.0, 180.0, 270.0};  // allowed, degrees
+  int order = 0;                                           // assembly order, 0-based
+};
+
+// How far the layout may move parts from their assembly order (issue 3, item 3).
+enum class OrderMode {
+  Strict,  // sheet k holds a contiguous run of the order
+  Window,  // a part may move at most `window` places
+  Free,
+};
+
+struct NestingOptions {
+  double width = 31.5;      // usable area; ignored in strip mode
+  double height = 17.5;     // usable area, or the strip's height
+  bool strip = false;       // one strip of fixed height, least length
+  double spacing = 0.0625;  // least distance between two outlines
+  double seconds = 5.0;     // improvement budget (wall clock)
+  OrderMode order = OrderMode::Free;
+  int window = 8;
+  unsigned seed = 1;
+  std::function<void(const std::string&)> progress;  // one line per improvement, optional
+};
+
+struct PartPlacement {
+  int part = 0;   // index into the parts
+  int sheet = 1;  // 1-based; always 1 in strip mode
+  double x = 0, y = 0;
+  double rotation = 0;  // degrees
+};
+
+struct NestingResult {
+  std::vector<PartPlacement> placements;  // one per part, in cutting order
+  int sheets = 0;
+  double stripLength = 0;  // strip mode: the rightmost extent of any part
+  double partArea = 0;     // sum of the outlines' areas
+  int evaluations = 0;     // layouts tried
+};
+
+// Throws std::invalid_argument naming the part when a part cannot fit the usable
+// area (or the strip's height) in any allowed rotation.
+NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options);
+
+// The placed outline of a part, in usable-area coordinates.
+Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement);
+
+// Exact check of a layout: every outline inside the area, no two outlines on a
+// sheet overlapping or nearer than `spacing - tolerance`. One line per problem.
+std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,
+                                        const NestingOptions& options, double tolerance = 1e-3);
+
+double polygonArea(const Polygon2& polygon);  // signed: positive counter-clockwise
+
+}  // namespace rotafab::jobs

@@ -1,0 +1,84 @@
+// `rotafab nest` through the built program: SPEC's summary, layout.json, and
+// one-line refusals of bad instance files.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+const std::string kCli = ROTAFAB_CLI;
+
+TEST(NestCli, StripRunWritesLayoutAndSummary) {
+  TempDir dir;
+  const auto instance = dir.write(
+      "parts.json",
+      R"({"name":"t","strip_height":10,"items":[)"
+      R"({"id":0,"demand":3,"allowed_orientations":[0,90],"shape":{"type":"simple_polygon","data":[[0,0],[4,0],[4,1],[1,1],[1,3],[0,3],[0,0]]}},)"
+      R"({"id":7,"demand":2,"allowed_orientations":[0],"shape":{"type":"simple_polygon","data":[[0,0],[2,0],[1,2]]}}]})");
+  const CommandResult result =
+      run(kCli + " nest " + instance.string() + " --strip --time 0.2 --json --out " + (dir.path() / "out").string());
+  ASSERT_EQ(result.status, 0) << result.err;
+  const auto summary = nlohmann::json::parse(result.out);
+  EXPECT_EQ(summary["sheets"], 1);
+  EXPECT_TRUE(summary["utilization"].is_null());
+  EXPECT_GT(summary["density"].get<double>(), 0.1);
+  EXPECT_LE(summary["density"].get<double>(), 1.0);
+  const double area = 3 * 6.0 + 2 * 2.0;
+  EXPECT_NEAR(summary["density"].get<double>(), area / (10 * summary["strip_length"].get<double>()), 1e-9);
+  const auto layout = nlohmann::json::parse(readFile(dir.path() / "out" / "layout.json"));
+  ASSERT_EQ(layout["placements"].size(), 5u);
+  std::multiset<int> items;
+  for (const auto& p : layout["placements"]) {
+    items.insert(p["item"].get<int>());
+    EXPECT_EQ(p["sheet"], 1);
+  }
+  EXPECT_EQ(items.count(0), 3u);
+  EXPECT_EQ(items.count(7), 2u);
+  EXPECT_NE(readFile(dir.path() / "out" / "layout.svg").find("<svg"), std::string::npos);
+}
+
+TEST(NestCli, BinRunUsesTheWorkshopBedByDefault) {
+  TempDir dir;
+  const auto instance = dir.write(
+      "parts.json", R"({"items":[{"id":1,"demand":4,"shape":{"type":"simple_polygon","data":[[0,0],[20,0],[20,10],[0,10]]}}]})");
+  const CommandResult result = run(kCli + " nest " + instance.string() + " --time 0 --json");
+  ASSERT_EQ(result.status, 0) << result.err;
+  const auto summary = nlohmann::json::parse(result.out);
+  EXPECT_EQ(summary["sheets"], 4) << "a 20 x 10 part fits once on a 31.5 x 17.5 usable bed";
+  EXPECT_NEAR(summary["utilization"].get<double>(), 200.0 / (31.5 * 17.5), 1e-9);
+}
+
+TEST(NestCli, BadInstancesAreOneLineNamingTheElement) {
+  TempDir dir;
+  struct Case {
+    const char* json;
+    std::string message;
+  };
+  const Case cases[] = {
+      {R"({"items":[{"id":1,"shape":{"type":"simple_polygon","data":[[0,0],[1,0]]}}]})",
+       "items[0].shape.data: expected a polygon of at least 3 points with area"},
+      {R"({"items":[{"id":1,"demand":0,"shape":{"type":"simple_polygon","data":[[0,0],[1,0],[0,1]]}}]})",
+       "items[0].demand: expected a whole number from 1"},
+      {R"({"items":[{"id":1,"shape":{"type":"simple_polygon","data":[[0,0],[1,"x"],[0,1]]}}]})",
+       "items[0].shape.data[1]: expected [x, y]"},
+      {R"({"items":[{"id":1,"shape":{"type":"simple_polygon","data":[[0,0],[40,0],[40,1]]}}]})",
+       "item 1 copy 1 (40 x 1) does not fit the usable area of 31.5 x 17.5 in any allowed rotation"},
+      {R"({"things":[]})", "items: expected an object with an \"items\" list"},
+  };
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.json);
+    const auto instance = dir.write("bad.json", c.json);
+    const CommandResult result = run(kCli + " nest " + instance.string() + " --time 0");
+    EXPECT_EQ(result.status, 1);
+    EXPECT_EQ(result.err, "error: " + instance.string() + ": " + c.message + "\n");
+  }
+  const CommandResult usage = run(kCli + " nest x.json --order sideways");
+  EXPECT_EQ(usage.status, 2);
+}
+
+}  // namespace
+}  // namespace rotafab::test

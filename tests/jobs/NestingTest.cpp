@@ -1,0 +1,186 @@
+// Nesting (issue 3, items 2-3): every layout is checked with exact polygon
+// geometry — no two parts nearer than the spacing, all inside the area — on
+// random concave parts, and the order modes keep their promises.
+
+#include "jobs/Nesting.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <set>
+
+namespace rotafab::jobs {
+namespace {
+
+// A star-shaped vertex panel: `spikes` points between two radii.
+Polygon2 star(std::mt19937& random, int spikes, double outer) {
+  std::uniform_real_distribution<double> inner(0.3, 0.7), jitter(0.85, 1.0);
+  Polygon2 p;
+  const double ratio = inner(random);
+  for (int i = 0; i < 2 * spikes; ++i) {
+    const double angle = std::numbers::pi * i / spikes;
+    const double r = (i % 2 ? ratio : 1.0) * outer * jitter(random);
+    p.emplace_back(r * std::cos(angle), r * std::sin(angle));
+  }
+  return p;
+}
+
+// A long wavy strip, like an unfolded woven ribbon.
+Polygon2 wavyStrip(std::mt19937& random, double length, double width) {
+  std::uniform_real_distribution<double> amplitude(0.1, 0.6);
+  const double a = amplitude(random);
+  const int steps = 24;
+  Polygon2 p;
+  for (int i = 0; i <= steps; ++i) {
+    const double x = length * i / steps;
+    p.emplace_back(x, a * std::sin(2 * std::numbers::pi * x / length * 2));
+  }
+  for (int i = steps; i >= 0; --i) {
+    const double x = length * i / steps;
+    p.emplace_back(x, width + a * std::sin(2 * std::numbers::pi * x / length * 2));
+  }
+  return p;
+}
+
+std::vector<NestingPart> randomParts(unsigned seed, int count) {
+  std::mt19937 random(seed);
+  std::vector<NestingPart> parts;
+  for (int i = 0; i < count; ++i) {
+    NestingPart part;
+    part.name = "panel " + std::to_string(i + 1);
+    part.order = i;
+    switch (random() % 4) {
+      case 0:
+        part.outline = wavyStrip(random, 6.0 + random() % 10, 0.6);
+        break;
+      case 1:
+        part.outline = star(random, 3 + random() % 3, 0.2 + (random() % 10) / 20.0);
+        break;  // tiny
+      default:
+        part.outline = star(random, 4 + random() % 8, 1.0 + (random() % 30) / 10.0);
+        break;
+    }
+    parts.push_back(std::move(part));
+  }
+  return parts;
+}
+
+void expectValid(const std::vector<NestingPart>& parts, const NestingResult& result, const NestingOptions& options) {
+  EXPECT_EQ(layoutProblems(parts, result, options), std::vector<std::string>{});
+  ASSERT_EQ(result.placements.size(), parts.size());
+  std::set<int> placed;
+  for (const auto& p : result.placements) {
+    placed.insert(p.part);
+    EXPECT_GE(p.sheet, 1);
+    EXPECT_LE(p.sheet, result.sheets);
+  }
+  EXPECT_EQ(placed.size(), parts.size()) << "every part exactly once";
+  double area = 0;
+  for (const auto& part : parts) area += std::abs(polygonArea(part.outline));
+  if (!options.strip) {
+    EXPECT_GE(result.sheets, std::ceil(area / (options.width * options.height) - 1e-9));
+  }
+}
+
+TEST(Nesting, RandomConcavePartsNeverOverlapAndStayInside) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(seed);
+    const auto parts = randomParts(seed, 16);
+    NestingOptions options;
+    options.width = 31.5;
+    options.height = 17.5;
+    options.spacing = 0.0625;
+    options.seconds = 0.2;
+    options.seed = seed;
+    expectValid(parts, nest(parts, options), options);
+  }
+}
+
+TEST(Nesting, StripModeKeepsTheHeightAndPacksTheLength) {
+  const auto parts = randomParts(7, 14);
+  NestingOptions options;
+  options.strip = true;
+  options.height = 10;
+  options.spacing = 0;
+  options.seconds = 0.2;
+  const NestingResult result = nest(parts, options);
+  expectValid(parts, result, options);
+  EXPECT_EQ(result.sheets, 1);
+  double area = 0;
+  for (const auto& part : parts) area += std::abs(polygonArea(part.outline));
+  EXPECT_GT(result.stripLength, area / options.height) << "no denser than solid";
+}
+
+TEST(Nesting, SameSeedNoBudgetSameLayout) {
+  const auto parts = randomParts(11, 12);
+  NestingOptions options;
+  options.seconds = 0;
+  const NestingResult a = nest(parts, options), b = nest(parts, options);
+  ASSERT_EQ(a.placements.size(), b.placements.size());
+  for (size_t i = 0; i < a.placements.size(); ++i) {
+    EXPECT_EQ(a.placements[i].part, b.placements[i].part);
+    EXPECT_EQ(a.placements[i].x, b.placements[i].x);
+    EXPECT_EQ(a.placements[i].y, b.placements[i].y);
+    EXPECT_EQ(a.placements[i].rotation, b.placements[i].rotation);
+  }
+}
+
+TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
+  const auto parts = randomParts(5, 20);
+  NestingOptions options;
+  options.order = OrderMode::Strict;
+  options.width = 15;
+  options.height = 10;
+  options.seconds = 0;
+  const NestingResult result = nest(parts, options);
+  expectValid(parts, result, options);
+  // In cutting order the assembly order never goes down.
+  for (size_t i = 1; i < result.placements.size(); ++i) {
+    EXPECT_EQ(parts[result.placements[i].part].order, parts[result.placements[i - 1].part].order + 1);
+  }
+}
+
+TEST(Nesting, WindowOrderMovesNoPartFartherThanTheWindow) {
+  const auto parts = randomParts(6, 20);
+  NestingOptions options;
+  options.order = OrderMode::Window;
+  options.window = 4;
+  options.width = 15;
+  options.height = 10;
+  options.seconds = 0.3;
+  const NestingResult result = nest(parts, options);
+  expectValid(parts, result, options);
+  for (size_t i = 0; i < result.placements.size(); ++i) {
+    EXPECT_LE(parts[result.placements[i].part].order - static_cast<int>(i), options.window)
+        << parts[result.placements[i].part].name << " cut at " << i;
+  }
+}
+
+TEST(Nesting, PartLargerThanTheBedIsRefusedByName) {
+  std::vector<NestingPart> parts = randomParts(8, 3);
+  parts[1].name = "panel 42";
+  parts[1].outline = {{0, 0}, {40, 0}, {40, 1}, {0, 1}};
+  NestingOptions options;
+  try {
+    nest(parts, options);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("panel 42 (40 x 1) does not fit the usable area of 31.5 x 17.5", 0), 0u)
+        << error.what();
+  }
+}
+
+TEST(Nesting, BedSizedPartFillsOneSheet) {
+  std::vector<NestingPart> parts(1);
+  parts[0].name = "board";
+  parts[0].outline = {{0, 0}, {31.5, 0}, {31.5, 17.5}, {0, 17.5}};
+  NestingOptions options;
+  const NestingResult result = nest(parts, options);
+  expectValid(parts, result, options);
+  EXPECT_EQ(result.sheets, 1);
+}
+
+}  // namespace
+}  // namespace rotafab::jobs
