@@ -70,7 +70,8 @@ void BM_ImportAnalyzeTrace(benchmark::State& state) {
   }
   state.SetComplexityN(faces);
   state.counters["faces"] = static_cast<double>(faces);
-  state.counters["faces/s"] = benchmark::Counter(static_cast<double>(faces), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["faces/s"] =
+      benchmark::Counter(static_cast<double>(faces), benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_ImportAnalyzeTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
 

@@ -132,14 +132,15 @@ class Packer {
   }
 
   // Lays out the parts in `sequence`; returns placements in cutting order.
-  NestingResult pack(const std::vector<int>& sequence) {
+  // `policy` Strict fills only the last sheet; otherwise first fit over all sheets.
+  NestingResult pack(const std::vector<int>& sequence, OrderMode policy) {
     std::vector<std::vector<PlacedShape>> sheets;
     std::vector<std::pair<int, PlacedShape>> placed;  // (sheet, shape) in placing order
     for (int part : sequence) {
       bool done = false;
-      const int firstSheet = options_.order == OrderMode::Strict ? std::max(0, static_cast<int>(sheets.size()) - 1) : 0;
+      const int firstSheet = policy == OrderMode::Strict ? std::max(0, static_cast<int>(sheets.size()) - 1) : 0;
       for (int s = firstSheet; s < static_cast<int>(sheets.size()) && !done; ++s) {
-        if (options_.order == OrderMode::Window && s + 1 < static_cast<int>(sheets.size())) {
+        if (policy == OrderMode::Window && s + 1 < static_cast<int>(sheets.size())) {
           // Placed on sheet s, the part is cut after every part on sheets 0..s.
           int cutBefore = 0;
           for (int k = 0; k <= s; ++k) cutBefore += static_cast<int>(sheets[k].size());
@@ -335,7 +336,16 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
       return std::abs(polygonArea(parts[a].outline)) > std::abs(polygonArea(parts[b].outline));
     });
   }
-  NestingResult best = packer.pack(sequence);
+  // Window: start from the strict layout (nothing moves) and accept only
+  // layouts in which no part is cut more than `window` places from its order.
+  auto withinWindow = [&](const NestingResult& result) {
+    if (options.order != OrderMode::Window) return true;
+    for (size_t i = 0; i < result.placements.size(); ++i) {
+      if (std::abs(static_cast<int>(i) - parts[result.placements[i].part].order) > options.window) return false;
+    }
+    return true;
+  };
+  NestingResult best = packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
   auto bestCost = cost(best, parts);
   int evaluations = 1;
   // Improvement: swap two parts of the sequence (within the window when the
@@ -354,10 +364,10 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
       }
       if (i == j) continue;
       std::swap(trial[i], trial[j]);
-      NestingResult result = packer.pack(trial);
+      NestingResult result = packer.pack(trial, options.order);
       ++evaluations;
       const auto trialCost = cost(result, parts);
-      if (trialCost <= bestCost) {
+      if (trialCost <= bestCost && withinWindow(result)) {
         if (trialCost < bestCost && options.progress) {
           options.progress(fmt::format("{} sheet{}, last sheet {:.2f} in long", trialCost.first,
                                        trialCost.first == 1 ? "" : "s", trialCost.second));

@@ -31,7 +31,7 @@ struct NestingPart {
 // How far the layout may move parts from their assembly order (issue 3, item 3).
 enum class OrderMode {
   Strict,  // sheet k holds a contiguous run of the order
-  Window,  // a part may move at most `window` places
+  Window,  // no part is cut more than `window` places before or after its order
   Free,
 };
 

@@ -44,7 +44,8 @@ TEST(NestCli, StripRunWritesLayoutAndSummary) {
 TEST(NestCli, BinRunUsesTheWorkshopBedByDefault) {
   TempDir dir;
   const auto instance = dir.write(
-      "parts.json", R"({"items":[{"id":1,"demand":4,"shape":{"type":"simple_polygon","data":[[0,0],[20,0],[20,10],[0,10]]}}]})");
+      "parts.json",
+      R"({"items":[{"id":1,"demand":4,"shape":{"type":"simple_polygon","data":[[0,0],[20,0],[20,10],[0,10]]}}]})");
   const CommandResult result = run(kCli + " nest " + instance.string() + " --time 0 --json");
   ASSERT_EQ(result.status, 0) << result.err;
   const auto summary = nlohmann::json::parse(result.out);

@@ -153,7 +153,7 @@ TEST(Nesting, WindowOrderMovesNoPartFartherThanTheWindow) {
   const NestingResult result = nest(parts, options);
   expectValid(parts, result, options);
   for (size_t i = 0; i < result.placements.size(); ++i) {
-    EXPECT_LE(parts[result.placements[i].part].order - static_cast<int>(i), options.window)
+    EXPECT_LE(std::abs(parts[result.placements[i].part].order - static_cast<int>(i)), options.window)
         << parts[result.placements[i].part].name << " cut at " << i;
   }
 }

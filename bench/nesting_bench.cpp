@@ -1,0 +1,81 @@
+// Bin-mode nesting benchmark (issue 3, item 8): 200 star-shaped vertex panels
+// and 100 wavy strips on the workshop bed (32 x 18 in, 1/4 in margins, 1/16 in
+// spacing). Prints sheets used against the area lower bound
+// ceil(part area / usable bed area) and the utilisation of every sheet but the
+// last (target: at least 75%).
+//
+//   build/rotafab_nest_bench [SECONDS]     improvement budget per instance (default 60)
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <string>
+
+#include "jobs/Nesting.h"
+
+using namespace rotafab::jobs;
+
+namespace {
+
+Polygon2 star(std::mt19937& random) {
+  std::uniform_real_distribution<double> radius(0.9, 2.4), inner(0.35, 0.65), jitter(0.85, 1.0);
+  const int spikes = 5 + random() % 4;  // vertex bands of valence 5 to 8
+  const double outer = radius(random), ratio = inner(random);
+  Polygon2 p;
+  for (int i = 0; i < 2 * spikes; ++i) {
+    const double a = std::numbers::pi * i / spikes;
+    const double r = (i % 2 ? ratio : 1.0) * outer * jitter(random);
+    p.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  return p;
+}
+
+Polygon2 wavyStrip(std::mt19937& random) {
+  std::uniform_real_distribution<double> length(8, 20), amplitude(0.2, 0.8), width(0.6, 1.0);
+  const double l = length(random), a = amplitude(random), w = width(random);
+  const int steps = 32;
+  Polygon2 p;
+  for (int i = 0; i <= steps; ++i) p.emplace_back(l * i / steps, a * std::sin(4 * std::numbers::pi * i / steps));
+  for (int i = steps; i >= 0; --i) p.emplace_back(l * i / steps, w + a * std::sin(4 * std::numbers::pi * i / steps));
+  return p;
+}
+
+void run(const std::string& name, const std::vector<NestingPart>& parts, double seconds) {
+  NestingOptions options;  // the workshop bed: 31.5 x 17.5 usable, 1/16 in spacing
+  options.seconds = seconds;
+  const auto start = std::chrono::steady_clock::now();
+  const NestingResult result = nest(parts, options);
+  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double usable = options.width * options.height;
+  std::vector<double> areaOnSheet(result.sheets, 0.0);
+  for (const auto& p : result.placements) areaOnSheet[p.sheet - 1] += std::abs(polygonArea(parts[p.part].outline));
+  double worst = 1.0;
+  std::string perSheet;
+  for (int s = 0; s < result.sheets; ++s) {
+    perSheet += fmt::format("{}{:.0f}%", s ? " " : "", 100 * areaOnSheet[s] / usable);
+    if (s + 1 < result.sheets) worst = std::min(worst, areaOnSheet[s] / usable);
+  }
+  const auto problems = layoutProblems(parts, result, options);
+  fmt::print("{}: {} parts, {} sheets (lower bound {}), worst sheet but the last {:.1f}%, {:.1f} s, {} layouts{}\n",
+             name, parts.size(), result.sheets, static_cast<int>(std::ceil(result.partArea / usable)),
+             100 * (result.sheets > 1 ? worst : areaOnSheet[0] / usable), elapsed, result.evaluations,
+             problems.empty() ? "" : " INVALID: " + problems.front());
+  fmt::print("  per sheet: {}\n", perSheet);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const double seconds = argc > 1 ? std::stod(argv[1]) : 60.0;
+  std::mt19937 random(2011);
+  std::vector<NestingPart> stars, strips;
+  for (int i = 0; i < 200; ++i) stars.push_back({fmt::format("star {}", i + 1), star(random), {0, 90, 180, 270}, i});
+  for (int i = 0; i < 100; ++i)
+    strips.push_back({fmt::format("strip {}", i + 1), wavyStrip(random), {0, 90, 180, 270}, i});
+  run("200 star panels", stars, seconds);
+  run("100 wavy strips", strips, seconds);
+  return 0;
+}

@@ -1,0 +1,108 @@
+#include "jobs/SheetPlanner.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "jobs/AtomicFile.h"
+#include "jobs/DxfWriter.h"
+#include "jobs/EpsWriter.h"
+#include "jobs/SvgWriter.h"
+
+namespace rotafab::jobs {
+
+Point2 onSheet(const PlannedPart& placement, const Point2& local) {
+  const double angle = placement.rotation * std::numbers::pi / 180.0;
+  double c = std::cos(angle), s = std::sin(angle);
+  const double quarter = placement.rotation / 90.0;
+  if (std::abs(quarter - std::round(quarter)) < 1e-12) {  // exact quarter turns, as the nester uses
+    static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
+    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
+    c = kCos[k];
+    s = kSin[k];
+  }
+  return {c * local.x() - s * local.y() + placement.x, s * local.x() + c * local.y() + placement.y};
+}
+
+SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,
+                     const PlanOptions& options) {
+  const profiles::Bed& bed = machine.bed;
+  std::vector<Part> cut;
+  cut.reserve(parts.size());
+  for (const Part& part : parts) cut.push_back(compensateKerf(part, options.kerf));
+
+  std::vector<NestingPart> nestingParts;
+  for (const Part& part : cut) nestingParts.push_back({part.name, part.outline, part.rotations, part.order});
+  NestingOptions nesting;
+  nesting.width = bed.width - 2 * bed.margin;
+  nesting.height = bed.height - 2 * bed.margin;
+  nesting.spacing = options.spacing >= 0 ? options.spacing : 1.0 / 16 + options.kerf;
+  nesting.seconds = options.seconds;
+  nesting.order = options.order;
+  nesting.window = options.window;
+  nesting.seed = options.seed;
+  nesting.progress = options.progress;
+  const NestingResult nested = nest(nestingParts, nesting);
+
+  SheetPlan plan;
+  for (size_t i = 0; i < nested.placements.size(); ++i) {
+    const PartPlacement& p = nested.placements[i];
+    plan.parts.push_back({p.part, p.sheet, p.x + bed.margin, p.y + bed.margin, p.rotation, static_cast<int>(i),
+                          static_cast<int>(i) - parts[p.part].order});
+  }
+  for (const Part& part : parts) plan.partArea += std::abs(polygonArea(part.outline));
+  plan.utilization = plan.partArea / (nested.sheets * nesting.width * nesting.height);
+
+  for (int s = 1; s <= nested.sheets; ++s) {
+    SheetDrawing sheet;
+    sheet.index = s;
+    sheet.sheetCount = nested.sheets;
+    sheet.width = bed.width;
+    sheet.height = bed.height;
+    sheet.margin = bed.margin;
+    sheet.title =
+        fmt::format("{}{}sheet {} of {}", options.title, options.title.empty() ? "" : " - ", s, nested.sheets);
+    for (profiles::Operation operation : profiles::kAllOperations)
+      sheet.colours[operation] = machine.settingFor(operation).rgb;
+    // The material's edge (not cut), then per operation in cutting order.
+    sheet.paths.push_back(
+        {Operation::Outline, {{0, 0}, {bed.width, 0}, {bed.width, bed.height}, {0, bed.height}}, true});
+    auto add = [&](Operation operation, const std::vector<Polyline2>& strokes, const PlannedPart& placed, bool closed) {
+      for (const Polyline2& stroke : strokes) {
+        if (stroke.size() < 2) continue;
+        DrawnPath path{operation, {}, closed};
+        for (const Point2& p : stroke) path.points.push_back(onSheet(placed, p));
+        sheet.paths.push_back(std::move(path));
+      }
+    };
+    for (Operation stage : {Operation::Etch, Operation::Score}) {
+      for (const PlannedPart& placed : plan.parts) {
+        if (placed.sheet != s) continue;
+        add(stage, stage == Operation::Etch ? cut[placed.part].etch : cut[placed.part].score, placed, false);
+      }
+    }
+    for (const PlannedPart& placed : plan.parts)
+      if (placed.sheet == s) add(Operation::Cut, cut[placed.part].holes, placed, true);
+    for (const PlannedPart& placed : plan.parts)
+      if (placed.sheet == s) add(Operation::Cut, {cut[placed.part].outline}, placed, true);
+    plan.sheets.push_back(std::move(sheet));
+  }
+  return plan;
+}
+
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  std::vector<std::vector<std::string>> files;
+  for (const SheetDrawing& sheet : plan.sheets) {
+    const std::string stem = fmt::format("sheet-{:03}", sheet.index);
+    writeFileAtomically(folder / (stem + ".eps"), [&](std::ostream& out) { writeEps(sheet, out); });
+    writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
+    writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
+    files.push_back({stem + ".eps", stem + ".svg", stem + ".dxf"});
+  }
+  return files;
+}
+
+}  // namespace rotafab::jobs

@@ -1,0 +1,57 @@
+#pragma once
+// The job planner (issue 3): from parts to laser-ready sheets. Kerf
+// compensation, true-shape nesting on the machine's bed within its margins,
+// the cutting order on each sheet (etch, then score, then inner cuts, then
+// outer cuts: a part is cut free last, so nothing moves while it is worked
+// on), the profile's colour for each operation, and the files.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "jobs/Part.h"
+#include "jobs/SheetDrawing.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::jobs {
+
+struct PlanOptions {
+  double kerf = 0.0;      // from the material profile
+  double spacing = -1.0;  // between two cut paths; negative: 1/16 in of material plus the kerf
+  double seconds = 5.0;   // nesting improvement budget
+  OrderMode order = OrderMode::Window;
+  int window = 8;
+  unsigned seed = 1;
+  std::string title;  // "bunny (band)"; the sheet number is appended
+  std::function<void(const std::string&)> progress;
+};
+
+struct PlannedPart {
+  int part = 0;         // index into the parts
+  int sheet = 1;        // 1-based
+  double x = 0, y = 0;  // part frame -> sheet: rotate by `rotation` degrees about the origin, then translate
+  double rotation = 0;
+  int cuttingIndex = 0;  // 0-based position in the cutting order over all sheets
+  int moved = 0;         // cuttingIndex - assembly order: how far the layout moved the part
+};
+
+struct SheetPlan {
+  std::vector<SheetDrawing> sheets;
+  std::vector<PlannedPart> parts;  // in cutting order
+  double partArea = 0;             // of the design outlines, square inches
+  double utilization = 0;          // part area / usable area of all sheets
+};
+
+// Throws std::invalid_argument naming the part that cannot be planned (larger
+// than the usable bed, a hole narrower than the kerf).
+SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,
+                     const PlanOptions& options);
+
+// The point of a part's frame on its sheet.
+Point2 onSheet(const PlannedPart& placement, const Point2& local);
+
+// Writes sheet-001.eps, .svg and .dxf, ... into `folder` (each atomically);
+// returns the file names of each sheet, in order.
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder);
+
+}  // namespace rotafab::jobs

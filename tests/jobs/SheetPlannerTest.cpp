@@ -1,0 +1,191 @@
+// The planner measured on its output sheets: kerf on every cut, the material
+// left between parts, the margins, the cutting order, and the files.
+
+#include "jobs/SheetPlanner.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+#include "TestSupport.h"
+
+namespace rotafab::jobs {
+namespace {
+
+Polygon2 circle(Point2 centre, double radius, int sides = 64) {
+  Polygon2 p;
+  for (int i = 0; i < sides; ++i) {
+    const double a = 2 * std::numbers::pi * i / sides;
+    p.emplace_back(centre.x() + radius * std::cos(a), centre.y() + radius * std::sin(a));
+  }
+  return p;
+}
+
+// A 2 x 2 in panel with a fastener hole, a fold line and a label stroke.
+Part panel(int order) {
+  Part part;
+  part.name = "panel " + std::to_string(order + 1);
+  part.order = order;
+  part.outline = {{0, 0}, {2, 0}, {2, 2}, {0, 2}};
+  part.holes = {circle({1, 1}, 0.125)};
+  part.score = {{{0.2, 0.2}, {1.8, 0.2}}};
+  part.etch = {{{0.5, 1.5}, {0.7, 1.7}}};
+  return part;
+}
+
+profiles::MachineProfile workshop() {
+  return profiles::loadMachineProfile(std::filesystem::path(ROTAFAB_SOURCE_DIR) /
+                                      "profiles/machines/workshop-32x18.yaml");
+}
+
+struct Extent {
+  double minX = 1e9, minY = 1e9, maxX = -1e9, maxY = -1e9;
+  void add(const Point2& p) {
+    minX = std::min(minX, p.x()), minY = std::min(minY, p.y()), maxX = std::max(maxX, p.x()),
+    maxY = std::max(maxY, p.y());
+  }
+};
+
+double segmentDistance(Point2 a, Point2 b, Point2 c, Point2 d) {
+  auto pointSegment = [](Point2 p, Point2 s, Point2 t) {
+    const Point2 st = t - s;
+    const double u = std::clamp((p - s).dot(st) / st.squaredNorm(), 0.0, 1.0);
+    return (p - (s + u * st)).norm();
+  };
+  return std::min({pointSegment(a, c, d), pointSegment(b, c, d), pointSegment(c, a, b), pointSegment(d, a, b)});
+}
+
+double pathDistance(const DrawnPath& a, const DrawnPath& b) {
+  double best = 1e9;
+  for (size_t i = 0; i < a.points.size(); ++i)
+    for (size_t j = 0; j < b.points.size(); ++j)
+      best = std::min(best, segmentDistance(a.points[i], a.points[(i + 1) % a.points.size()], b.points[j],
+                                            b.points[(j + 1) % b.points.size()]));
+  return best;
+}
+
+TEST(SheetPlanner, KerfIsOnEveryCutAndMaterialStaysBetweenParts) {
+  std::vector<Part> parts;
+  for (int i = 0; i < 40; ++i) parts.push_back(panel(i));
+  PlanOptions options;
+  options.kerf = 0.01;
+  options.seconds = 0;
+  const SheetPlan plan = planSheets(parts, workshop(), options);
+  ASSERT_GE(plan.sheets.size(), 1u);
+  for (const SheetDrawing& sheet : plan.sheets) {
+    std::vector<const DrawnPath*> outers;
+    for (const DrawnPath& path : sheet.paths) {
+      if (path.operation != Operation::Cut) continue;
+      Extent e;
+      for (const Point2& p : path.points) e.add(p);
+      const double size = e.maxX - e.minX;
+      if (size > 1) {
+        // The outer contour: the design's 2 in plus the kerf.
+        EXPECT_NEAR(size, 2.01, 1e-3);
+        EXPECT_NEAR(e.maxY - e.minY, 2.01, 1e-3);
+        outers.push_back(&path);
+        // Inside the margins.
+        EXPECT_GE(e.minX, 0.25 - 1e-9);
+        EXPECT_GE(e.minY, 0.25 - 1e-9);
+        EXPECT_LE(e.maxX, 32 - 0.25 + 1e-9);
+        EXPECT_LE(e.maxY, 18 - 0.25 + 1e-9);
+      } else {
+        // The hole: its 0.25 in diameter less the kerf.
+        EXPECT_NEAR(size, 0.24, 1e-3);
+      }
+    }
+    // Between two cut paths: 1/16 in of material plus the kerf.
+    for (size_t a = 0; a < outers.size(); ++a)
+      for (size_t b = a + 1; b < outers.size(); ++b)
+        EXPECT_GE(pathDistance(*outers[a], *outers[b]), 1.0 / 16 + 0.01 - 1e-3);
+  }
+}
+
+TEST(SheetPlanner, EachSheetIsEtchedThenScoredThenCutInsideOut) {
+  std::vector<Part> parts;
+  for (int i = 0; i < 6; ++i) parts.push_back(panel(i));
+  PlanOptions options;
+  options.seconds = 0;
+  const SheetPlan plan = planSheets(parts, workshop(), options);
+  ASSERT_EQ(plan.sheets.size(), 1u);
+  const auto& paths = plan.sheets[0].paths;
+  ASSERT_EQ(paths.size(), 1 + 6 * 4u);  // the material outline, then etch, score, hole, outline of each part
+  EXPECT_EQ(paths[0].operation, Operation::Outline);
+  auto stage = [](const DrawnPath& p) {
+    if (p.operation == Operation::Etch) return 0;
+    if (p.operation == Operation::Score) return 1;
+    return p.points.size() == 64 ? 2 : 3;  // holes before outer contours
+  };
+  for (size_t i = 2; i < paths.size(); ++i) EXPECT_LE(stage(paths[i - 1]), stage(paths[i])) << "path " << i;
+  // The dissertation's colours from the profile.
+  EXPECT_EQ(plan.sheets[0].colours.at(Operation::Cut), (Rgb{0, 0, 255}));
+  EXPECT_EQ(plan.sheets[0].colours.at(Operation::Etch), (Rgb{255, 255, 0}));
+}
+
+TEST(SheetPlanner, WindowOrderReportsHowFarEachPartMoved) {
+  std::vector<Part> parts;
+  for (int i = 0; i < 30; ++i) {
+    Part part = panel(i);
+    const double w = 1 + (i * 7 % 11) * 0.6;  // mixed sizes, so the layout wants to reorder
+    part.outline = {{0, 0}, {w, 0}, {w, 1.5}, {0, 1.5}};
+    part.holes.clear();
+    parts.push_back(part);
+  }
+  PlanOptions options;
+  options.order = OrderMode::Window;
+  options.window = 3;
+  options.seconds = 0.5;
+  const SheetPlan plan = planSheets(parts, workshop(), options);
+  ASSERT_EQ(plan.parts.size(), parts.size());
+  for (const PlannedPart& p : plan.parts) {
+    EXPECT_EQ(p.moved, p.cuttingIndex - parts[p.part].order);
+    EXPECT_LE(std::abs(p.moved), options.window) << parts[p.part].name;
+  }
+  EXPECT_GT(plan.utilization, 0.0);
+  EXPECT_LE(plan.utilization, 1.0);
+}
+
+TEST(SheetPlanner, HoleNarrowerThanTheKerfIsRefusedByName) {
+  std::vector<Part> parts{panel(0)};
+  parts[0].holes = {circle({1, 1}, 0.004)};
+  PlanOptions options;
+  options.kerf = 0.01;
+  try {
+    planSheets(parts, workshop(), options);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_STREQ(error.what(), "panel 1: hole 1 is narrower than the kerf (0.01 in)");
+  }
+}
+
+TEST(SheetPlanner, WritesEpsSvgAndDxfForEverySheet) {
+  std::vector<Part> parts;
+  for (int i = 0; i < 3; ++i) parts.push_back(panel(i));
+  PlanOptions options;
+  options.seconds = 0;
+  options.title = "test";
+  const SheetPlan plan = planSheets(parts, workshop(), options);
+  test::TempDir dir;
+  const auto files = writeSheets(plan, dir.path());
+  ASSERT_EQ(files.size(), plan.sheets.size());
+  EXPECT_EQ(files[0], (std::vector<std::string>{"sheet-001.eps", "sheet-001.svg", "sheet-001.dxf"}));
+  const std::string eps = test::readFile(dir.path() / "sheet-001.eps");
+  EXPECT_EQ(eps.rfind("%!PS-Adobe-3.0 EPSF-3.0", 0), 0u);
+  EXPECT_NE(eps.find("%%BoundingBox: 0 0 2304 1296"), std::string::npos);
+  const auto gs = test::run("gs -q -dNOPAUSE -dBATCH -dSAFER -sDEVICE=bbox " + (dir.path() / "sheet-001.eps").string());
+  EXPECT_EQ(gs.status, 0) << gs.err;
+  // The green material outline spans the bed; the hairline adds a few hundredths of a point.
+  const size_t at = gs.err.find("%%HiResBoundingBox:");
+  ASSERT_NE(at, std::string::npos) << gs.err;
+  double box[4] = {};
+  std::istringstream(gs.err.substr(at + 19)) >> box[0] >> box[1] >> box[2] >> box[3];
+  EXPECT_NEAR(box[0], 0, 0.1);
+  EXPECT_NEAR(box[1], 0, 0.1);
+  EXPECT_NEAR(box[2], 2304, 0.1);
+  EXPECT_NEAR(box[3], 1296, 0.1);
+}
+
+}  // namespace
+}  // namespace rotafab::jobs
