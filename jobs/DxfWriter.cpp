@@ -14,17 +14,6 @@ namespace {
 
 constexpr int kDecimals = 9;
 
-// Fixed-point with `decimals` digits, trailing zeros dropped, never "-0".
-std::string number(double value, int decimals = kDecimals) {
-  std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.find('.') != std::string::npos) {
-    text.erase(text.find_last_not_of('0') + 1);
-    if (text.back() == '.') text.pop_back();
-  }
-  if (text == "-0") text = "0";
-  return text;
-}
-
 // A DXF string value: one line, printable ASCII (R12 predates UTF-8).
 std::string dxfText(std::string_view text) {
   std::string out;
@@ -42,9 +31,9 @@ class GroupWriter {
   void operator()(int code, std::string_view value) { fmt::format_to(to_, "{:>3}\n{}\n", code, value); }
   void operator()(int code, int value) { fmt::format_to(to_, "{:>3}\n{}\n", code, value); }
   void point(int code, double x, double y, double z = 0) {
-    (*this)(code, number(x));
-    (*this)(code + 10, number(y));
-    (*this)(code + 20, number(z));
+    (*this)(code, formatDecimal(x, kDecimals));
+    (*this)(code + 10, formatDecimal(y, kDecimals));
+    (*this)(code + 20, formatDecimal(z, kDecimals));
   }
 
  private:
@@ -145,11 +134,11 @@ void writeDxf(const SheetDrawing& sheet, std::ostream& out) {
   group(9, "$EXTMAX");
   group.point(10, sheet.width, sheet.height);
   group(9, "$LIMMIN");
-  group(10, number(0));
-  group(20, number(0));
+  group(10, formatDecimal(0, kDecimals));
+  group(20, formatDecimal(0, kDecimals));
   group(9, "$LIMMAX");
-  group(10, number(sheet.width));
-  group(20, number(sheet.height));
+  group(10, formatDecimal(sheet.width, kDecimals));
+  group(20, formatDecimal(sheet.height, kDecimals));
   group(9, "$LUNITS");
   group(70, 2);  // decimal
   group(9, "$MEASUREMENT");
@@ -167,7 +156,7 @@ void writeDxf(const SheetDrawing& sheet, std::ostream& out) {
   group(3, "Solid line");
   group(72, 65);
   group(73, 0);
-  group(40, number(0));
+  group(40, formatDecimal(0, kDecimals));
   group(0, "ENDTAB");
   group(0, "TABLE");
   group(2, "LAYER");

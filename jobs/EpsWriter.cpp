@@ -14,17 +14,6 @@ constexpr double kPointsPerInch = 72.0;
 constexpr double kHairlineInches = 0.001;
 constexpr int kPointsPerLine = 8;  // keeps lines well under DSC's 255 bytes
 
-// Fixed-point with `decimals` digits, trailing zeros dropped, never "-0".
-std::string number(double value, int decimals) {
-  std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.find('.') != std::string::npos) {
-    text.erase(text.find_last_not_of('0') + 1);
-    if (text.back() == '.') text.pop_back();
-  }
-  if (text == "-0") text = "0";
-  return text;
-}
-
 // A DSC text line: printable ASCII only, bounded length.
 std::string dscText(std::string_view text) {
   std::string out;
@@ -51,7 +40,7 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
   // Integer box: the smallest that contains the bed (DSC rounds outwards).
   fmt::format_to(to, "%%BoundingBox: 0 0 {} {}\n", static_cast<long long>(std::ceil(widthPt - 1e-9)),
                  static_cast<long long>(std::ceil(heightPt - 1e-9)));
-  fmt::format_to(to, "%%HiResBoundingBox: 0 0 {} {}\n", number(widthPt, 4), number(heightPt, 4));
+  fmt::format_to(to, "%%HiResBoundingBox: 0 0 {} {}\n", formatDecimal(widthPt, 4), formatDecimal(heightPt, 4));
   fmt::format_to(to, "%%Title: {}\n",
                  dscText(sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title));
   line("%%Creator: rotafab");
@@ -74,19 +63,20 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
   line("%%Page: 1 1");
   line("rotafab begin");
   line("gsave");
-  fmt::format_to(to, "{} setlinewidth 1 setlinejoin 1 setlinecap\n", number(kHairlineInches * kPointsPerInch, 4));
+  fmt::format_to(to, "{} setlinewidth 1 setlinejoin 1 setlinecap\n",
+                 formatDecimal(kHairlineInches * kPointsPerInch, 4));
 
   std::optional<Operation> current;
   for (const DrawnPath& path : sheet.paths) {
     if (path.operation != current) {
       const Rgb& rgb = sheet.colours.at(path.operation);
-      fmt::format_to(to, "% {}\n{} {} {} c\n", profiles::operationName(path.operation), number(rgb.r / 255.0, 6),
-                     number(rgb.g / 255.0, 6), number(rgb.b / 255.0, 6));
+      fmt::format_to(to, "% {}\n{} {} {} c\n", profiles::operationName(path.operation), formatDecimal(rgb.r / 255.0, 6),
+                     formatDecimal(rgb.g / 255.0, 6), formatDecimal(rgb.b / 255.0, 6));
       current = path.operation;
     }
     for (size_t i = 0; i < path.points.size(); ++i) {
       const Point2& p = path.points[i];
-      fmt::format_to(to, "{} {} {}", number(p.x() * kPointsPerInch, 4), number(p.y() * kPointsPerInch, 4),
+      fmt::format_to(to, "{} {} {}", formatDecimal(p.x() * kPointsPerInch, 4), formatDecimal(p.y() * kPointsPerInch, 4),
                      i == 0 ? "m" : "l");
       buffer.push_back((i + 1) % kPointsPerLine == 0 ? '\n' : ' ');
     }

@@ -29,4 +29,13 @@ void checkDrawable(const SheetDrawing& sheet) {
   }
 }
 
+std::string formatDecimal(double value, int decimals) {
+  std::string text = fmt::format("{:.{}f}", value, decimals);
+  if (text.find('.') != std::string::npos) {
+    text.erase(text.find_last_not_of('0') + 1);
+    if (text.back() == '.') text.pop_back();
+  }
+  return text == "-0" ? std::string(1, '0') : text;
+}
+
 }  // namespace rotafab::jobs

@@ -42,4 +42,8 @@ struct SheetDrawing {
 // the bed. Throws std::invalid_argument naming the sheet, the path and what is wrong.
 void checkDrawable(const SheetDrawing& sheet);
 
+// Fixed-point with `decimals` digits, trailing zeros dropped, never "-0": the
+// numbers of every sheet format, the same in any locale.
+std::string formatDecimal(double value, int decimals);
+
 }  // namespace rotafab::jobs

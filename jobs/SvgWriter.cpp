@@ -14,17 +14,6 @@ namespace {
 constexpr int kDecimals = 9;
 constexpr double kHairlineInches = 0.001;
 
-// Fixed-point with `decimals` digits, trailing zeros dropped, never "-0".
-std::string number(double value, int decimals = kDecimals) {
-  std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.find('.') != std::string::npos) {
-    text.erase(text.find_last_not_of('0') + 1);
-    if (text.back() == '.') text.pop_back();
-  }
-  if (text == "-0") text = "0";
-  return text;
-}
-
 // Character data for XML 1.0: markup characters escaped, control characters
 // (not allowed in XML 1.0) and bytes that are not valid UTF-8 replaced by '?'.
 std::string xmlText(std::string_view text) {
@@ -73,7 +62,7 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   fmt::memory_buffer buffer;
   const auto to = std::back_inserter(buffer);
 
-  const std::string width = number(sheet.width), height = number(sheet.height);
+  const std::string width = formatDecimal(sheet.width, kDecimals), height = formatDecimal(sheet.height, kDecimals);
   fmt::format_to(to, "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n");
   fmt::format_to(to,
                  "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0}in\" height=\"{1}in\" "
@@ -82,7 +71,7 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   fmt::format_to(to, "<title>{}</title>\n",
                  xmlText(sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title));
   fmt::format_to(to, "<desc>rotafab sheet {} of {}; units: inches; bed {} x {} in, margin {} in</desc>\n", sheet.index,
-                 sheet.sheetCount, width, height, number(sheet.margin));
+                 sheet.sheetCount, width, height, formatDecimal(sheet.margin, kDecimals));
 
   std::vector<Operation> order;  // operations by their first path
   for (const DrawnPath& path : sheet.paths)
@@ -93,13 +82,14 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
     fmt::format_to(to,
                    "<g id=\"{}\" fill=\"none\" stroke=\"#{:02x}{:02x}{:02x}\" stroke-width=\"{}\" "
                    "stroke-linecap=\"round\" stroke-linejoin=\"round\">\n",
-                   profiles::operationName(operation), int{rgb.r}, int{rgb.g}, int{rgb.b}, number(kHairlineInches));
+                   profiles::operationName(operation), int{rgb.r}, int{rgb.g}, int{rgb.b},
+                   formatDecimal(kHairlineInches, kDecimals));
     for (const DrawnPath& path : sheet.paths) {
       if (path.operation != operation) continue;
       fmt::format_to(to, "<path d=\"");
       for (size_t i = 0; i < path.points.size(); ++i)
-        fmt::format_to(to, "{}{} {}", i == 0 ? "M" : " L", number(path.points[i].x()),
-                       number(sheet.height - path.points[i].y()));
+        fmt::format_to(to, "{}{} {}", i == 0 ? "M" : " L", formatDecimal(path.points[i].x(), kDecimals),
+                       formatDecimal(sheet.height - path.points[i].y(), kDecimals));
       fmt::format_to(to, "{}\"/>\n", path.closed ? " Z" : "");
     }
     fmt::format_to(to, "</g>\n");
