@@ -117,6 +117,7 @@ class Packer {
       for (double rotation : parts[i].rotations)
         shapes_[i].push_back(makeShape(parts[i].outline, rotation, options.spacing));
     }
+    for (const auto& shapes : shapes_) area_.push_back(std::abs(ClipperLib::Area(shapes.front().grown)));
     width_ = options.strip ? stripBound() : toInt(options.width);
     height_ = toInt(options.height);
     for (size_t i = 0; i < parts.size(); ++i) {
@@ -135,7 +136,9 @@ class Packer {
   // `policy` Strict fills only the last sheet; otherwise first fit over all sheets.
   NestingResult pack(const std::vector<int>& sequence, OrderMode policy) {
     std::vector<std::vector<PlacedShape>> sheets;
+    std::vector<double> sheetFree;                    // area not yet covered, square grid units
     std::vector<std::pair<int, PlacedShape>> placed;  // (sheet, shape) in placing order
+    const double sheetArea = static_cast<double>(width_) * static_cast<double>(height_);
     for (int part : sequence) {
       bool done = false;
       const int firstSheet = policy == OrderMode::Strict ? std::max(0, static_cast<int>(sheets.size()) - 1) : 0;
@@ -146,8 +149,10 @@ class Packer {
           for (int k = 0; k <= s; ++k) cutBefore += static_cast<int>(sheets[k].size());
           if (parts_[part].order - cutBefore > options_.window) continue;
         }
+        if (sheetFree[s] < area_[part]) continue;  // cannot hold it: skip the no-fit polygons
         if (auto spot = bestSpot(part, sheets[s])) {
           sheets[s].push_back(*spot);
+          sheetFree[s] -= area_[part];
           placed.emplace_back(s, *spot);
           done = true;
         }
@@ -157,6 +162,7 @@ class Packer {
           throw std::invalid_argument(fmt::format("{} does not fit the strip", parts_[part].name));
         }
         sheets.emplace_back();
+        sheetFree.push_back(sheetArea - area_[part]);
         const auto spot = bestSpot(part, sheets.back());
         if (!spot) throw std::invalid_argument(fmt::format("{} does not fit an empty sheet", parts_[part].name));
         sheets.back().push_back(*spot);
@@ -287,6 +293,7 @@ class Packer {
   const NestingOptions& options_;
   std::vector<std::vector<Shape>> shapes_;
   std::map<std::tuple<int, int, int, int>, Paths> sums_;
+  std::vector<double> area_;  // each part's grown area, square grid units
   cInt width_ = 0, height_ = 0;
 };
 
