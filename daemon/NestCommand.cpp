@@ -238,13 +238,16 @@ int runNest(const NestOptions& options) {
       std::vector<int> itemOfPart;
       for (const auto& item : items)
         for (int c = 0; c < item.demand; ++c) itemOfPart.push_back(item.id);
-      for (const auto& p : result.placements) {
+      for (size_t cut = 0; cut < result.placements.size(); ++cut) {
+        const auto& p = result.placements[cut];
         layout["placements"].push_back({{"item", itemOfPart[p.part]},
                                         {"copy", copyOfPart[p.part]},
                                         {"sheet", p.sheet},
                                         {"x", p.x + margin},
                                         {"y", p.y + margin},
-                                        {"rotation", p.rotation}});
+                                        {"rotation", p.rotation},
+                                        // Extension: how far the layout moved the part from its order in the file.
+                                        {"moved", static_cast<int>(cut) - parts[p.part].order}});
       }
       jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.json", layout.dump(1) + "\n");
       jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.svg",

@@ -32,9 +32,13 @@ TEST(NestCli, StripRunWritesLayoutAndSummary) {
   const auto layout = nlohmann::json::parse(readFile(dir.path() / "out" / "layout.json"));
   ASSERT_EQ(layout["placements"].size(), 5u);
   std::multiset<int> items;
+  int cut = 0;
   for (const auto& p : layout["placements"]) {
     items.insert(p["item"].get<int>());
     EXPECT_EQ(p["sheet"], 1);
+    // Copies are numbered in file order: item 0's three, then item 7's two.
+    const int order = p["item"] == 0 ? p["copy"].get<int>() : 3 + p["copy"].get<int>();
+    EXPECT_EQ(p["moved"], cut++ - order);
   }
   EXPECT_EQ(items.count(0), 3u);
   EXPECT_EQ(items.count(7), 2u);
