@@ -3,15 +3,15 @@
 #include <fmt/format.h>
 
 #include <chrono>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "daemon/ExitCode.h"
 #include "jobs/AtomicFile.h"
+#include "jobs/LayoutSvg.h"
 #include "jobs/Nesting.h"
+#include "jobs/NestingInstance.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
 
@@ -46,122 +46,17 @@ double lengthOption(const std::string& text, const char* option) {
   return *value;
 }
 
-struct Item {
-  int id = 0;
-  int demand = 1;
-};
-
-// Reads the instance: one part per copy of each item. Names the element at fault.
-std::vector<jobs::NestingPart> readInstance(const std::string& file, std::vector<Item>& items, double& stripHeight) {
-  std::ifstream in(file);
-  if (!in) throw UserError(fmt::format("{}: cannot open the file", file));
-  nlohmann::json instance;
-  try {
-    instance = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& error) {
-    throw UserError(fmt::format("{}: not JSON: {}", file, error.what()));
-  }
-  auto fail = [&](const std::string& where, const std::string& what) -> UserError {
-    return UserError(fmt::format("{}: {}: {}", file, where, what));
-  };
-  if (!instance.is_object() || !instance.contains("items") || !instance["items"].is_array()) {
-    throw fail("items", "expected an object with an \"items\" list");
-  }
-  stripHeight = instance.value("strip_height", 0.0);
-  std::vector<jobs::NestingPart> parts;
-  for (size_t i = 0; i < instance["items"].size(); ++i) {
-    const auto& item = instance["items"][i];
-    const std::string at = fmt::format("items[{}]", i);
-    if (!item.is_object()) throw fail(at, "expected an object");
-    Item entry;
-    entry.id = item.contains("id") && item["id"].is_number_integer() ? item["id"].get<int>() : static_cast<int>(i);
-    if (item.contains("demand")) {
-      if (!item["demand"].is_number_integer() || item["demand"].get<int>() < 1 || item["demand"].get<int>() > 100000) {
-        throw fail(at + ".demand", "expected a whole number from 1");
-      }
-      entry.demand = item["demand"].get<int>();
-    }
-    std::vector<double> rotations{0.0};
-    if (item.contains("allowed_orientations")) {
-      rotations.clear();
-      for (const auto& r : item["allowed_orientations"]) {
-        if (!r.is_number()) throw fail(at + ".allowed_orientations", "expected numbers (degrees)");
-        rotations.push_back(r.get<double>());
-      }
-      if (rotations.empty()) throw fail(at + ".allowed_orientations", "is empty");
-    }
-    const auto shape = item.value("shape", nlohmann::json::object());
-    if (shape.value("type", "") != "simple_polygon") throw fail(at + ".shape.type", "only simple_polygon is supported");
-    if (!shape.contains("data") || !shape["data"].is_array())
-      throw fail(at + ".shape.data", "expected a list of points");
-    jobs::Polygon2 outline;
-    for (size_t k = 0; k < shape["data"].size(); ++k) {
-      const auto& point = shape["data"][k];
-      if (!point.is_array() || point.size() != 2 || !point[0].is_number() || !point[1].is_number()) {
-        throw fail(fmt::format("{}.shape.data[{}]", at, k), "expected [x, y]");
-      }
-      outline.emplace_back(point[0].get<double>(), point[1].get<double>());
-      if (!outline.back().allFinite()) throw fail(fmt::format("{}.shape.data[{}]", at, k), "not a finite point");
-    }
-    if (outline.size() > 1 && outline.front() == outline.back()) outline.pop_back();  // closed rings repeat the start
-    if (outline.size() < 3 || std::abs(jobs::polygonArea(outline)) <= 0) {
-      throw fail(at + ".shape.data", "expected a polygon of at least 3 points with area");
-    }
-    for (int copy = 0; copy < entry.demand; ++copy) {
-      jobs::NestingPart part;
-      part.name = fmt::format("item {} copy {}", entry.id, copy + 1);
-      part.outline = outline;
-      part.rotations = rotations;
-      part.order = static_cast<int>(parts.size());
-      parts.push_back(std::move(part));
-    }
-    items.push_back(entry);
-  }
-  if (parts.empty()) throw fail("items", "no items");
-  return parts;
-}
-
-std::string layoutSvg(const std::vector<jobs::NestingPart>& parts, const jobs::NestingResult& result,
-                      const jobs::NestingOptions& options, double margin) {
-  const double width = options.strip ? std::max(result.stripLength, 1e-9) : options.width + 2 * margin;
-  const double height = options.strip ? options.height : options.height + 2 * margin;
-  const double gap = height * 0.05;
-  const int sheets = std::max(1, result.sheets);
-  const double total = sheets * height + (sheets - 1) * gap;
-  std::ostringstream svg;
-  svg << fmt::format(
-      R"(<?xml version="1.0" encoding="UTF-8"?>)"
-      "\n"
-      R"(<svg xmlns="http://www.w3.org/2000/svg" width="{:.4f}in" height="{:.4f}in" viewBox="0 0 {:.4f} {:.4f}">)"
-      "\n",
-      width, total, width, total);
-  for (int s = 0; s < sheets; ++s) {
-    const double top = s * (height + gap);
-    svg << fmt::format(
-        R"(<rect x="0" y="{:.4f}" width="{:.4f}" height="{:.4f}" fill="#f4f4f4" stroke="#000" stroke-width="{:.4f}"/>)"
-        "\n",
-        top, width, height, height * 0.002);
-  }
-  for (const auto& placement : result.placements) {
-    const double top = (placement.sheet - 1) * (height + gap);
-    std::string d;
-    for (const auto& p : jobs::placedOutline(parts[placement.part], placement)) {
-      d += fmt::format("{}{:.4f},{:.4f} ", d.empty() ? "M" : "L", p.x() + margin, top + height - (p.y() + margin));
-    }
-    svg << fmt::format(R"(<path d="{}Z" fill="#8ab4f8" stroke="#1a4f9c" stroke-width="{:.4f}"><title>{}</title></path>)"
-                       "\n",
-                       d, height * 0.001, parts[placement.part].name);
-  }
-  svg << "</svg>\n";
-  return svg.str();
-}
-
 int runNest(const NestOptions& options) {
   try {
     const auto start = std::chrono::steady_clock::now();
-    std::vector<Item> items;
-    double stripHeight = 0;
-    std::vector<jobs::NestingPart> parts = readInstance(options.instance, items, stripHeight);
+    jobs::NestingInstance instance;
+    try {
+      instance = jobs::readNestingInstance(options.instance);
+    } catch (const std::invalid_argument& error) {
+      throw UserError(error.what());
+    }
+    const std::vector<jobs::NestingPart>& parts = instance.parts;
+    const double stripHeight = instance.stripHeight;
 
     jobs::NestingOptions nesting;
     nesting.strip = options.strip;
@@ -232,16 +127,10 @@ int runNest(const NestOptions& options) {
     if (!options.out.empty()) {
       std::filesystem::create_directories(options.out);
       nlohmann::ordered_json layout = {{"placements", nlohmann::ordered_json::array()}};
-      std::vector<int> copyOfPart(parts.size());
-      for (size_t p = 0, i = 0; i < items.size(); ++i)
-        for (int c = 0; c < items[i].demand; ++c, ++p) copyOfPart[p] = c;
-      std::vector<int> itemOfPart;
-      for (const auto& item : items)
-        for (int c = 0; c < item.demand; ++c) itemOfPart.push_back(item.id);
       for (size_t cut = 0; cut < result.placements.size(); ++cut) {
         const auto& p = result.placements[cut];
-        layout["placements"].push_back({{"item", itemOfPart[p.part]},
-                                        {"copy", copyOfPart[p.part]},
+        layout["placements"].push_back({{"item", instance.itemOfPart[p.part]},
+                                        {"copy", instance.copyOfPart[p.part]},
                                         {"sheet", p.sheet},
                                         {"x", p.x + margin},
                                         {"y", p.y + margin},
@@ -251,7 +140,7 @@ int runNest(const NestOptions& options) {
       }
       jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.json", layout.dump(1) + "\n");
       jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.svg",
-                                layoutSvg(parts, result, nesting, margin));
+                                jobs::layoutSvg(parts, result, nesting, margin));
     }
     if (options.json) {
       std::cout << summary.dump() << '\n';
