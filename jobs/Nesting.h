@@ -1,11 +1,13 @@
 #pragma once
 // True-shape nesting of parts onto beds or into a strip (issue 3): no-fit
 // polygons from Clipper's Minkowski sums, bottom-left placement on the
-// vertices of the feasible region, then an improvement phase that tries other
-// orders and rotations within a time budget. Parts are concave and interlock;
-// bounding boxes and hulls are never used for collisions. Deterministic for a
-// given seed and budget... of evaluations: the time budget only stops the
-// search early, the sequence of candidates tried is fixed by the seed.
+// vertices of the feasible region, each candidate confirmed by an exact
+// intersection test, then an improvement phase that swaps parts in the
+// sequence within a time budget. Parts are concave and interlock; bounding
+// boxes and hulls are never used for collisions. The first layout is
+// deterministic; the search tries a sequence fixed by the seed, and the time
+// budget decides how far along it gets, so with a budget the result can differ
+// between machines.
 //
 // Coordinates in inches; a placement rotates the part's outline about its own
 // origin by `rotation` degrees (counter-clockwise), then translates it by
