@@ -31,6 +31,7 @@ struct NestOptions {
   std::string order = "free";
   int window = 8;
   unsigned seed = 1;
+  int evaluations = 0;
 };
 
 class UserError : public std::runtime_error {
@@ -62,6 +63,7 @@ int runNest(const NestOptions& options) {
     nesting.strip = options.strip;
     nesting.seconds = options.seconds;
     nesting.seed = options.seed;
+    nesting.evaluations = options.evaluations;
     double margin = 0;
     if (options.strip) {
       if (!(stripHeight > 0))
@@ -186,6 +188,8 @@ void addNestCommand(CLI::App& app, int& status) {
   command->add_option("--window", options->window, "With --order window: at most this many places")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the improvement search")->capture_default_str();
+  command->add_option("--evaluations", options->evaluations,
+                      "Stop the search after this many layouts (with a long --time: the same layout on any machine)");
   command->add_option("--out", options->out, "Folder for layout.json and layout.svg");
   command->add_flag("--json", options->json,
                     "Print one JSON object: sheets, utilization, strip_length, density, seconds");

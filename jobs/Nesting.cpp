@@ -360,7 +360,8 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   if (options.order != OrderMode::Strict && parts.size() > 1) {
     std::mt19937 random(options.seed);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.seconds);
-    while (std::chrono::steady_clock::now() < deadline) {
+    while (std::chrono::steady_clock::now() < deadline &&
+           (options.evaluations <= 0 || evaluations < options.evaluations)) {
       std::vector<int> trial = sequence;
       const size_t i = random() % trial.size();
       size_t j = random() % trial.size();

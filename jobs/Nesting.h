@@ -43,6 +43,7 @@ struct NestingOptions {
   bool strip = false;       // one strip of fixed height, least length
   double spacing = 0.0625;  // least distance between two outlines
   double seconds = 5.0;     // improvement budget (wall clock)
+  int evaluations = 0;      // if positive, stop after this many layouts: reproducible on any machine
   OrderMode order = OrderMode::Free;
   int window = 8;
   unsigned seed = 1;

@@ -127,6 +127,22 @@ TEST(Nesting, SameSeedNoBudgetSameLayout) {
   }
 }
 
+TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
+  const auto parts = randomParts(12, 10);
+  NestingOptions options;
+  options.seconds = 600;  // never the limit here
+  options.evaluations = 25;
+  options.seed = 9;
+  const NestingResult a = nest(parts, options), b = nest(parts, options);
+  EXPECT_EQ(a.evaluations, 25);
+  ASSERT_EQ(a.placements.size(), b.placements.size());
+  for (size_t i = 0; i < a.placements.size(); ++i) {
+    EXPECT_EQ(a.placements[i].part, b.placements[i].part);
+    EXPECT_EQ(a.placements[i].x, b.placements[i].x);
+    EXPECT_EQ(a.placements[i].y, b.placements[i].y);
+  }
+}
+
 TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
   const auto parts = randomParts(5, 20);
   NestingOptions options;
