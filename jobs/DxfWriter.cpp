@@ -14,16 +14,6 @@ namespace {
 
 constexpr int kDecimals = 9;
 
-// A DXF string value: one line, printable ASCII (R12 predates UTF-8).
-std::string dxfText(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (out.size() >= 200) break;
-    out += (c >= ' ' && c <= '~') ? c : '?';
-  }
-  return out;
-}
-
 class GroupWriter {
  public:
   explicit GroupWriter(fmt::memory_buffer& buffer) : to_(std::back_inserter(buffer)) {}
@@ -121,8 +111,8 @@ void writeDxf(const SheetDrawing& sheet, std::ostream& out) {
   fmt::memory_buffer buffer;
   GroupWriter group(buffer);
 
-  group(999,
-        dxfText(fmt::format("rotafab sheet {} of {}: {}; units: inches", sheet.index, sheet.sheetCount, sheet.title)));
+  group(999, printableAscii(
+                 fmt::format("rotafab sheet {} of {}: {}; units: inches", sheet.index, sheet.sheetCount, sheet.title)));
   group(0, "SECTION");
   group(2, "HEADER");
   group(9, "$ACADVER");

@@ -14,16 +14,6 @@ constexpr double kPointsPerInch = 72.0;
 constexpr double kHairlineInches = 0.001;
 constexpr int kPointsPerLine = 8;  // keeps lines well under DSC's 255 bytes
 
-// A DSC text line: printable ASCII only, bounded length.
-std::string dscText(std::string_view text) {
-  std::string out;
-  for (char c : text) {
-    if (out.size() >= 200) break;
-    out += (c >= ' ' && c <= '~') ? c : '?';
-  }
-  return out;
-}
-
 }  // namespace
 
 void writeEps(const SheetDrawing& sheet, std::ostream& out) {
@@ -42,7 +32,7 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
                  static_cast<long long>(std::ceil(heightPt - 1e-9)));
   fmt::format_to(to, "%%HiResBoundingBox: 0 0 {} {}\n", formatDecimal(widthPt, 4), formatDecimal(heightPt, 4));
   fmt::format_to(to, "%%Title: {}\n",
-                 dscText(sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title));
+                 printableAscii(sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title));
   line("%%Creator: rotafab");
   line("%%Pages: 1");
   line("%%LanguageLevel: 1");

@@ -39,18 +39,9 @@ Path toPath(const Polygon2& polygon) {
 }
 
 Polygon2 rotated(const Polygon2& polygon, double degrees) {
-  // Quarter turns exactly, so that 90-degree layouts stay on the grid.
-  double c = std::cos(degrees * std::numbers::pi / 180.0), s = std::sin(degrees * std::numbers::pi / 180.0);
-  const double quarter = degrees / 90.0;
-  if (std::abs(quarter - std::round(quarter)) < 1e-12) {
-    static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
-    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
-    c = kCos[k];
-    s = kSin[k];
-  }
   Polygon2 out;
   out.reserve(polygon.size());
-  for (const Point2& p : polygon) out.emplace_back(c * p.x() - s * p.y(), s * p.x() + c * p.y());
+  for (const Point2& p : polygon) out.push_back(rotatedPoint(p, degrees));
   return out;
 }
 
@@ -309,6 +300,19 @@ std::pair<int, double> cost(const NestingResult& result, const std::vector<Nesti
 }
 
 }  // namespace
+
+Point2 rotatedPoint(const Point2& p, double degrees) {
+  // Quarter turns exactly, so that 90-degree layouts stay on the grid.
+  double c = std::cos(degrees * std::numbers::pi / 180.0), s = std::sin(degrees * std::numbers::pi / 180.0);
+  const double quarter = degrees / 90.0;
+  if (std::abs(quarter - std::round(quarter)) < 1e-12) {
+    static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
+    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
+    c = kCos[k];
+    s = kSin[k];
+  }
+  return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
+}
 
 double polygonArea(const Polygon2& polygon) {
   double twice = 0;

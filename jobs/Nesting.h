@@ -77,6 +77,9 @@ Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement);
 std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,
                                         const NestingOptions& options, double tolerance = 1e-3);
 
-double polygonArea(const Polygon2& polygon);  // signed: positive counter-clockwise
+double polygonArea(const Polygon2& polygon);
+
+// `p` turned counter-clockwise about the origin; quarter turns are exact.
+Point2 rotatedPoint(const Point2& p, double degrees);  // signed: positive counter-clockwise
 
 }  // namespace rotafab::jobs

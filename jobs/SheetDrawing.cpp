@@ -29,6 +29,15 @@ void checkDrawable(const SheetDrawing& sheet) {
   }
 }
 
+std::string printableAscii(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    if (out.size() >= 200) break;
+    out += (c >= ' ' && c <= '~') ? c : '?';
+  }
+  return out;
+}
+
 std::string formatDecimal(double value, int decimals) {
   std::string text = fmt::format("{:.{}f}", value, decimals);
   if (text.find('.') != std::string::npos) {

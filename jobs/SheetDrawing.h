@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <map>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "profiles/Operation.h"
@@ -45,5 +46,9 @@ void checkDrawable(const SheetDrawing& sheet);
 // Fixed-point with `decimals` digits, trailing zeros dropped, never "-0": the
 // numbers of every sheet format, the same in any locale.
 std::string formatDecimal(double value, int decimals);
+
+// Text for a one-line header field: printable ASCII only ('?' for anything
+// else), at most 200 characters.
+std::string printableAscii(std::string_view text);
 
 }  // namespace rotafab::jobs

@@ -14,16 +14,7 @@
 namespace rotafab::jobs {
 
 Point2 onSheet(const PlannedPart& placement, const Point2& local) {
-  const double angle = placement.rotation * std::numbers::pi / 180.0;
-  double c = std::cos(angle), s = std::sin(angle);
-  const double quarter = placement.rotation / 90.0;
-  if (std::abs(quarter - std::round(quarter)) < 1e-12) {  // exact quarter turns, as the nester uses
-    static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
-    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
-    c = kCos[k];
-    s = kSin[k];
-  }
-  return {c * local.x() - s * local.y() + placement.x, s * local.x() + c * local.y() + placement.y};
+  return rotatedPoint(local, placement.rotation) + Point2(placement.x, placement.y);
 }
 
 SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,

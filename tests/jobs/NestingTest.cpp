@@ -84,6 +84,16 @@ void expectValid(const std::vector<NestingPart>& parts, const NestingResult& res
   }
 }
 
+void expectSameLayout(const NestingResult& a, const NestingResult& b) {
+  ASSERT_EQ(a.placements.size(), b.placements.size());
+  for (size_t i = 0; i < a.placements.size(); ++i) {
+    EXPECT_EQ(a.placements[i].part, b.placements[i].part);
+    EXPECT_EQ(a.placements[i].x, b.placements[i].x);
+    EXPECT_EQ(a.placements[i].y, b.placements[i].y);
+    EXPECT_EQ(a.placements[i].rotation, b.placements[i].rotation);
+  }
+}
+
 TEST(Nesting, RandomConcavePartsNeverOverlapAndStayInside) {
   for (unsigned seed : {1u, 2u, 3u}) {
     SCOPED_TRACE(seed);
@@ -118,13 +128,7 @@ TEST(Nesting, SameSeedNoBudgetSameLayout) {
   NestingOptions options;
   options.seconds = 0;
   const NestingResult a = nest(parts, options), b = nest(parts, options);
-  ASSERT_EQ(a.placements.size(), b.placements.size());
-  for (size_t i = 0; i < a.placements.size(); ++i) {
-    EXPECT_EQ(a.placements[i].part, b.placements[i].part);
-    EXPECT_EQ(a.placements[i].x, b.placements[i].x);
-    EXPECT_EQ(a.placements[i].y, b.placements[i].y);
-    EXPECT_EQ(a.placements[i].rotation, b.placements[i].rotation);
-  }
+  expectSameLayout(a, b);
 }
 
 TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
@@ -135,12 +139,7 @@ TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
   options.seed = 9;
   const NestingResult a = nest(parts, options), b = nest(parts, options);
   EXPECT_EQ(a.evaluations, 25);
-  ASSERT_EQ(a.placements.size(), b.placements.size());
-  for (size_t i = 0; i < a.placements.size(); ++i) {
-    EXPECT_EQ(a.placements[i].part, b.placements[i].part);
-    EXPECT_EQ(a.placements[i].x, b.placements[i].x);
-    EXPECT_EQ(a.placements[i].y, b.placements[i].y);
-  }
+  expectSameLayout(a, b);
 }
 
 TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
