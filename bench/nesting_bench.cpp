@@ -2,7 +2,8 @@
 // and 100 wavy strips on the workshop bed (32 x 18 in, 1/4 in margins, 1/16 in
 // spacing). Prints sheets used against the area lower bound
 // ceil(part area / usable bed area) and the utilisation of every sheet but the
-// last (target: at least 75%).
+// last (target: at least 75%), beside the same parts through libnest2d in
+// convex-hull mode (bench/Libnest2dBaseline.h): we must use fewer sheets.
 //
 //   build/rotafab_nest_bench [SECONDS]     improvement budget per instance (default 60)
 
@@ -14,6 +15,7 @@
 #include <random>
 #include <string>
 
+#include "bench/Libnest2dBaseline.h"
 #include "jobs/Nesting.h"
 
 using namespace rotafab::jobs;
@@ -64,6 +66,13 @@ void run(const std::string& name, const std::vector<NestingPart>& parts, double 
              100 * (result.sheets > 1 ? worst : areaOnSheet[0] / usable), elapsed, result.evaluations,
              problems.empty() ? "" : " INVALID: " + problems.front());
   fmt::print("  per sheet: {}\n", perSheet);
+  const auto baseline = rotafab::bench::nestWithLibnest2d(parts, options);
+  std::string baselineSheets;
+  for (size_t s = 0; s < baseline.sheetArea.size(); ++s) {
+    baselineSheets += fmt::format("{}{:.0f}%", s ? " " : "", 100 * baseline.sheetArea[s] / usable);
+  }
+  fmt::print("  libnest2d (convex hulls): {} sheets, {:.1f} s{}\n  per sheet: {}\n", baseline.sheets, baseline.seconds,
+             baseline.valid ? "" : " INVALID: " + baseline.problem, baselineSheets);
 }
 
 }  // namespace

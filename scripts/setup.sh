@@ -18,6 +18,8 @@ packages=(
   hershey-fonts-data libumockdev-dev umockdev
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev ghostscript hyperfine
+  # the nesting benchmark's baseline: the same parts through libnest2d
+  libnest2d-dev libnlopt-cxx-dev
   # real tools that read our SVG and DXF sheets in the tests
   librsvg2-bin libxml2-utils python3-ezdxf
   # meshes other people made, read by the tests where these packages install
