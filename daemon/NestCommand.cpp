@@ -125,6 +125,7 @@ int runNest(const NestOptions& options) {
     summary["density"] = options.strip ? nlohmann::ordered_json(result.partArea / (nesting.height * result.stripLength))
                                        : nlohmann::ordered_json(nullptr);
     summary["seconds"] = seconds;
+    summary["layouts"] = result.evaluations;  // an extension of SPEC's summary: how far the search got
 
     if (!options.out.empty()) {
       std::filesystem::create_directories(options.out);
@@ -192,7 +193,7 @@ void addNestCommand(CLI::App& app, int& status) {
                       "Stop the search after this many layouts (with a long --time: the same layout on any machine)");
   command->add_option("--out", options->out, "Folder for layout.json and layout.svg");
   command->add_flag("--json", options->json,
-                    "Print one JSON object: sheets, utilization, strip_length, density, seconds");
+                    "Print one JSON object: sheets, utilization, strip_length, density, seconds, layouts");
   command->footer(
       "Lengths take in, mm or cm (a bare number is inches). In bin mode utilization is part area over the usable\n"
       "area of all sheets; in strip mode density is part area over strip_height x strip_length.\n\n"
