@@ -10,6 +10,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -32,6 +33,8 @@ constexpr double kScale = 1e4;
 // Outlines are simplified for nesting after being grown by this much, so the
 // simplified shape still contains the true one.
 constexpr double kSimplifyTolerance = 0.002;
+// Grid units (see Packer::overlapping).
+constexpr double kRoundingDepth = 1.5;
 
 cInt toInt(double value) { return static_cast<cInt>(std::llround(value * kScale)); }
 
@@ -80,6 +83,16 @@ struct Shape {
   cInt minX = 0, minY = 0, maxX = 0, maxY = 0;
   double rotation = 0;
 };
+
+double perimeterOf(const Path& path) {
+  double length = 0;
+  for (size_t i = 0; i < path.size(); ++i) {
+    const IntPoint& a = path[i];
+    const IntPoint& b = path[(i + 1) % path.size()];
+    length += std::hypot(static_cast<double>(b.X - a.X), static_cast<double>(b.Y - a.Y));
+  }
+  return length;
+}
 
 Box boxOf(const Path& path) {
   Box box{std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::min(),
@@ -264,6 +277,12 @@ struct Sheet {
 // region), and the grid rounds by a unit.
 constexpr cInt kRoomSlack = 4;
 
+// Strip compaction: the first shortening (2%), the least (0.1%), rounds of
+// moves per try, and the most candidate places weighed per move and rotation.
+constexpr double kFirstShrink = 0.02, kLeastShrink = 0.001;
+constexpr int kRounds = 150;
+constexpr size_t kMostCandidates = 3000, kMostSkipped = 12;
+
 // Places parts one by one, bottom-left on the vertices of the feasible region.
 class Packer {
  public:
@@ -346,10 +365,17 @@ class Packer {
           done = true;
         }
       }
-      if (!done) {
-        if (options_.strip && !sheets.empty()) {
+      if (!done && options_.strip && !sheets.empty()) {
+        // The strip is one sheet: a fixed rotation that does not fit it gives way.
+        if (auto spot = only >= 0 ? bestSpot(part, sheets.front(), -1) : std::nullopt) {
+          put(sheets.front(), *spot);
+          placed.emplace_back(0, *spot);
+          done = true;
+        } else {
           throw std::invalid_argument(fmt::format("{} does not fit the strip", parts_[part].name));
         }
+      }
+      if (!done) {
         sheets.emplace_back();
         sheets.back().freeArea = sheetArea;
         auto spot = bestSpot(part, sheets.back(), only);
@@ -359,23 +385,87 @@ class Packer {
         placed.emplace_back(static_cast<int>(sheets.size()) - 1, *spot);
       }
     }
-    NestingResult result;
-    result.sheets = static_cast<int>(sheets.size());
     // Cutting order: sheet by sheet, each in the order its parts were placed.
     std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    cInt right = 0;
-    for (const auto& [sheet, spot] : placed) {
-      const Shape& shape = shapes_[spot.part][spot.shape];
-      result.placements.push_back({spot.part, sheet + 1, spot.at.X / kScale, spot.at.Y / kScale, shape.rotation});
-      right = std::max(right, spot.at.X + shape.maxX);
+    lastLayout_.clear();
+    for (const auto& [sheet, spot] : placed) lastLayout_.push_back(spot);
+    return resultOf(placed, static_cast<int>(sheets.size()));
+  }
+
+  // Strip compaction by overlap minimisation, after the sequence search (in
+  // the spirit of Umetani et al. 2009 and sparrow): shorten the strip a
+  // little, push the parts beyond the new end inside it, then move
+  // overlapping parts one at a time to where they overlap least, weighting
+  // the pairs that keep overlapping more at every round (guided local search),
+  // until nothing overlaps (a shorter layout: keep it, shorten again) or the
+  // rounds run out (go back, shorten by less). `goOn` says whether the budget
+  // allows another move; `moves` counts them. The layout is exact: a try
+  // succeeds only when no two grown shapes overlap beyond rounding.
+  NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves) {
+    std::vector<PlacedShape> best = acceptedLayout_;
+    const size_t n = best.size();
+    auto lengthOf = [&](const std::vector<PlacedShape>& layout) {
+      cInt length = 0;
+      for (const PlacedShape& s : layout) length = std::max(length, s.at.X + shapes_[s.part][s.shape].maxX);
+      return length;
+    };
+    cInt bestLength = lengthOf(best);
+    double shrink = kFirstShrink;
+    std::vector<double> weights(n * n);
+    while (goOn() && shrink >= kLeastShrink) {
+      const cInt target = bestLength - std::max<cInt>(1, static_cast<cInt>(static_cast<double>(bestLength) * shrink));
+      std::vector<PlacedShape> trial = best;
+      bool fits = true;
+      for (PlacedShape& s : trial) {
+        const Shape& shape = shapes_[s.part][s.shape];
+        if (s.at.X + shape.maxX > target) s.at.X = target - shape.maxX;
+        fits = fits && s.at.X + shape.minX >= 0;
+      }
+      if (!fits) break;  // a part is as long as the strip
+      std::fill(weights.begin(), weights.end(), 1.0);
+      bool solved = false;
+      for (int round = 0; round < kRounds && goOn(); ++round) {
+        std::vector<std::pair<size_t, size_t>> pairs;
+        for (size_t i = 0; i < n; ++i) {
+          for (size_t j = i + 1; j < n; ++j) {
+            if (overlapping(trial[i], trial[j])) pairs.emplace_back(i, j);
+          }
+        }
+
+        if (pairs.empty()) {
+          solved = true;
+          break;
+        }
+        for (double& w : weights) w = std::max(1.0, w * 0.95);
+        for (const auto& [i, j] : pairs) weights[i * n + j] *= 1.4, weights[j * n + i] *= 1.4;
+        std::vector<size_t> overlapped;
+        for (const auto& [i, j] : pairs) overlapped.push_back(i), overlapped.push_back(j);
+        std::sort(overlapped.begin(), overlapped.end());
+        overlapped.erase(std::unique(overlapped.begin(), overlapped.end()), overlapped.end());
+        std::shuffle(overlapped.begin(), overlapped.end(), random);
+        for (size_t i : overlapped) {
+          if (!goOn()) break;
+          moveToLeastPenetration(trial, i, target, weights, random);
+          ++moves;
+        }
+      }
+      if (solved) {
+        best = std::move(trial);
+        bestLength = lengthOf(best);
+      } else {
+        shrink /= 2;
+      }
     }
-    result.stripLength = right / kScale;
-    return result;
+    acceptedLayout_ = best;
+    std::vector<std::pair<int, PlacedShape>> placed;
+    for (const PlacedShape& s : best) placed.emplace_back(0, s);
+    return resultOf(placed, 1);
   }
 
   // The last pack() becomes the sequence later calls compare with: its
   // checkpoints, and the earlier ones it resumed from, are kept.
   void accept() {
+    acceptedLayout_ = lastLayout_;
     std::erase_if(accepted_, [&](const auto& checkpoint) { return checkpoint.first > pendingStart_; });
     if (pendingPolicy_ != acceptedPolicy_) accepted_.clear();
     for (auto& checkpoint : pending_) accepted_.push_back(std::move(checkpoint));
@@ -390,9 +480,115 @@ class Packer {
     std::vector<std::pair<int, PlacedShape>> placed;  // (sheet, shape) in placing order
   };
   static constexpr size_t kCheckpointEvery = 8;
+  std::vector<PlacedShape> lastLayout_, acceptedLayout_;          // in cutting order
   std::vector<std::pair<size_t, PackState>> accepted_, pending_;  // (parts placed, state), ascending
   size_t pendingStart_ = 0;
   std::optional<OrderMode> acceptedPolicy_, pendingPolicy_;
+
+  NestingResult resultOf(const std::vector<std::pair<int, PlacedShape>>& placed, int sheets) const {
+    NestingResult result;
+    result.sheets = sheets;
+    cInt right = 0;
+    for (const auto& [sheet, spot] : placed) {
+      const Shape& shape = shapes_[spot.part][spot.shape];
+      result.placements.push_back({spot.part, sheet + 1, spot.at.X / kScale, spot.at.Y / kScale, shape.rotation});
+      right = std::max(right, spot.at.X + shape.maxX);
+    }
+    result.stripLength = right / kScale;
+    return result;
+  }
+
+  // Moves layout[i] to the place and rotation, inside a strip of `length`,
+  // where its weighted penetration into the others is least. Penetration
+  // into part j at reference point p: 0 outside their no-fit polygon, else
+  // the distance from p to its boundary. Candidates: the vertices of the
+  // no-fit polygons (where the part touches one without entering it), the
+  // inner-fit rectangle's corners, where the part is.
+  void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, cInt length,
+                              const std::vector<double>& weights, std::mt19937& random) {
+    const size_t n = layout.size();
+    const int part = layout[i].part;
+    PlacedShape best = layout[i];
+    double bestScore = std::numeric_limits<double>::max();
+    for (int k = 0; k < static_cast<int>(shapes_[part].size()); ++k) {
+      const Shape& moving = shapes_[part][k];
+      const cInt x0 = -moving.minX, x1 = length - moving.maxX, y0 = -moving.minY, y1 = height_ - moving.maxY;
+      if (x1 < x0 || y1 < y0) continue;
+      const auto inArea = [&](const Box& b) { return b[0] <= x1 && b[2] >= x0 && b[1] <= y1 && b[3] >= y0; };
+      struct Obstacle {
+        size_t other;
+        Paths region;
+        Box box;
+      };
+      std::vector<Obstacle> obstaclesOf;
+      for (size_t j = 0; j < n; ++j) {
+        if (j == i) continue;
+        const PlacedShape& q = layout[j];
+        const Shape& fixed = shapes_[q.part][q.shape];
+        const Box box{q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
+                      q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
+        if (!inArea(box)) continue;
+        Paths region = obstacles(part, k, {q}, inArea);
+        if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
+      }
+      std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
+      if (k == layout[i].shape) candidates.push_back(layout[i].at);
+      for (const Obstacle& o : obstaclesOf) {
+        for (const Path& path : o.region) {
+          for (const IntPoint& p : path) {
+            if (p.X >= x0 && p.X <= x1 && p.Y >= y0 && p.Y <= y1) candidates.push_back(p);
+          }
+        }
+      }
+      // The corners of the places clear of all but at most one other part:
+      // where the no-fit polygons' boundaries cross.
+      const auto cornersClearOf = [&](size_t skip) {
+        ClipperLib::Clipper clipper;
+        clipper.AddPath(Path{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, ClipperLib::ptSubject, true);
+        for (size_t o = 0; o < obstaclesOf.size(); ++o) {
+          if (o != skip) clipper.AddPaths(obstaclesOf[o].region, ClipperLib::ptClip, true);
+        }
+        Paths free;
+        clipper.Execute(ClipperLib::ctDifference, free, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+        for (const Path& path : free) candidates.insert(candidates.end(), path.begin(), path.end());
+      };
+      cornersClearOf(obstaclesOf.size());
+      for (size_t o = 0; o < obstaclesOf.size() && o < kMostSkipped; ++o) cornersClearOf(o);
+      if (candidates.size() > kMostCandidates) {
+        std::shuffle(candidates.begin() + 5, candidates.end(), random);
+        candidates.resize(kMostCandidates);
+      }
+      for (const IntPoint& p : candidates) {
+        double score = 0;
+        for (const Obstacle& o : obstaclesOf) {
+          if (p.X <= o.box[0] || p.X >= o.box[2] || p.Y <= o.box[1] || p.Y >= o.box[3]) continue;
+          double depth = penetration(o.region, p);
+          if (depth <= kRoundingDepth) depth = 0;
+          score += weights[i * n + o.other] * depth;
+          if (score >= bestScore) break;
+        }
+        if (score < bestScore) bestScore = score, best = {part, k, p};
+      }
+    }
+    layout[i] = best;
+  }
+
+  // How deep `p` lies inside `region` (outer contours and holes): 0 outside
+  // or on the boundary, else the distance to the nearest edge.
+  static double penetration(const Paths& region, IntPoint p) {
+    int winding = 0;
+    for (const Path& path : region) {
+      const int inside = ClipperLib::PointInPolygon(p, path);
+      if (inside == -1) return 0;  // on the boundary: touching
+      if (inside == 1) winding += ClipperLib::Orientation(path) ? 1 : -1;
+    }
+    if (winding <= 0) return 0;
+    double nearest = std::numeric_limits<double>::max();
+    for (const Path& path : region) {
+      nearest = std::min(nearest, distanceToBoundary(path, static_cast<double>(p.X), static_cast<double>(p.Y)));
+    }
+    return nearest;
+  }
 
   Point2 extentOf(size_t part) const {
     const Shape& s = shapes_[part].front();
@@ -545,8 +741,30 @@ class Packer {
     if (!any) return std::nullopt;
     // A box of reference points matters only if it reaches left of `upTo` and might hold a feasible point.
     const auto matters = [&](const Box& b) { return b[0] <= upTo && mightFit(b); };
+    clipper.AddPaths(obstacles(part, k, sheet.parts, matters), ClipperLib::ptClip, true);
+    Paths feasible;
+    clipper.Execute(ClipperLib::ctDifference, feasible, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    std::vector<IntPoint> candidates;
+    for (const Path& region : feasible) candidates.insert(candidates.end(), region.begin(), region.end());
+    // Bottom-left: leftmost, then lowest; the first that an exact check
+    // confirms, so that no rounding in the no-fit polygons can let parts overlap.
+    std::sort(candidates.begin(), candidates.end(),
+              [](const IntPoint& a, const IntPoint& b) { return a.X < b.X || (a.X == b.X && a.Y < b.Y); });
+    for (const IntPoint& p : candidates) {
+      if (best && rankOf({part, k, p}) >= rankOf(*best)) break;
+      if (clear(moving, p, sheet.parts)) return PlacedShape{part, k, p};
+    }
+    return std::nullopt;
+  }
+
+  // The reference points where shape k of `part` would overlap one of
+  // `others`: the union of their no-fit polygons, built only where a box of
+  // reference points `matters`.
+  template <typename Matters>
+  Paths obstacles(int part, int k, const std::vector<PlacedShape>& others, const Matters& matters) {
+    const Shape& moving = shapes_[part][k];
     std::vector<Paths> noFitPolygons;
-    for (const PlacedShape& q : sheet.parts) {
+    for (const PlacedShape& q : others) {
       const Shape& fixed = shapes_[q.part][q.shape];
       // The no-fit polygon lies in this box.
       if (!matters({q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
@@ -556,7 +774,7 @@ class Packer {
       if (!fixed.pieces.empty() && !moving.pieces.empty()) {
         // The union over pairs of convex pieces of their linear-time sums is
         // the whole no-fit polygon, either shape inside the other included.
-        // Only the part of it in the window and near the room matters. Each
+        // Only the part of it in boxes that matter is built. Each
         // pair's sums are united first, which Clipper does faster than one
         // union of everything.
         if (classSize_[classOf_[part][k]] > 1 && classSize_[classOf_[q.part][q.shape]] > 1) {
@@ -586,20 +804,7 @@ class Packer {
       whole.push_back(translatedPath(moving.negated, {q.at.X + fixed.grown[0].X, q.at.Y + fixed.grown[0].Y}));
       noFitPolygons.push_back(std::move(whole));
     }
-    clipper.AddPaths(unionOf(std::move(noFitPolygons)), ClipperLib::ptClip, true);
-    Paths feasible;
-    clipper.Execute(ClipperLib::ctDifference, feasible, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-    std::vector<IntPoint> candidates;
-    for (const Path& region : feasible) candidates.insert(candidates.end(), region.begin(), region.end());
-    // Bottom-left: leftmost, then lowest; the first that an exact check
-    // confirms, so that no rounding in the no-fit polygons can let parts overlap.
-    std::sort(candidates.begin(), candidates.end(),
-              [](const IntPoint& a, const IntPoint& b) { return a.X < b.X || (a.X == b.X && a.Y < b.Y); });
-    for (const IntPoint& p : candidates) {
-      if (best && rankOf({part, k, p}) >= rankOf(*best)) break;
-      if (clear(moving, p, sheet.parts)) return PlacedShape{part, k, p};
-    }
-    return std::nullopt;
+    return unionOf(std::move(noFitPolygons));
   }
 
   // Bottom-left across rotations compares where the parts themselves would
@@ -615,28 +820,44 @@ class Packer {
 
   // Whether the grown shape at `at` keeps off every placed grown shape (touching allowed).
   bool clear(const Shape& moving, IntPoint at, const std::vector<PlacedShape>& sheet) const {
-    const Path candidate = translatedPath(moving.grown, at);
-    cInt minX = std::numeric_limits<cInt>::max(), minY = minX, maxX = std::numeric_limits<cInt>::min(), maxY = maxX;
-    for (const IntPoint& p : candidate) {
-      minX = std::min(minX, p.X), minY = std::min(minY, p.Y), maxX = std::max(maxX, p.X), maxY = std::max(maxY, p.Y);
-    }
     for (const PlacedShape& q : sheet) {
-      const Shape& fixed = shapes_[q.part][q.shape];
-      const cInt grow = toInt(options_.spacing / 2 + 2 * kSimplifyTolerance);
-      if (q.at.X + fixed.maxX + grow < minX || q.at.X + fixed.minX - grow > maxX || q.at.Y + fixed.maxY + grow < minY ||
-          q.at.Y + fixed.minY - grow > maxY) {
-        continue;
-      }
-      ClipperLib::Clipper clipper;
-      clipper.AddPath(candidate, ClipperLib::ptSubject, true);
-      clipper.AddPath(translatedPath(fixed.grown, q.at), ClipperLib::ptClip, true);
-      Paths common;
-      clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-      double area = 0;
-      for (const Path& c : common) area += std::abs(ClipperLib::Area(c));
-      if (area > 4.0 * static_cast<double>(candidate.size())) return false;  // beyond rounding along the edges
+      if (overlapping(overlap(moving, at, shapes_[q.part][q.shape], q.at), moving)) return false;
     }
     return true;
+  }
+
+  // What two placed grown shapes have in common (nothing when their boxes are apart).
+  Paths common(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) const {
+    if (atA.X + a.grownMaxX <= atB.X + b.grownMinX || atB.X + b.grownMaxX <= atA.X + a.grownMinX ||
+        atA.Y + a.grownMaxY <= atB.Y + b.grownMinY || atB.Y + b.grownMaxY <= atA.Y + a.grownMinY) {
+      return {};
+    }
+    ClipperLib::Clipper clipper;
+    clipper.AddPath(translatedPath(a.grown, atA), ClipperLib::ptSubject, true);
+    clipper.AddPath(translatedPath(b.grown, atB), ClipperLib::ptClip, true);
+    Paths out;
+    clipper.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+    return out;
+  }
+  double overlap(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) const {
+    double area = 0;
+    for (const Path& c : common(a, atA, b, atB)) area += std::abs(ClipperLib::Area(c));
+    return area;
+  }
+  // Whether an overlap is beyond rounding along the edges of `shape`.
+  static bool overlapping(double area, const Shape& shape) {
+    return area > 4.0 * static_cast<double>(shape.grown.size());
+  }
+  // For the compaction: whether two placed shapes overlap more than a sliver
+  // of rounding (no-fit polygon vertices rounded to the grid reach up to a
+  // unit into a neighbour): some piece of their intersection is thicker
+  // (twice its area over its perimeter) than kRoundingDepth.
+  bool overlapping(const PlacedShape& a, const PlacedShape& b) const {
+    for (const Path& piece : common(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at)) {
+      const double perimeter = perimeterOf(piece);
+      if (perimeter > 0 && 2 * std::abs(ClipperLib::Area(piece)) / perimeter > kRoundingDepth) return true;
+    }
+    return false;
   }
 
   static Paths translatedPathsOf(const Paths& paths, IntPoint by) {
@@ -658,6 +879,10 @@ class Packer {
   std::vector<double> area_;                     // each part's grown area, square grid units
   cInt width_ = 0, height_ = 0;
 };
+
+// The share of the time budget (and of a cap on layouts) that the sequence
+// search has in the strip; the compaction has the rest.
+constexpr double kSequenceShare = 0.4;
 
 // Smaller is better: fewer sheets, then less used of the last sheet (or a shorter strip).
 std::pair<int, double> cost(const NestingResult& result, const std::vector<NestingPart>& parts) {
@@ -735,11 +960,16 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
   // change when the layout is no worse.
+  // In the strip (free order), the sequence search has the first part of the
+  // budget and the compaction the rest.
+  const bool compaction = options.strip && options.order == OrderMode::Free && parts.size() > 1;
+  const double sequenceShare = compaction ? kSequenceShare : 1.0;
+  const auto start = std::chrono::steady_clock::now();
+  std::mt19937 random(options.seed);
   if (options.order != OrderMode::Strict && parts.size() > 1) {
-    std::mt19937 random(options.seed);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(options.seconds);
-    while (std::chrono::steady_clock::now() < deadline &&
-           (options.evaluations <= 0 || evaluations < options.evaluations)) {
+    const auto deadline = start + std::chrono::duration<double>(sequenceShare * options.seconds);
+    const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
+    while (std::chrono::steady_clock::now() < deadline && (options.evaluations <= 0 || evaluations < lastEvaluation)) {
       std::vector<int> trial = sequence, trialShapes = shapeOf;
       const size_t i = random() % trial.size();
       size_t j = i;
@@ -775,6 +1005,20 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
         shapeOf = std::move(trialShapes);
         packer.accept();
       }
+    }
+  }
+  if (compaction) {
+    const auto deadline = start + std::chrono::duration<double>(options.seconds);
+    const auto goOn = [&] {
+      return std::chrono::steady_clock::now() < deadline &&
+             (options.evaluations <= 0 || evaluations < options.evaluations);
+    };
+    NestingResult compacted = packer.compact(random, goOn, evaluations);
+    // The compaction allows slivers of rounding between grown shapes; the
+    // layout is kept only if the true outlines keep the spacing exactly.
+    if (compacted.stripLength < best.stripLength && layoutProblems(parts, compacted, options).empty()) {
+      if (options.progress) options.progress(fmt::format("compacted: strip {:.2f} long", compacted.stripLength));
+      best = std::move(compacted);
     }
   }
   best.evaluations = evaluations;

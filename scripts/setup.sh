@@ -21,7 +21,7 @@ packages=(
   # the nesting benchmark's baseline: the same parts through libnest2d
   libnest2d-dev libnlopt-cxx-dev
   # real tools that read our SVG and DXF sheets in the tests
-  librsvg2-bin libxml2-utils python3-ezdxf
+  librsvg2-bin libxml2-utils python3-ezdxf inkscape
   # meshes other people made, read by the tests where these packages install
   # them (tests/data/external/README.md)
   assimp-testmodels geomview openscad-testing-data libcgal-demo

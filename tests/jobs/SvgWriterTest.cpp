@@ -195,5 +195,46 @@ TEST(SvgWriter, LibrsvgDrawsTheSameSheetAsTheEps) {
   }
 }
 
+TEST(SvgWriter, InkscapeReadsTheSameSheet) {
+  // Inkscape is what our users open sheets with (and LightBurn, which is not
+  // free software and cannot run here). Its command line reports the
+  // bounding box of every element it parsed, in its own pixels.
+  TempDir dir;
+  const SheetDrawing sheet = sampleSheet();
+  const auto file = dir.write("sheet.svg", svgOf(sheet));
+  const std::string environment = "HOME=" + shellQuote(dir.path()) + " ";
+  CommandResult result = run(environment + "inkscape --query-all " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err << " (inkscape is in Debian's inkscape)";
+  std::map<std::string, std::array<double, 4>> boxes;  // id -> x, y, width, height
+  std::istringstream lines(result.out);
+  for (std::string line; std::getline(lines, line);) {
+    std::array<double, 4> box{};
+    char id[128];
+    if (std::sscanf(line.c_str(), "%127[^,],%lf,%lf,%lf,%lf", id, &box[0], &box[1], &box[2], &box[3]) == 5) {
+      boxes[id] = box;
+    }
+  }
+  ASSERT_FALSE(boxes.empty()) << result.out;
+  for (Operation operation : profiles::kAllOperations) {
+    const std::string id(profiles::operationName(operation));
+    SCOPED_TRACE(id);
+    ASSERT_TRUE(boxes.contains(id)) << result.out;
+    // Inkscape's pixels are 1/96 in, y down from the top of the bed; its
+    // boxes include the hairline's width.
+    const Box mine = extentOf(sheet, operation);
+    const auto& [x, y, width, height] = boxes.at(id);
+    EXPECT_NEAR(x / 96, mine.x0, 0.002);
+    EXPECT_NEAR((x + width) / 96, mine.x1, 0.002);
+    EXPECT_NEAR(sheet.height - (y + height) / 96, mine.y0, 0.002);
+    EXPECT_NEAR(sheet.height - y / 96, mine.y1, 0.002);
+  }
+  // And it exports the bed at its size: 32 x 18 in at 36 dpi.
+  const auto png = dir.path() / "inkscape.png";
+  result = run(environment + "inkscape --export-type=png --export-dpi=36 --export-area-page --export-filename=" +
+               shellQuote(png) + " " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_EQ(pngSize(png), std::make_pair(1152, 648));
+}
+
 }  // namespace
 }  // namespace rotafab::jobs::test
