@@ -328,8 +328,12 @@ class Packer {
   // checkpoint among them instead of starting over.
   // `shapeOf[part]`, when given and not negative, is the only rotation (index
   // into the part's rotations) tried for the part, unless it cannot go on an empty sheet.
-  NestingResult pack(const std::vector<int>& sequence, OrderMode policy, size_t unchanged = 0,
-                     const std::vector<int>& shapeOf = {}) {
+  //
+  // `until`: a trial layout is given up (nothing returned) once past it, so
+  // that the search keeps to its time budget.
+  std::optional<NestingResult> pack(
+      const std::vector<int>& sequence, OrderMode policy, size_t unchanged = 0, const std::vector<int>& shapeOf = {},
+      std::chrono::steady_clock::time_point until = std::chrono::steady_clock::time_point::max()) {
     PackState state;
     size_t start = 0;
     if (policy == acceptedPolicy_) {
@@ -343,6 +347,7 @@ class Packer {
     auto& [sheets, placed] = state;
     const double sheetArea = static_cast<double>(width_) * static_cast<double>(height_);
     for (size_t index = start; index < sequence.size(); ++index) {
+      if (std::chrono::steady_clock::now() > until) return std::nullopt;
       if (index > start && index % kCheckpointEvery == 0) {
         pending_.emplace_back(index, state);
         for (Sheet& sheet : pending_.back().second.sheets) sheet.room.clear();  // rebuilt on demand
@@ -953,7 +958,7 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
     return true;
   };
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
-  NestingResult best = packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
+  NestingResult best = *packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
   packer.accept();
   auto bestCost = cost(best, parts);
   int evaluations = 1;
@@ -967,7 +972,8 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   const auto start = std::chrono::steady_clock::now();
   std::mt19937 random(options.seed);
   if (options.order != OrderMode::Strict && parts.size() > 1) {
-    const auto deadline = start + std::chrono::duration<double>(sequenceShare * options.seconds);
+    const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(sequenceShare * options.seconds));
     const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
     while (std::chrono::steady_clock::now() < deadline && (options.evaluations <= 0 || evaluations < lastEvaluation)) {
       std::vector<int> trial = sequence, trialShapes = shapeOf;
@@ -991,7 +997,11 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
         std::swap(trial[i], trial[j]);
       }
       // The parts before the first changed one are placed as before.
-      NestingResult result = packer.pack(trial, options.order, std::min(i, j), trialShapes);
+      // Without a cap on layouts, a trial that would end past the deadline is given up.
+      auto packed = packer.pack(trial, options.order, std::min(i, j), trialShapes,
+                                options.evaluations > 0 ? std::chrono::steady_clock::time_point::max() : deadline);
+      if (!packed) break;
+      NestingResult result = std::move(*packed);
       ++evaluations;
       const auto trialCost = cost(result, parts);
       if (trialCost <= bestCost && withinWindow(result)) {
