@@ -53,9 +53,13 @@ Polygon2 rotated(const Polygon2& polygon, double degrees) {
 }
 
 // The largest path of an offset; an outward offset of a simple polygon has one.
+// The boundary is grown too, as a line: a needle or slit in the outline (a
+// cut out and back along one line) encloses no area, and growing the polygon
+// alone would drop it, though the laser cuts it and neighbours must keep clear.
 Path grown(const Path& path, double by, ClipperLib::JoinType join) {
   ClipperLib::ClipperOffset offset(2.0, 0.25 * kScale * 0.001);
   offset.AddPath(path, join, ClipperLib::etClosedPolygon);
+  offset.AddPath(path, ClipperLib::jtRound, ClipperLib::etClosedLine);
   Paths out;
   offset.Execute(out, by * kScale);
   if (out.empty()) return path;

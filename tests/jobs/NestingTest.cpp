@@ -220,5 +220,47 @@ TEST(Nesting, BedSizedPartFillsOneSheet) {
   EXPECT_EQ(result.sheets, 1);
 }
 
+TEST(Nesting, AwkwardOutlinesAreNestedExactly) {
+  // Outlines as instance files and unfoldings give them: repeated points,
+  // straight corners, needles, bow ties (self-crossing), slivers, and
+  // coordinates far from the origin. Each is nested with the rest, or the
+  // whole call is refused naming one part; never overlapping parts.
+  std::mt19937 random(99);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int trial = 0; trial < 6; ++trial) {
+    SCOPED_TRACE(trial);
+    std::vector<NestingPart> parts = randomParts(100 + trial, 6);
+    const auto add = [&](std::string name, Polygon2 outline) {
+      NestingPart part;
+      part.name = std::move(name);
+      part.outline = std::move(outline);
+      part.order = static_cast<int>(parts.size());
+      parts.push_back(std::move(part));
+    };
+    const double s = 0.5 + 2 * unit(random);
+    add("repeated points", {{0, 0}, {0, 0}, {s, 0}, {s, 0}, {s, s}, {0, s}, {0, s}});
+    add("straight corners", {{0, 0}, {s / 2, 0}, {s, 0}, {s, s / 2}, {s, s}, {0, s}});
+    add("needle", {{0, 0}, {s, 0}, {s, s}, {s / 2, s}, {s / 2, 3 * s}, {s / 2, s}, {0, s}});
+    // Lopsided, so that its signed area is not zero; only in the last trial,
+    // since a refusal stops the whole call.
+    if (trial == 5) add("bow tie", {{0, 0}, {s, s}, {s, 0}, {0, 2 * s}});
+    add("sliver", {{0, 0}, {3 * s, 0}, {3 * s, 0.001}});
+    add("far away", {{1000, 1000}, {1000 + s, 1000}, {1000 + s, 1000 + s / 3}, {1000, 1000 + s}});
+    NestingOptions options;
+    options.evaluations = 20;
+    options.seconds = 600;
+    options.strip = trial % 2 == 1;
+    options.height = options.strip ? 8 : 17.5;
+    try {
+      expectValid(parts, nest(parts, options), options);
+    } catch (const std::invalid_argument& error) {
+      const std::string message = error.what();
+      const bool named = std::any_of(parts.begin(), parts.end(),
+                                     [&](const NestingPart& part) { return message.rfind(part.name, 0) == 0; });
+      EXPECT_TRUE(named) << message;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rotafab::jobs
