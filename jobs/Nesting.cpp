@@ -445,6 +445,8 @@ class Packer {
           solved = true;
           break;
         }
+        // Pairs that overlap now weigh more; old conflicts fade, so that they
+        // do not pin parts that have since moved apart.
         for (double& w : weights) w = std::max(1.0, w * 0.95);
         for (const auto& [i, j] : pairs) weights[i * n + j] *= 1.4, weights[j * n + i] *= 1.4;
         std::vector<size_t> overlapped;
@@ -510,9 +512,10 @@ class Packer {
   // Moves layout[i] to the place and rotation, inside a strip of `length`,
   // where its weighted penetration into the others is least. Penetration
   // into part j at reference point p: 0 outside their no-fit polygon, else
-  // the distance from p to its boundary. Candidates: the vertices of the
-  // no-fit polygons (where the part touches one without entering it), the
-  // inner-fit rectangle's corners, where the part is.
+  // the distance from p to its boundary. Candidates: the inner-fit
+  // rectangle's corners, where the part is, the vertices of the no-fit
+  // polygons (where it touches one without entering it), and the corners of
+  // the places clear of all others or of all but one.
   void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, cInt length,
                               const std::vector<double>& weights, std::mt19937& random) {
     const size_t n = layout.size();
@@ -563,7 +566,7 @@ class Packer {
       };
       cornersClearOf(obstaclesOf.size());
       for (size_t o = 0; o < obstaclesOf.size() && o < kMostSkipped; ++o) cornersClearOf(o);
-      if (candidates.size() > kMostCandidates) {
+      if (candidates.size() > kMostCandidates) {  // a random sample, keeping the first few
         std::shuffle(candidates.begin() + 5, candidates.end(), random);
         candidates.resize(kMostCandidates);
       }
@@ -687,7 +690,7 @@ class Packer {
       if (only >= 0 && k != only) continue;
       const Shape& moving = shapes_[part][k];
       const CellCover* centres = moving.centres.empty() ? nullptr : &room(sheet, moving.radius);
-      if (centres && centres->empty()) return best;  // no room for this part in any rotation
+      if (centres && centres->empty()) continue;  // no room for this rotation's discs
       // Inner-fit rectangle: reference positions keeping the true outline on the area.
       const cInt x0 = -moving.minX, y0 = -moving.minY;
       cInt x1 = width_ - moving.maxX, y1 = height_ - moving.maxY;

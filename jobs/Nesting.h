@@ -1,13 +1,15 @@
 #pragma once
 // True-shape nesting of parts onto beds or into a strip (issue 3): no-fit
-// polygons from Clipper's Minkowski sums, bottom-left placement on the
-// vertices of the feasible region, each candidate confirmed by an exact
-// intersection test, then an improvement phase that swaps parts in the
-// sequence within a time budget. Parts are concave and interlock; bounding
-// boxes and hulls are never used for collisions. The first layout is
-// deterministic; the search tries a sequence fixed by the seed, and the time
-// budget decides how far along it gets, so with a budget the result can differ
-// between machines.
+// polygons (unions of the Minkowski sums of convex pieces), bottom-left
+// placement on the vertices of the feasible region, each candidate confirmed
+// by an exact intersection test. Then, within a time budget, a search over
+// the sequence (swaps, fixed or freed rotations) and, in the strip with free
+// order, a compaction by guided local search that lets parts overlap and
+// moves them apart again. Parts are concave and interlock; bounding boxes and
+// hulls are never used for collisions. The first layout is deterministic; the
+// search follows a course fixed by the seed, and the time budget decides how
+// far along it gets, so with a budget the result can differ between machines
+// (a cap on layouts, `evaluations`, makes it the same everywhere).
 //
 // Coordinates in inches; a placement rotates the part's outline about its own
 // origin by `rotation` degrees (counter-clockwise), then translates it by
@@ -42,8 +44,8 @@ struct NestingOptions {
   double height = 17.5;     // usable area, or the strip's height
   bool strip = false;       // one strip of fixed height, least length
   double spacing = 0.0625;  // least distance between two outlines
-  double seconds = 5.0;     // improvement budget (wall clock)
-  int evaluations = 0;      // if positive, stop after this many layouts: reproducible on any machine
+  double seconds = 5.0;     // improvement budget (wall clock), after the first layout
+  int evaluations = 0;      // if positive, stop after this many layouts (and compaction moves): the same everywhere
   OrderMode order = OrderMode::Free;
   int window = 8;
   unsigned seed = 1;
