@@ -965,9 +965,15 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
     return true;
   };
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
+  // The first layout can take many seconds (25 s for 100 long strips): say so.
+  if (options.progress) options.progress(fmt::format("first layout of {} parts", parts.size()));
   NestingResult best = *packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
   packer.accept();
   auto bestCost = cost(best, parts);
+  if (options.progress) {
+    options.progress(fmt::format("{} sheet{}, last sheet {:.2f} in long; improving for {} s", bestCost.first,
+                                 bestCost.first == 1 ? "" : "s", bestCost.second, options.seconds));
+  }
   int evaluations = 1;
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
