@@ -143,10 +143,7 @@ RoomScale roomScaleFor(cInt height) {
 // that is farthest from the centres so far, while that is at least a radius
 // away. Every radius is a true distance to the boundary, so every disc is inside.
 std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radiusStep, int maxDiscs = 5) {
-  cInt minX = std::numeric_limits<cInt>::max(), minY = minX, maxX = std::numeric_limits<cInt>::min(), maxY = maxX;
-  for (const IntPoint& p : polygon) {
-    minX = std::min(minX, p.X), minY = std::min(minY, p.Y), maxX = std::max(maxX, p.X), maxY = std::max(maxY, p.Y);
-  }
+  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
   std::vector<std::pair<IntPoint, double>> inside;  // grid points and their distance to the boundary
   IntPoint best{(minX + maxX) / 2, (minY + maxY) / 2};
   double bestDistance = -1;
@@ -195,26 +192,12 @@ Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt r
   shape.rotation = rotation;
   Path path = toPath(rotated(outline, rotation));
   if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
-  shape.minX = shape.minY = std::numeric_limits<cInt>::max();
-  shape.maxX = shape.maxY = std::numeric_limits<cInt>::min();
-  for (const IntPoint& p : path) {
-    shape.minX = std::min(shape.minX, p.X);
-    shape.minY = std::min(shape.minY, p.Y);
-    shape.maxX = std::max(shape.maxX, p.X);
-    shape.maxY = std::max(shape.maxY, p.Y);
-  }
+  std::tie(shape.minX, shape.minY, shape.maxX, shape.maxY) = std::tuple_cat(boxOf(path));
   shape.grown = grown(path, spacing / 2 + kSimplifyTolerance, ClipperLib::jtMiter);
   ClipperLib::CleanPolygon(shape.grown, kSimplifyTolerance * kScale);
   if (ClipperLib::Area(shape.grown) < 0) std::reverse(shape.grown.begin(), shape.grown.end());
   for (const IntPoint& p : shape.grown) shape.negated.push_back({-p.X, -p.Y});
-  shape.grownMinX = shape.grownMinY = std::numeric_limits<cInt>::max();
-  shape.grownMaxX = shape.grownMaxY = std::numeric_limits<cInt>::min();
-  for (const IntPoint& p : shape.grown) {
-    shape.grownMinX = std::min(shape.grownMinX, p.X);
-    shape.grownMinY = std::min(shape.grownMinY, p.Y);
-    shape.grownMaxX = std::max(shape.grownMaxX, p.X);
-    shape.grownMaxY = std::max(shape.grownMaxY, p.Y);
-  }
+  std::tie(shape.grownMinX, shape.grownMinY, shape.grownMaxX, shape.grownMaxY) = std::tuple_cat(boxOf(shape.grown));
   std::tie(shape.radius, shape.centres) = clearDiscs(shape.grown, radiusStep);
   if (auto pieces = convexPieces(shape.grown)) {
     shape.pieces = std::move(*pieces);
