@@ -32,6 +32,7 @@ struct NestOptions {
   int window = 8;
   unsigned seed = 1;
   int evaluations = 0;
+  int threads = 0;
 };
 
 class UserError : public std::runtime_error {
@@ -64,6 +65,7 @@ int runNest(const NestOptions& options) {
     nesting.seconds = options.seconds;
     nesting.seed = options.seed;
     nesting.evaluations = options.evaluations;
+    nesting.threads = options.threads;
     double margin = 0;
     if (options.strip) {
       if (!(stripHeight > 0))
@@ -190,7 +192,13 @@ void addNestCommand(CLI::App& app, int& status) {
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the improvement search")->capture_default_str();
   command->add_option("--evaluations", options->evaluations,
-                      "Stop the search after this many layouts (with a long --time: the same layout on any machine)");
+                      "Stop each search after this many layouts (with a long --time: the same layout on any machine\n"
+                      "with the same --threads)");
+  command
+      ->add_option("--threads", options->threads,
+                   "Searches side by side, seeds SEED, SEED+1, ...; the best layout wins (default 0: one per core)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 256));
   command->add_option("--out", options->out, "Folder for layout.json and layout.svg");
   command->add_flag("--json", options->json,
                     "Print one JSON object: sheets, utilization, strip_length, density, seconds, layouts");

@@ -10,14 +10,17 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <limits>
 #include <map>
+#include <mutex>
 #include <numbers>
 #include <numeric>
 #include <optional>
 #include <random>
 #include <stdexcept>
+#include <thread>
 #include <tuple>
 
 namespace rotafab::jobs {
@@ -265,10 +268,17 @@ struct Sheet {
 constexpr cInt kRoomSlack = 4;
 
 // Strip compaction: the first shortening (2%), the least (0.1%), rounds of
-// moves per try, and the most candidate places weighed per move and rotation.
+// moves per try, tries per shortening before it is halved, and the most
+// candidate places weighed per move and rotation. One move in kGlobalEvery
+// may take a part anywhere, the others keep it near where it is. The
+// candidates include the corners of the places clear of all others but one,
+// for the kMostSkipped heaviest. Chosen on jakobs2, shapes0, shapes1 and swim,
+// two seeds each, 60 s (docs/PERFORMANCE.md).
 constexpr double kFirstShrink = 0.02, kLeastShrink = 0.001;
-constexpr int kRounds = 150;
-constexpr size_t kMostCandidates = 3000, kMostSkipped = 12;
+constexpr int kRounds = 150, kTriesPerShrink = 5, kGlobalEvery = 4;
+constexpr size_t kMostCandidates = 3000, kMostSkipped = 1;
+// The kept no-fit polygons are dropped when they hold this many points (16 bytes each).
+constexpr size_t kMostSharedPoints = 8'000'000;
 
 // Places parts one by one, bottom-left on the vertices of the feasible region.
 class Packer {
@@ -393,9 +403,9 @@ class Packer {
   // rounds run out (go back, shorten by less). `goOn` says whether the budget
   // allows another move; `moves` counts them. The layout is exact: a try
   // succeeds only when no two grown shapes overlap beyond rounding.
-  NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves) {
+  NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves,
+                        const std::function<void(double)>& shorter) {
     std::vector<PlacedShape> best = acceptedLayout_;
-    const size_t n = best.size();
     auto lengthOf = [&](const std::vector<PlacedShape>& layout) {
       cInt length = 0;
       for (const PlacedShape& s : layout) length = std::max(length, s.at.X + shapes_[s.part][s.shape].maxX);
@@ -403,51 +413,61 @@ class Packer {
     };
     cInt bestLength = lengthOf(best);
     double shrink = kFirstShrink;
-    std::vector<double> weights(n * n);
-    while (goOn() && shrink >= kLeastShrink) {
-      const cInt target = bestLength - std::max<cInt>(1, static_cast<cInt>(static_cast<double>(bestLength) * shrink));
+    int failures = 0;
+    while (goOn()) {
+      // Down to the least shortening: start again from the first, at other
+      // places, after a disruption (as sparrow does): two parts of different
+      // shapes trade places, and the layout is kept if they can be moved
+      // apart at the same length.
+      if (shrink < kLeastShrink) {
+        shrink = kFirstShrink;
+        if (best.size() > 1) {
+          std::vector<PlacedShape> trial = best;
+          const size_t a = random() % trial.size(), b = random() % trial.size();
+          if (a != b && classOf_[trial[a].part][trial[a].shape] != classOf_[trial[b].part][trial[b].shape]) {
+            const auto centreOf = [&](const PlacedShape& p) {
+              const Shape& shape = shapes_[p.part][p.shape];
+              return IntPoint{p.at.X + (shape.minX + shape.maxX) / 2, p.at.Y + (shape.minY + shape.maxY) / 2};
+            };
+            const IntPoint ca = centreOf(trial[a]), cb = centreOf(trial[b]);
+            const auto moveTo = [&](PlacedShape& p, IntPoint centre) {
+              const Shape& shape = shapes_[p.part][p.shape];
+              p.at.X =
+                  std::max(std::min(centre.X - (shape.minX + shape.maxX) / 2, bestLength - shape.maxX), -shape.minX);
+              p.at.Y = std::max(std::min(centre.Y - (shape.minY + shape.maxY) / 2, height_ - shape.maxY), -shape.minY);
+            };
+            moveTo(trial[a], cb);
+            moveTo(trial[b], ca);
+            if (separate(trial, bestLength, kRounds, random, goOn, moves)) {
+              best = std::move(trial);
+              bestLength = lengthOf(best);
+            }
+          }
+        }
+      }
+      const cInt cut = std::max<cInt>(1, static_cast<cInt>(static_cast<double>(bestLength) * shrink));
+      const cInt target = bestLength - cut;
+      // Take a slice out of the strip at a random place (as sparrow does):
+      // the parts right of it move left, so the overlaps to resolve are
+      // somewhere else at every try, not always at the end.
+      const cInt at = std::uniform_int_distribution<cInt>(0, bestLength)(random);
       std::vector<PlacedShape> trial = best;
       bool fits = true;
       for (PlacedShape& s : trial) {
         const Shape& shape = shapes_[s.part][s.shape];
-        if (s.at.X + shape.maxX > target) s.at.X = target - shape.maxX;
-        fits = fits && s.at.X + shape.minX >= 0;
+        if (s.at.X + (shape.minX + shape.maxX) / 2 > at) s.at.X -= cut;
+        fits = fits && shape.maxX - shape.minX <= target;
+        s.at.X = std::max(std::min(s.at.X, target - shape.maxX), -shape.minX);
       }
       if (!fits) break;  // a part is as long as the strip
-      std::fill(weights.begin(), weights.end(), 1.0);
-      bool solved = false;
-      for (int round = 0; round < kRounds && goOn(); ++round) {
-        std::vector<std::pair<size_t, size_t>> pairs;
-        for (size_t i = 0; i < n; ++i) {
-          for (size_t j = i + 1; j < n; ++j) {
-            if (overlapping(trial[i], trial[j])) pairs.emplace_back(i, j);
-          }
-        }
-
-        if (pairs.empty()) {
-          solved = true;
-          break;
-        }
-        // Pairs that overlap now weigh more; old conflicts fade, so that they
-        // do not pin parts that have since moved apart.
-        for (double& w : weights) w = std::max(1.0, w * 0.95);
-        for (const auto& [i, j] : pairs) weights[i * n + j] *= 1.4, weights[j * n + i] *= 1.4;
-        std::vector<size_t> overlapped;
-        for (const auto& [i, j] : pairs) overlapped.push_back(i), overlapped.push_back(j);
-        std::sort(overlapped.begin(), overlapped.end());
-        overlapped.erase(std::unique(overlapped.begin(), overlapped.end()), overlapped.end());
-        std::shuffle(overlapped.begin(), overlapped.end(), random);
-        for (size_t i : overlapped) {
-          if (!goOn()) break;
-          moveToLeastPenetration(trial, i, target, weights, random);
-          ++moves;
-        }
-      }
-      if (solved) {
+      if (separate(trial, target, kRounds, random, goOn, moves)) {
         best = std::move(trial);
         bestLength = lengthOf(best);
-      } else {
+        failures = 0;
+        shorter(bestLength / kScale);
+      } else if (++failures == kTriesPerShrink) {
         shrink /= 2;
+        failures = 0;
       }
     }
     acceptedLayout_ = best;
@@ -492,6 +512,41 @@ class Packer {
     return result;
   }
 
+  // Moves the parts of `layout` (inside `length` x the height) apart by
+  // guided local search: overlapping parts move one at a time to where they
+  // overlap least, the pairs that keep overlapping weighing more at every
+  // round, until nothing overlaps (true) or the rounds or the budget run out
+  // (false). Moves stay near the part (within its own size) except one in
+  // kGlobalEvery, which may go anywhere.
+  bool separate(std::vector<PlacedShape>& layout, cInt length, int rounds, std::mt19937& random,
+                const std::function<bool()>& goOn, int& moves) {
+    const size_t n = layout.size();
+    std::vector<double> weights(n * n, 1.0);
+    for (int round = 0; round < rounds && goOn(); ++round) {
+      std::vector<std::pair<size_t, size_t>> pairs;
+      for (size_t i = 0; i < n; ++i) {
+        for (size_t j = i + 1; j < n; ++j) {
+          if (overlapping(layout[i], layout[j])) pairs.emplace_back(i, j);
+        }
+      }
+      if (pairs.empty()) return true;
+      // Pairs that overlap now weigh more; old conflicts fade, so that they
+      // do not pin parts that have since moved apart.
+      for (double& w : weights) w = std::max(1.0, w * 0.95);
+      for (const auto& [i, j] : pairs) weights[i * n + j] *= 1.4, weights[j * n + i] *= 1.4;
+      std::vector<size_t> overlapped;
+      for (const auto& [i, j] : pairs) overlapped.push_back(i), overlapped.push_back(j);
+      std::sort(overlapped.begin(), overlapped.end());
+      overlapped.erase(std::unique(overlapped.begin(), overlapped.end()), overlapped.end());
+      std::shuffle(overlapped.begin(), overlapped.end(), random);
+      for (size_t i : overlapped) {
+        if (!goOn()) return false;
+        moveToLeastPenetration(layout, i, length, weights, random, ++moves % kGlobalEvery != 0);
+      }
+    }
+    return false;
+  }
+
   // Moves layout[i] to the place and rotation, inside a strip of `length`,
   // where its weighted penetration into the others is least. Penetration
   // into part j at reference point p: 0 outside their no-fit polygon, else
@@ -499,15 +554,26 @@ class Packer {
   // rectangle's corners, where the part is, the vertices of the no-fit
   // polygons (where it touches one without entering it), and the corners of
   // the places clear of all others or of all but one.
+  // `local`: only places that keep the part's box centre within the part's
+  // own size of where it is.
   void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, cInt length,
-                              const std::vector<double>& weights, std::mt19937& random) {
+                              const std::vector<double>& weights, std::mt19937& random, bool local) {
     const size_t n = layout.size();
     const int part = layout[i].part;
     PlacedShape best = layout[i];
     double bestScore = std::numeric_limits<double>::max();
+    const Shape& current = shapes_[part][layout[i].shape];
+    const cInt centreX = layout[i].at.X + (current.minX + current.maxX) / 2;
+    const cInt centreY = layout[i].at.Y + (current.minY + current.maxY) / 2;
+    const cInt reach = std::max(current.maxX - current.minX, current.maxY - current.minY);
     for (int k = 0; k < static_cast<int>(shapes_[part].size()); ++k) {
       const Shape& moving = shapes_[part][k];
-      const cInt x0 = -moving.minX, x1 = length - moving.maxX, y0 = -moving.minY, y1 = height_ - moving.maxY;
+      cInt x0 = -moving.minX, x1 = length - moving.maxX, y0 = -moving.minY, y1 = height_ - moving.maxY;
+      if (local) {
+        const cInt atX = centreX - (moving.minX + moving.maxX) / 2, atY = centreY - (moving.minY + moving.maxY) / 2;
+        x0 = std::max(x0, atX - reach), x1 = std::min(x1, atX + reach);
+        y0 = std::max(y0, atY - reach), y1 = std::min(y1, atY + reach);
+      }
       if (x1 < x0 || y1 < y0) continue;
       const auto inArea = [&](const Box& b) { return b[0] <= x1 && b[2] >= x0 && b[1] <= y1 && b[3] >= y0; };
       struct Obstacle {
@@ -523,7 +589,8 @@ class Packer {
         const Box box{q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
                       q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
         if (!inArea(box)) continue;
-        Paths region = obstacles(part, k, {q}, inArea);
+        // The same pairs meet again and again: their whole no-fit polygons are kept.
+        Paths region = translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at);
         if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
       }
       std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
@@ -548,7 +615,14 @@ class Packer {
         for (const Path& path : free) candidates.insert(candidates.end(), path.begin(), path.end());
       };
       cornersClearOf(obstaclesOf.size());
-      for (size_t o = 0; o < obstaclesOf.size() && o < kMostSkipped; ++o) cornersClearOf(o);
+      // Skipping, in turn, the parts that weigh most (those the part keeps overlapping).
+      std::vector<size_t> heaviest(obstaclesOf.size());
+      std::iota(heaviest.begin(), heaviest.end(), 0);
+      const size_t skipped = std::min(heaviest.size(), kMostSkipped);
+      std::partial_sort(heaviest.begin(), heaviest.begin() + skipped, heaviest.end(), [&](size_t a, size_t b) {
+        return weights[i * n + obstaclesOf[a].other] > weights[i * n + obstaclesOf[b].other];
+      });
+      for (size_t o = 0; o < skipped; ++o) cornersClearOf(heaviest[o]);
       if (candidates.size() > kMostCandidates) {  // a random sample, keeping the first few
         std::shuffle(candidates.begin() + 5, candidates.end(), random);
         candidates.resize(kMostCandidates);
@@ -610,6 +684,7 @@ class Packer {
     const auto key = std::make_pair(classOf_[movingPart][movingShape], classOf_[placedPart][placedShape]);
     auto it = shared_.find(key);
     if (it == shared_.end()) {
+      if (sharedPoints_ > kMostSharedPoints) shared_.clear(), sharedPoints_ = 0;  // bounded memory
       std::vector<Paths> sums;
       for (const Path& a : shapes_[placedPart][placedShape].pieces) {
         Paths sum;
@@ -617,6 +692,25 @@ class Packer {
         sums.push_back(std::move(sum));
       }
       it = shared_.emplace(key, unionOf(std::move(sums))).first;
+      for (const Path& path : it->second) sharedPoints_ += path.size();
+    }
+    return it->second;
+  }
+
+  // The whole no-fit polygon of any two shapes, at the origin.
+  const Paths& wholeNoFitPolygon(int movingPart, int movingShape, int placedPart, int placedShape) {
+    if (!shapes_[placedPart][placedShape].pieces.empty() && !shapes_[movingPart][movingShape].pieces.empty()) {
+      return sharedNoFitPolygon(movingPart, movingShape, placedPart, placedShape);
+    }
+    const auto key = std::make_tuple(movingPart, movingShape, placedPart, placedShape);
+    auto it = wholes_.find(key);
+    if (it == wholes_.end()) {
+      const Shape& fixed = shapes_[placedPart][placedShape];
+      const Shape& moving = shapes_[movingPart][movingShape];
+      Paths whole = boundarySum(movingPart, movingShape, placedPart, placedShape);
+      whole.push_back(translatedPath(fixed.grown, {-moving.grown[0].X, -moving.grown[0].Y}));
+      whole.push_back(translatedPath(moving.negated, {fixed.grown[0].X, fixed.grown[0].Y}));
+      it = wholes_.emplace(key, unionOf({std::move(whole)})).first;
     }
     return it->second;
   }
@@ -871,13 +965,15 @@ class Packer {
   std::vector<std::vector<int>> classOf_;
   std::vector<int> classSize_;
   std::map<std::pair<int, int>, Paths> shared_;  // (moving class, placed class) -> no-fit polygon
-  std::vector<double> area_;                     // each part's grown area, square grid units
+  size_t sharedPoints_ = 0;
+  std::map<std::tuple<int, int, int, int>, Paths> wholes_;  // no-fit polygons without convex pieces
+  std::vector<double> area_;                                // each part's grown area, square grid units
   cInt width_ = 0, height_ = 0;
 };
 
 // The share of the time budget (and of a cap on layouts) that the sequence
 // search has in the strip; the compaction has the rest.
-constexpr double kSequenceShare = 0.4;
+constexpr double kSequenceShare = 0.15;
 
 // Smaller is better: fewer sheets, then less used of the last sheet (or a shorter strip).
 std::pair<int, double> cost(const NestingResult& result, const std::vector<NestingPart>& parts) {
@@ -921,13 +1017,35 @@ Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement) 
   return out;
 }
 
-NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options) {
-  for (const auto& part : parts) {
-    if (part.outline.size() < 3 || std::abs(polygonArea(part.outline)) <= 0) {
-      throw std::invalid_argument(fmt::format("{}: the outline is not a polygon with area", part.name));
-    }
-    if (part.rotations.empty()) throw std::invalid_argument(fmt::format("{}: no allowed rotation", part.name));
+namespace {
+
+// The progress lines of searches running side by side: remarks from the
+// first search only, and an improvement only when it beats every search's
+// best so far.
+class SharedProgress {
+ public:
+  explicit SharedProgress(const std::function<void(const std::string&)>& out) : out_(out) {}
+  void remark(unsigned search, const std::string& line) {
+    const std::lock_guard lock(mutex_);
+    if (out_ && search == 0) out_(line);
   }
+  void improved(const std::pair<int, double>& cost, const std::string& line) {
+    const std::lock_guard lock(mutex_);
+    if (best_ && cost >= *best_) return;
+    best_ = cost;
+    if (out_) out_(line);
+  }
+
+ private:
+  const std::function<void(const std::string&)>& out_;
+  std::mutex mutex_;
+  std::optional<std::pair<int, double>> best_;
+};
+
+// One search: the first layout, then the sequence search and, in the strip,
+// the compaction, following the course `seed` sets.
+NestingResult searchLayout(const std::vector<NestingPart>& parts, const NestingOptions& options, unsigned search,
+                           SharedProgress& progress) {
   Packer packer(parts, options);
   // The first layout: assembly order, or for free order the largest parts first.
   std::vector<int> sequence(parts.size());
@@ -949,14 +1067,12 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   };
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
   // The first layout can take many seconds (25 s for 100 long strips): say so.
-  if (options.progress) options.progress(fmt::format("first layout of {} parts", parts.size()));
+  progress.remark(search, fmt::format("first layout of {} parts", parts.size()));
   NestingResult best = *packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
   packer.accept();
   auto bestCost = cost(best, parts);
-  if (options.progress) {
-    options.progress(fmt::format("{} sheet{}, last sheet {:.2f} in long; improving for {} s", bestCost.first,
-                                 bestCost.first == 1 ? "" : "s", bestCost.second, options.seconds));
-  }
+  progress.improved(bestCost, fmt::format("{} sheet{}, last sheet {:.2f} in long; improving for {} s", bestCost.first,
+                                          bestCost.first == 1 ? "" : "s", bestCost.second, options.seconds));
   int evaluations = 1;
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
@@ -966,7 +1082,7 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   const bool compaction = options.strip && options.order == OrderMode::Free && parts.size() > 1;
   const double sequenceShare = compaction ? kSequenceShare : 1.0;
   const auto start = std::chrono::steady_clock::now();
-  std::mt19937 random(options.seed);
+  std::mt19937 random(options.seed + search);
   if (options.order != OrderMode::Strict && parts.size() > 1) {
     const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                       std::chrono::duration<double>(sequenceShare * options.seconds));
@@ -1001,9 +1117,9 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
       ++evaluations;
       const auto trialCost = cost(result, parts);
       if (trialCost <= bestCost && withinWindow(result)) {
-        if (trialCost < bestCost && options.progress) {
-          options.progress(fmt::format("{} sheet{}, last sheet {:.2f} in long", trialCost.first,
-                                       trialCost.first == 1 ? "" : "s", trialCost.second));
+        if (trialCost < bestCost) {
+          progress.improved(trialCost, fmt::format("{} sheet{}, last sheet {:.2f} in long", trialCost.first,
+                                                   trialCost.first == 1 ? "" : "s", trialCost.second));
         }
         best = std::move(result);
         bestCost = trialCost;
@@ -1019,14 +1135,64 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
       return std::chrono::steady_clock::now() < deadline &&
              (options.evaluations <= 0 || evaluations < options.evaluations);
     };
-    NestingResult compacted = packer.compact(random, goOn, evaluations);
+    // Progress while compacting: the strip so far (its exact check comes at the end).
+    const auto shorter = [&](double length) {
+      progress.improved({1, length}, fmt::format("compacting: strip {:.2f} long", length));
+    };
+    NestingResult compacted = packer.compact(random, goOn, evaluations, shorter);
     // The compaction allows slivers of rounding between grown shapes; the
     // layout is kept only if the true outlines keep the spacing exactly.
     if (compacted.stripLength < best.stripLength && layoutProblems(parts, compacted, options).empty()) {
-      if (options.progress) options.progress(fmt::format("compacted: strip {:.2f} long", compacted.stripLength));
       best = std::move(compacted);
     }
   }
+  best.evaluations = evaluations;
+  return best;
+}
+
+}  // namespace
+
+NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options) {
+  for (const auto& part : parts) {
+    if (part.outline.size() < 3 || std::abs(polygonArea(part.outline)) <= 0) {
+      throw std::invalid_argument(fmt::format("{}: the outline is not a polygon with area", part.name));
+    }
+    if (part.rotations.empty()) throw std::invalid_argument(fmt::format("{}: no allowed rotation", part.name));
+  }
+  // Searches side by side, one per core, each on its own course; the best
+  // layout wins (on a tie, the lowest seed's). Strict order has nothing to search.
+  const unsigned searches = options.order == OrderMode::Strict || parts.size() < 2 ? 1u
+                            : options.threads > 0 ? static_cast<unsigned>(options.threads)
+                                                  : std::max(1u, std::thread::hardware_concurrency());
+  SharedProgress progress(options.progress);
+  std::vector<NestingResult> results(searches);
+  std::vector<std::exception_ptr> errors(searches);
+  std::vector<std::thread> threads;
+  for (unsigned search = 1; search < searches; ++search) {
+    threads.emplace_back([&, search] {
+      try {
+        results[search] = searchLayout(parts, options, search, progress);
+      } catch (...) {
+        errors[search] = std::current_exception();
+      }
+    });
+  }
+  try {
+    results[0] = searchLayout(parts, options, 0, progress);
+  } catch (...) {
+    errors[0] = std::current_exception();
+  }
+  for (std::thread& thread : threads) thread.join();
+  for (const auto& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+  size_t winner = 0;
+  int evaluations = 0;
+  for (size_t i = 0; i < results.size(); ++i) {
+    evaluations += results[i].evaluations;
+    if (cost(results[i], parts) < cost(results[winner], parts)) winner = i;
+  }
+  NestingResult best = std::move(results[winner]);
   best.evaluations = evaluations;
   for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));
   return best;

@@ -6,10 +6,11 @@
 // the sequence (swaps, fixed or freed rotations) and, in the strip with free
 // order, a compaction by guided local search that lets parts overlap and
 // moves them apart again. Parts are concave and interlock; bounding boxes and
-// hulls are never used for collisions. The first layout is deterministic; the
-// search follows a course fixed by the seed, and the time budget decides how
-// far along it gets, so with a budget the result can differ between machines
-// (a cap on layouts, `evaluations`, makes it the same everywhere).
+// hulls are never used for collisions. The first layout is deterministic;
+// the searches (one per core, side by side) each follow a course fixed by
+// their seed, and the time budget decides how far along they get, so with a
+// budget the result can differ between machines (a cap on layouts,
+// `evaluations`, makes it the same everywhere for the same `threads`).
 //
 // Coordinates in inches; a placement rotates the part's outline about its own
 // origin by `rotation` degrees (counter-clockwise), then translates it by
@@ -45,10 +46,14 @@ struct NestingOptions {
   bool strip = false;       // one strip of fixed height, least length
   double spacing = 0.0625;  // least distance between two outlines
   double seconds = 5.0;     // improvement budget (wall clock), after the first layout
-  int evaluations = 0;      // if positive, stop after this many layouts (and compaction moves): the same everywhere
+  int evaluations = 0;      // if positive, each search stops after this many layouts (and compaction moves)
   OrderMode order = OrderMode::Free;
   int window = 8;
   unsigned seed = 1;
+  // Searches run side by side, one per thread, with seeds seed, seed + 1, ...;
+  // the best layout wins. 0: one per core. With a cap on layouts, the result
+  // is the same on every machine for the same number of threads.
+  int threads = 0;
   std::function<void(const std::string&)> progress;  // one line per improvement, optional
 };
 
@@ -64,7 +69,7 @@ struct NestingResult {
   int sheets = 0;
   double stripLength = 0;  // strip mode: the rightmost extent of any part
   double partArea = 0;     // sum of the outlines' areas
-  int evaluations = 0;     // layouts tried
+  int evaluations = 0;     // layouts tried (and compaction moves), all searches together
 };
 
 // Throws std::invalid_argument naming the part when a part cannot fit the usable
