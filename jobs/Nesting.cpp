@@ -396,12 +396,11 @@ class Packer {
 
   // Strip compaction by overlap minimisation, after the sequence search (in
   // the spirit of Umetani et al. 2009 and sparrow): shorten the strip a
-  // little, push the parts beyond the new end inside it, then move
-  // overlapping parts one at a time to where they overlap least, weighting
-  // the pairs that keep overlapping more at every round (guided local search),
+  // little by taking out a slice, then move the parts apart (separate())
   // until nothing overlaps (a shorter layout: keep it, shorten again) or the
-  // rounds run out (go back, shorten by less). `goOn` says whether the budget
-  // allows another move; `moves` counts them. The layout is exact: a try
+  // rounds run out (go back; after a few such tries, shorten by less).
+  // `goOn` says whether the budget allows another move; `moves` counts them;
+  // `shorter` hears of each shorter layout kept. The layout is exact: a try
   // succeeds only when no two grown shapes overlap beyond rounding.
   NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves,
                         const std::function<void(double)>& shorter) {
@@ -675,11 +674,10 @@ class Packer {
     return total;
   }
 
-  // The no-fit polygon of moving shape `m` against placed shape `q` (at q.at):
-  // the reference positions where the two grown shapes overlap. The Minkowski
-  // sum of the boundaries, plus the two cases where one shape holds the other.
-  // The whole no-fit polygon from convex pieces, kept for every copy of the
-  // two shapes (instances repeat items many times).
+  // The no-fit polygon of a moving shape against a placed one (at the
+  // origin): the reference positions where the two grown shapes overlap.
+  // Built whole from convex pieces and kept for the two shapes' classes
+  // (instances repeat items many times), up to kMostSharedPoints.
   const Paths& sharedNoFitPolygon(int movingPart, int movingShape, int placedPart, int placedShape) {
     const auto key = std::make_pair(classOf_[movingPart][movingShape], classOf_[placedPart][placedShape]);
     auto it = shared_.find(key);
@@ -697,7 +695,9 @@ class Packer {
     return it->second;
   }
 
-  // The whole no-fit polygon of any two shapes, at the origin.
+  // The whole no-fit polygon of any two shapes, at the origin. Without
+  // convex pieces: the Minkowski sum of the boundaries, plus the two cases
+  // where one shape holds the other.
   const Paths& wholeNoFitPolygon(int movingPart, int movingShape, int placedPart, int placedShape) {
     if (!shapes_[placedPart][placedShape].pieces.empty() && !shapes_[movingPart][movingShape].pieces.empty()) {
       return sharedNoFitPolygon(movingPart, movingShape, placedPart, placedShape);
@@ -888,10 +888,7 @@ class Packer {
         if (!sums.empty()) noFitPolygons.push_back(unionOf(std::move(sums)));
         continue;
       }
-      Paths whole = translatedPathsOf(boundarySum(part, k, q.part, q.shape), q.at);
-      whole.push_back(translatedPath(fixed.grown, {q.at.X - moving.grown[0].X, q.at.Y - moving.grown[0].Y}));
-      whole.push_back(translatedPath(moving.negated, {q.at.X + fixed.grown[0].X, q.at.Y + fixed.grown[0].Y}));
-      noFitPolygons.push_back(std::move(whole));
+      noFitPolygons.push_back(translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at));
     }
     return unionOf(std::move(noFitPolygons));
   }
