@@ -707,22 +707,11 @@ class Packer {
     if (it == wholes_.end()) {
       const Shape& fixed = shapes_[placedPart][placedShape];
       const Shape& moving = shapes_[movingPart][movingShape];
-      Paths whole = boundarySum(movingPart, movingShape, placedPart, placedShape);
+      Paths whole;
+      ClipperLib::MinkowskiSum(moving.negated, fixed.grown, whole, true);
       whole.push_back(translatedPath(fixed.grown, {-moving.grown[0].X, -moving.grown[0].Y}));
       whole.push_back(translatedPath(moving.negated, {fixed.grown[0].X, fixed.grown[0].Y}));
       it = wholes_.emplace(key, unionOf({std::move(whole)})).first;
-    }
-    return it->second;
-  }
-
-  const Paths& boundarySum(int movingPart, int movingShape, int placedPart, int placedShape) {
-    const auto key = std::make_tuple(movingPart, movingShape, placedPart, placedShape);
-    auto it = sums_.find(key);
-    if (it == sums_.end()) {
-      Paths sum;
-      ClipperLib::MinkowskiSum(shapes_[movingPart][movingShape].negated, shapes_[placedPart][placedShape].grown, sum,
-                               true);
-      it = sums_.emplace(key, std::move(sum)).first;
     }
     return it->second;
   }
@@ -957,7 +946,6 @@ class Packer {
   const NestingOptions& options_;
   const RoomScale roomScale_;
   std::vector<std::vector<Shape>> shapes_;
-  std::map<std::tuple<int, int, int, int>, Paths> sums_;
   // Shapes that are exact copies share a class (one per part and rotation).
   std::vector<std::vector<int>> classOf_;
   std::vector<int> classSize_;
