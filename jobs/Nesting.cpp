@@ -305,6 +305,7 @@ class Packer {
     }
     width_ = options.strip ? stripBound() : toInt(options.width);
     height_ = toInt(options.height);
+    if (!options.strip) pitch_ = width_ + toInt(options.spacing) + toInt(1.0);
     for (size_t i = 0; i < parts.size(); ++i) {
       const bool fits = std::any_of(shapes_[i].begin(), shapes_[i].end(), [&](const Shape& s) {
         return s.maxX - s.minX <= width_ && s.maxY - s.minY <= height_;
@@ -390,20 +391,27 @@ class Packer {
     // Cutting order: sheet by sheet, each in the order its parts were placed.
     std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     lastLayout_.clear();
-    for (const auto& [sheet, spot] : placed) lastLayout_.push_back(spot);
+    for (auto [sheet, spot] : placed) {
+      spot.at.X += sheet * pitch_;
+      lastLayout_.push_back(spot);
+    }
     return resultOf(placed, static_cast<int>(sheets.size()));
   }
 
-  // Strip compaction by overlap minimisation, after the sequence search (in
-  // the spirit of Umetani et al. 2009 and sparrow): shorten the strip a
-  // little by taking out a slice, then move the parts apart (separate())
-  // until nothing overlaps (a shorter layout: keep it, shorten again) or the
-  // rounds run out (go back; after a few such tries, shorten by less).
+  // Compaction by overlap minimisation, after the sequence search (in the
+  // spirit of Umetani et al. 2009 and sparrow): shorten the strip a little by
+  // taking out a slice, then move the parts apart (separate()) until nothing
+  // overlaps (a shorter layout: keep it, shorten again) or the rounds run out
+  // (go back; after a few such tries, shorten by less).
+  // On beds, the beds lie side by side in one row (see pitch_) and the slice
+  // comes out of the last bed: what it holds moves to the earlier beds, which
+  // fill up, until the last bed is empty and one bed fewer is used.
   // `goOn` says whether the budget allows another move; `moves` counts them;
-  // `shorter` hears of each shorter layout kept. The layout is exact: a try
-  // succeeds only when no two grown shapes overlap beyond rounding.
+  // `shorter` hears of each better layout kept (beds, last bed's length in
+  // inches). The layout is exact: a try succeeds only when no two grown
+  // shapes overlap beyond rounding.
   NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves,
-                        const std::function<void(double)>& shorter) {
+                        const std::function<void(int, double)>& shorter) {
     std::vector<PlacedShape> best = acceptedLayout_;
     auto lengthOf = [&](const std::vector<PlacedShape>& layout) {
       cInt length = 0;
@@ -424,55 +432,61 @@ class Packer {
           std::vector<PlacedShape> trial = best;
           const size_t a = random() % trial.size(), b = random() % trial.size();
           if (a != b && classOf_[trial[a].part][trial[a].shape] != classOf_[trial[b].part][trial[b].shape]) {
-            const auto centreOf = [&](const PlacedShape& p) {
-              const Shape& shape = shapes_[p.part][p.shape];
-              return IntPoint{p.at.X + (shape.minX + shape.maxX) / 2, p.at.Y + (shape.minY + shape.maxY) / 2};
-            };
             const IntPoint ca = centreOf(trial[a]), cb = centreOf(trial[b]);
-            const auto moveTo = [&](PlacedShape& p, IntPoint centre) {
-              const Shape& shape = shapes_[p.part][p.shape];
-              p.at.X =
-                  std::max(std::min(centre.X - (shape.minX + shape.maxX) / 2, bestLength - shape.maxX), -shape.minX);
-              p.at.Y = std::max(std::min(centre.Y - (shape.minY + shape.maxY) / 2, height_ - shape.maxY), -shape.minY);
-            };
-            moveTo(trial[a], cb);
-            moveTo(trial[b], ca);
-            if (separate(trial, bestLength, kRounds, random, goOn, moves)) {
+            const auto lanes = lanesUpTo(bestLength);
+            if (moveInto(trial[a], cb, lanes) && moveInto(trial[b], ca, lanes) &&
+                separate(trial, bestLength, kRounds, random, goOn, moves)) {
               best = std::move(trial);
               bestLength = lengthOf(best);
             }
           }
         }
       }
-      const cInt cut = std::max<cInt>(1, static_cast<cInt>(static_cast<double>(bestLength) * shrink));
-      const cInt target = bestLength - cut;
-      // Take a slice out of the strip at a random place (as sparrow does):
-      // the parts right of it move left, so the overlaps to resolve are
-      // somewhere else at every try, not always at the end.
-      const cInt at = std::uniform_int_distribution<cInt>(0, bestLength)(random);
+      // In the strip, a share of its length; on beds, of a bed's, so that
+      // the last bed empties in steps of the same size however full it is.
+      const cInt lastStart = laneStartOf(bestLength);
+      const cInt cut =
+          std::max<cInt>(1, static_cast<cInt>(static_cast<double>(options_.strip ? bestLength : width_) * shrink));
+      cInt target = bestLength - cut;
+      if (target <= lastStart) {
+        if (lastStart == 0) break;             // one bed, or the strip, as short as a part
+        target = lastStart - pitch_ + width_;  // the last bed empties: the one before ends at its edge
+      }
+      // Take a slice out at a random place (as sparrow does): the parts right
+      // of it move left, so the overlaps to resolve are somewhere else at
+      // every try, not always at the end.
+      const cInt at = std::uniform_int_distribution<cInt>(lastStart, bestLength)(random);
+      const auto lanes = lanesUpTo(target);
       std::vector<PlacedShape> trial = best;
       bool fits = true;
       for (PlacedShape& s : trial) {
-        const Shape& shape = shapes_[s.part][s.shape];
-        if (s.at.X + (shape.minX + shape.maxX) / 2 > at) s.at.X -= cut;
-        fits = fits && shape.maxX - shape.minX <= target;
-        s.at.X = std::max(std::min(s.at.X, target - shape.maxX), -shape.minX);
+        if (centreOf(s).X > at) s.at.X -= cut;
+        fits = fits && moveInto(s, centreOf(s), lanes);
       }
       if (!fits) break;  // a part is as long as the strip
       if (separate(trial, target, kRounds, random, goOn, moves)) {
         best = std::move(trial);
         bestLength = lengthOf(best);
         failures = 0;
-        shorter(bestLength / kScale);
+        shorter(sheetOf(bestLength) + 1, (bestLength - laneStartOf(bestLength)) / kScale);
       } else if (++failures == kTriesPerShrink) {
         shrink /= 2;
         failures = 0;
       }
     }
     acceptedLayout_ = best;
+    // Back from the row of beds to each bed's own coordinates, in cutting
+    // order: bed by bed, each in the order of the layout.
     std::vector<std::pair<int, PlacedShape>> placed;
-    for (const PlacedShape& s : best) placed.emplace_back(0, s);
-    return resultOf(placed, 1);
+    int sheets = 1;
+    for (PlacedShape s : best) {
+      const int sheet = sheetOf(s.at.X + shapes_[s.part][s.shape].maxX);
+      s.at.X -= sheet * pitch_;
+      placed.emplace_back(sheet, s);
+      sheets = std::max(sheets, sheet + 1);
+    }
+    std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return resultOf(placed, sheets);
   }
 
   // The last pack() becomes the sequence later calls compare with: its
@@ -497,6 +511,47 @@ class Packer {
   std::vector<std::pair<size_t, PackState>> accepted_, pending_;  // (parts placed, state), ascending
   size_t pendingStart_ = 0;
   std::optional<OrderMode> acceptedPolicy_, pendingPolicy_;
+
+  // The compaction lays the beds side by side in one row, bed s from
+  // s * pitch_ on, a gap wider than any overhang of a grown shape between
+  // two: a layout of many beds is then one layout. These give the x ranges
+  // (lanes) of the beds in a row ending at `length` (in the strip: one),
+  // and the bed that a part ending at `right` is on.
+  std::vector<std::pair<cInt, cInt>> lanesUpTo(cInt length) const {
+    if (options_.strip) return {{0, length}};
+    std::vector<std::pair<cInt, cInt>> lanes;
+    for (cInt start = 0; start < length; start += pitch_) lanes.emplace_back(start, std::min(start + width_, length));
+    return lanes;
+  }
+  cInt laneStartOf(cInt right) const { return options_.strip ? 0 : (std::max<cInt>(right, 1) - 1) / pitch_ * pitch_; }
+  int sheetOf(cInt right) const { return options_.strip ? 0 : static_cast<int>(laneStartOf(right) / pitch_); }
+
+  IntPoint centreOf(const PlacedShape& p) const {
+    const Shape& shape = shapes_[p.part][p.shape];
+    return {p.at.X + (shape.minX + shape.maxX) / 2, p.at.Y + (shape.minY + shape.maxY) / 2};
+  }
+
+  // Puts `p`'s box centre at `centre`, or as near as its lane allows: the
+  // last lane that starts left of `centre`, or the first before it that is
+  // long enough for the part, in its rotation or else in the first other
+  // that fits. False when none is.
+  bool moveInto(PlacedShape& p, IntPoint centre, const std::vector<std::pair<cInt, cInt>>& lanes) const {
+    size_t lane = 0;
+    while (lane + 1 < lanes.size() && lanes[lane + 1].first <= centre.X) ++lane;
+    for (size_t l = lane + 1; l-- > 0;) {
+      const auto [from, to] = lanes[l];
+      for (int k = -1; k < static_cast<int>(shapes_[p.part].size()); ++k) {
+        const int tried = k < 0 ? p.shape : k;
+        const Shape& shape = shapes_[p.part][tried];
+        if (to - from < shape.maxX - shape.minX || height_ < shape.maxY - shape.minY) continue;
+        p.shape = tried;
+        p.at.X = std::clamp(centre.X - (shape.minX + shape.maxX) / 2, from - shape.minX, to - shape.maxX);
+        p.at.Y = std::clamp(centre.Y - (shape.minY + shape.maxY) / 2, -shape.minY, height_ - shape.maxY);
+        return true;
+      }
+    }
+    return false;
+  }
 
   NestingResult resultOf(const std::vector<std::pair<int, PlacedShape>>& placed, int sheets) const {
     NestingResult result;
@@ -565,77 +620,87 @@ class Packer {
     const cInt centreX = layout[i].at.X + (current.minX + current.maxX) / 2;
     const cInt centreY = layout[i].at.Y + (current.minY + current.maxY) / 2;
     const cInt reach = std::max(current.maxX - current.minX, current.maxY - current.minY);
+    // The lanes (beds) to look in: where the part is, and for a move that
+    // may go anywhere, one other chosen at random.
+    const auto lanes = lanesUpTo(length);
+    const size_t here = static_cast<size_t>(sheetOf(layout[i].at.X + current.maxX));
+    std::vector<size_t> looked{std::min(here, lanes.size() - 1)};
+    if (!local && lanes.size() > 1) looked.push_back(random() % lanes.size());
+    if (looked.size() == 2 && looked[0] == looked[1]) looked.pop_back();
     for (int k = 0; k < static_cast<int>(shapes_[part].size()); ++k) {
-      const Shape& moving = shapes_[part][k];
-      cInt x0 = -moving.minX, x1 = length - moving.maxX, y0 = -moving.minY, y1 = height_ - moving.maxY;
-      if (local) {
-        const cInt atX = centreX - (moving.minX + moving.maxX) / 2, atY = centreY - (moving.minY + moving.maxY) / 2;
-        x0 = std::max(x0, atX - reach), x1 = std::min(x1, atX + reach);
-        y0 = std::max(y0, atY - reach), y1 = std::min(y1, atY + reach);
-      }
-      if (x1 < x0 || y1 < y0) continue;
-      const auto inArea = [&](const Box& b) { return b[0] <= x1 && b[2] >= x0 && b[1] <= y1 && b[3] >= y0; };
-      struct Obstacle {
-        size_t other;
-        Paths region;
-        Box box;
-      };
-      std::vector<Obstacle> obstaclesOf;
-      for (size_t j = 0; j < n; ++j) {
-        if (j == i) continue;
-        const PlacedShape& q = layout[j];
-        const Shape& fixed = shapes_[q.part][q.shape];
-        const Box box{q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
-                      q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
-        if (!inArea(box)) continue;
-        // The same pairs meet again and again: their whole no-fit polygons are kept.
-        Paths region = translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at);
-        if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
-      }
-      std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
-      if (k == layout[i].shape) candidates.push_back(layout[i].at);
-      for (const Obstacle& o : obstaclesOf) {
-        for (const Path& path : o.region) {
-          for (const IntPoint& p : path) {
-            if (p.X >= x0 && p.X <= x1 && p.Y >= y0 && p.Y <= y1) candidates.push_back(p);
+      for (size_t lane : looked) {
+        const Shape& moving = shapes_[part][k];
+        cInt x0 = lanes[lane].first - moving.minX, x1 = lanes[lane].second - moving.maxX, y0 = -moving.minY,
+             y1 = height_ - moving.maxY;
+        if (local) {
+          const cInt atX = centreX - (moving.minX + moving.maxX) / 2, atY = centreY - (moving.minY + moving.maxY) / 2;
+          x0 = std::max(x0, atX - reach), x1 = std::min(x1, atX + reach);
+          y0 = std::max(y0, atY - reach), y1 = std::min(y1, atY + reach);
+        }
+        if (x1 < x0 || y1 < y0) continue;
+        const auto inArea = [&](const Box& b) { return b[0] <= x1 && b[2] >= x0 && b[1] <= y1 && b[3] >= y0; };
+        struct Obstacle {
+          size_t other;
+          Paths region;
+          Box box;
+        };
+        std::vector<Obstacle> obstaclesOf;
+        for (size_t j = 0; j < n; ++j) {
+          if (j == i) continue;
+          const PlacedShape& q = layout[j];
+          const Shape& fixed = shapes_[q.part][q.shape];
+          const Box box{q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
+                        q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
+          if (!inArea(box)) continue;
+          // The same pairs meet again and again: their whole no-fit polygons are kept.
+          Paths region = translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at);
+          if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
+        }
+        std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
+        if (k == layout[i].shape && layout[i].at.X >= x0 && layout[i].at.X <= x1) candidates.push_back(layout[i].at);
+        for (const Obstacle& o : obstaclesOf) {
+          for (const Path& path : o.region) {
+            for (const IntPoint& p : path) {
+              if (p.X >= x0 && p.X <= x1 && p.Y >= y0 && p.Y <= y1) candidates.push_back(p);
+            }
           }
         }
-      }
-      // The corners of the places clear of all but at most one other part:
-      // where the no-fit polygons' boundaries cross.
-      const auto cornersClearOf = [&](size_t skip) {
-        ClipperLib::Clipper clipper;
-        clipper.AddPath(Path{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, ClipperLib::ptSubject, true);
-        for (size_t o = 0; o < obstaclesOf.size(); ++o) {
-          if (o != skip) clipper.AddPaths(obstaclesOf[o].region, ClipperLib::ptClip, true);
+        // The corners of the places clear of all but at most one other part:
+        // where the no-fit polygons' boundaries cross.
+        const auto cornersClearOf = [&](size_t skip) {
+          ClipperLib::Clipper clipper;
+          clipper.AddPath(Path{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, ClipperLib::ptSubject, true);
+          for (size_t o = 0; o < obstaclesOf.size(); ++o) {
+            if (o != skip) clipper.AddPaths(obstaclesOf[o].region, ClipperLib::ptClip, true);
+          }
+          Paths free;
+          clipper.Execute(ClipperLib::ctDifference, free, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+          for (const Path& path : free) candidates.insert(candidates.end(), path.begin(), path.end());
+        };
+        cornersClearOf(obstaclesOf.size());
+        // Skipping, in turn, the parts that weigh most (those the part keeps overlapping).
+        std::vector<size_t> heaviest(obstaclesOf.size());
+        std::iota(heaviest.begin(), heaviest.end(), 0);
+        const size_t skipped = std::min(heaviest.size(), kMostSkipped);
+        std::partial_sort(heaviest.begin(), heaviest.begin() + skipped, heaviest.end(), [&](size_t a, size_t b) {
+          return weights[i * n + obstaclesOf[a].other] > weights[i * n + obstaclesOf[b].other];
+        });
+        for (size_t o = 0; o < skipped; ++o) cornersClearOf(heaviest[o]);
+        if (candidates.size() > kMostCandidates) {  // a random sample, keeping the first few
+          std::shuffle(candidates.begin() + 5, candidates.end(), random);
+          candidates.resize(kMostCandidates);
         }
-        Paths free;
-        clipper.Execute(ClipperLib::ctDifference, free, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-        for (const Path& path : free) candidates.insert(candidates.end(), path.begin(), path.end());
-      };
-      cornersClearOf(obstaclesOf.size());
-      // Skipping, in turn, the parts that weigh most (those the part keeps overlapping).
-      std::vector<size_t> heaviest(obstaclesOf.size());
-      std::iota(heaviest.begin(), heaviest.end(), 0);
-      const size_t skipped = std::min(heaviest.size(), kMostSkipped);
-      std::partial_sort(heaviest.begin(), heaviest.begin() + skipped, heaviest.end(), [&](size_t a, size_t b) {
-        return weights[i * n + obstaclesOf[a].other] > weights[i * n + obstaclesOf[b].other];
-      });
-      for (size_t o = 0; o < skipped; ++o) cornersClearOf(heaviest[o]);
-      if (candidates.size() > kMostCandidates) {  // a random sample, keeping the first few
-        std::shuffle(candidates.begin() + 5, candidates.end(), random);
-        candidates.resize(kMostCandidates);
-      }
-      for (const IntPoint& p : candidates) {
-        double score = 0;
-        for (const Obstacle& o : obstaclesOf) {
-          if (p.X <= o.box[0] || p.X >= o.box[2] || p.Y <= o.box[1] || p.Y >= o.box[3]) continue;
-          double depth = penetration(o.region, p);
-          if (depth <= kRoundingDepth) depth = 0;
-          score += weights[i * n + o.other] * depth;
-          if (score >= bestScore) break;
+        for (const IntPoint& p : candidates) {
+          double score = 0;
+          for (const Obstacle& o : obstaclesOf) {
+            if (p.X <= o.box[0] || p.X >= o.box[2] || p.Y <= o.box[1] || p.Y >= o.box[3]) continue;
+            double depth = penetration(o.region, p);
+            if (depth <= kRoundingDepth) depth = 0;
+            score += weights[i * n + o.other] * depth;
+            if (score >= bestScore) break;
+          }
+          if (score < bestScore) bestScore = score, best = {part, k, p};
         }
-        if (score < bestScore) bestScore = score, best = {part, k, p};
       }
     }
     layout[i] = best;
@@ -954,6 +1019,7 @@ class Packer {
   std::map<std::tuple<int, int, int, int>, Paths> wholes_;  // no-fit polygons without convex pieces
   std::vector<double> area_;                                // each part's grown area, square grid units
   cInt width_ = 0, height_ = 0;
+  cInt pitch_ = 0;  // beds side by side for the compaction (lanesUpTo()); 0 in the strip
 };
 
 // The share of the time budget (and of a cap on layouts) that the sequence
@@ -1062,9 +1128,9 @@ NestingResult searchLayout(const std::vector<NestingPart>& parts, const NestingO
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
   // change when the layout is no worse.
-  // In the strip (free order), the sequence search has the first part of the
-  // budget and the compaction the rest.
-  const bool compaction = options.strip && options.order == OrderMode::Free && parts.size() > 1;
+  // In free order, the sequence search has the first part of the budget and
+  // the compaction the rest.
+  const bool compaction = options.order == OrderMode::Free && parts.size() > 1;
   const double sequenceShare = compaction ? kSequenceShare : 1.0;
   const auto start = std::chrono::steady_clock::now();
   std::mt19937 random(options.seed + search);
@@ -1120,14 +1186,17 @@ NestingResult searchLayout(const std::vector<NestingPart>& parts, const NestingO
       return std::chrono::steady_clock::now() < deadline &&
              (options.evaluations <= 0 || evaluations < options.evaluations);
     };
-    // Progress while compacting: the strip so far (its exact check comes at the end).
-    const auto shorter = [&](double length) {
-      progress.improved({1, length}, fmt::format("compacting: strip {:.2f} long", length));
+    // Progress while compacting: the layout so far (its exact check comes at the end).
+    const auto shorter = [&](int sheets, double length) {
+      progress.improved({sheets, length}, options.strip
+                                              ? fmt::format("compacting: strip {:.2f} long", length)
+                                              : fmt::format("compacting: {} sheet{}, last sheet {:.2f} in long", sheets,
+                                                            sheets == 1 ? "" : "s", length));
     };
     NestingResult compacted = packer.compact(random, goOn, evaluations, shorter);
     // The compaction allows slivers of rounding between grown shapes; the
     // layout is kept only if the true outlines keep the spacing exactly.
-    if (compacted.stripLength < best.stripLength && layoutProblems(parts, compacted, options).empty()) {
+    if (cost(compacted, parts) < cost(best, parts) && layoutProblems(parts, compacted, options).empty()) {
       best = std::move(compacted);
     }
   }

@@ -3,9 +3,10 @@
 // polygons (unions of the Minkowski sums of convex pieces), bottom-left
 // placement on the vertices of the feasible region, each candidate confirmed
 // by an exact intersection test. Then, within a time budget, a search over
-// the sequence (swaps, fixed or freed rotations) and, in the strip with free
-// order, a compaction by guided local search that lets parts overlap and
-// moves them apart again. Parts are concave and interlock; bounding boxes and
+// the sequence (swaps, fixed or freed rotations) and, with free order, a
+// compaction by guided local search that lets parts overlap and moves them
+// apart again: it shortens the strip, or on beds the last sheet, whose parts
+// move onto the earlier ones. Parts are concave and interlock; bounding boxes and
 // hulls are never used for collisions. The first layout is deterministic;
 // the searches (one per core, side by side) each follow a course fixed by
 // their seed, and the time budget decides how far along they get, so with a
