@@ -1,28 +1,63 @@
 // Bin-mode nesting benchmark (issue 3, item 8): 200 star-shaped vertex panels
 // and 100 wavy strips on the workshop bed (32 x 18 in, 1/4 in margins, 1/16 in
-// spacing). Prints sheets used against the area lower bound
-// ceil(part area / usable bed area) and the utilisation of every sheet but the
-// last (target: at least 75%), beside the same parts through libnest2d in
-// convex-hull mode (bench/Libnest2dBaseline.h): we must use fewer sheets.
+// spacing). The vertex panels are shaped as the dissertation's vertex
+// components (V.1-V.2): a vertex band, a polygon with one side per edge of
+// the dual vertex, and on each side the edge band that leaves it, a
+// quadrilateral about as long as the side. 200 spiky stars (spikes 35-65% of
+// the radius deep, sharper than any vertex component) are a harder extra. Prints sheets used against the area lower
+// bound ceil(part area / usable bed area) and the utilisation of every sheet but the last (target: at least 75%),
+// beside the same parts through libnest2d in convex-hull mode (bench/Libnest2dBaseline.h): we must use fewer sheets.
 //
-//   build/rotafab_nest_bench [SECONDS]     improvement budget per instance (default 60)
+//   build/rotafab_nest_bench [SECONDS [SVG_DIR]]
+//     SECONDS: improvement budget per instance (default 60); SVG_DIR: also
+//     draw each layout there (NAME.svg), to look at.
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <numbers>
 #include <random>
 #include <string>
 
 #include "bench/Libnest2dBaseline.h"
+#include "jobs/LayoutSvg.h"
 #include "jobs/Nesting.h"
 
 using namespace rotafab::jobs;
 
 namespace {
 
-Polygon2 star(std::mt19937& random) {
+// A vertex component: 3 to 6 sides (triangle meshes give 3, quad meshes 4),
+// the polygon's corners a little off regular, each edge band 70-130% as long
+// as its side and 70-100% as wide at its far end.
+Polygon2 vertexPanel(std::mt19937& random) {
+  std::uniform_real_distribution<double> radius(0.4, 0.9), wobble(-0.12, 0.12), length(0.7, 1.3), width(0.7, 1.0);
+  static constexpr int kSides[] = {3, 3, 3, 3, 4, 4, 5, 6};
+  const int sides = kSides[random() % 8];
+  const double r = radius(random);
+  std::vector<Point2> corners;
+  for (int i = 0; i < sides; ++i) {
+    const double a = 2 * std::numbers::pi * (i + wobble(random)) / sides;
+    corners.emplace_back(r * std::cos(a), r * std::sin(a));
+  }
+  Polygon2 p;
+  for (int i = 0; i < sides; ++i) {
+    const Point2 a = corners[i], b = corners[(i + 1) % sides];
+    const Point2 along = (b - a).normalized();
+    const Point2 outward(along.y(), -along.x());  // counter-clockwise corners: the outside is on the right
+    const double side = (b - a).norm(), reach = side * length(random), half = side * width(random) / 2;
+    const Point2 end = (a + b) / 2 + reach * outward;
+    p.push_back(a);
+    p.push_back(end - half * along);
+    p.push_back(end + half * along);
+  }
+  return p;
+}
+
+Polygon2 spikyStar(std::mt19937& random) {
   std::uniform_real_distribution<double> radius(0.9, 2.4), inner(0.35, 0.65), jitter(0.85, 1.0);
   const int spikes = 5 + random() % 4;  // vertex bands of valence 5 to 8
   const double outer = radius(random), ratio = inner(random);
@@ -45,7 +80,7 @@ Polygon2 wavyStrip(std::mt19937& random) {
   return p;
 }
 
-void run(const std::string& name, const std::vector<NestingPart>& parts, double seconds) {
+void run(const std::string& name, const std::vector<NestingPart>& parts, double seconds, const char* svgDir) {
   NestingOptions options;  // the workshop bed: 31.5 x 17.5 usable, 1/16 in spacing
   options.seconds = seconds;
   const auto start = std::chrono::steady_clock::now();
@@ -61,6 +96,11 @@ void run(const std::string& name, const std::vector<NestingPart>& parts, double 
     if (s + 1 < result.sheets) worst = std::min(worst, areaOnSheet[s] / usable);
   }
   const auto problems = layoutProblems(parts, result, options);
+  if (svgDir) {
+    std::string file = name;
+    std::replace(file.begin(), file.end(), ' ', '-');
+    std::ofstream(std::string(svgDir) + "/" + file + ".svg") << layoutSvg(parts, result, options, 0.25);
+  }
   fmt::print("{}: {} parts, {} sheets (lower bound {}), worst sheet but the last {:.1f}%, {:.1f} s, {} layouts{}\n",
              name, parts.size(), result.sheets, static_cast<int>(std::ceil(result.partArea / usable)),
              100 * (result.sheets > 1 ? worst : areaOnSheet[0] / usable), elapsed, result.evaluations,
@@ -80,11 +120,17 @@ void run(const std::string& name, const std::vector<NestingPart>& parts, double 
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::stod(argv[1]) : 60.0;
   std::mt19937 random(2011);
-  std::vector<NestingPart> stars, strips;
-  for (int i = 0; i < 200; ++i) stars.push_back({fmt::format("star {}", i + 1), star(random), {0, 90, 180, 270}, i});
+  std::vector<NestingPart> stars, strips, panels;
+  for (int i = 0; i < 200; ++i)
+    stars.push_back({fmt::format("star {}", i + 1), spikyStar(random), {0, 90, 180, 270}, i});
   for (int i = 0; i < 100; ++i)
     strips.push_back({fmt::format("strip {}", i + 1), wavyStrip(random), {0, 90, 180, 270}, i});
-  run("200 star panels", stars, seconds);
-  run("100 wavy strips", strips, seconds);
+  // Drawn after the others, so that those stay the instances measured before.
+  for (int i = 0; i < 200; ++i)
+    panels.push_back({fmt::format("panel {}", i + 1), vertexPanel(random), {0, 90, 180, 270}, i});
+  const char* svgDir = argc > 2 ? argv[2] : nullptr;
+  run("200 vertex panels", panels, seconds, svgDir);
+  run("100 wavy strips", strips, seconds, svgDir);
+  run("200 spiky stars", stars, seconds, svgDir);
   return 0;
 }

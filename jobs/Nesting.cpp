@@ -111,18 +111,26 @@ Box boxOf(const Path& path) {
   return box;
 }
 
-double distanceToBoundary(const Path& polygon, double x, double y) {
+// The square of the distance from (x, y) to the polygon's boundary (squares:
+// the compaction asks this for every candidate place, and a square root per
+// edge took a fifth of its time).
+double squaredDistanceToBoundary(const Path& polygon, double x, double y) {
   double best = std::numeric_limits<double>::max();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const IntPoint& a = polygon[i];
-    const IntPoint& b = polygon[(i + 1) % polygon.size()];
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const IntPoint& a = polygon[j];
+    const IntPoint& b = polygon[i];
     const double dx = static_cast<double>(b.X - a.X), dy = static_cast<double>(b.Y - a.Y);
     const double length2 = dx * dx + dy * dy;
     double t = length2 > 0 ? ((x - a.X) * dx + (y - a.Y) * dy) / length2 : 0.0;
     t = std::clamp(t, 0.0, 1.0);
-    best = std::min(best, std::hypot(x - (a.X + t * dx), y - (a.Y + t * dy)));
+    const double ex = x - (a.X + t * dx), ey = y - (a.Y + t * dy);
+    best = std::min(best, ex * ex + ey * ey);
   }
   return best;
+}
+
+double distanceToBoundary(const Path& polygon, double x, double y) {
+  return std::sqrt(squaredDistanceToBoundary(polygon, x, y));
 }
 
 // The sizes of the sheet's `room` machinery, in proportion to the area's
@@ -413,11 +421,6 @@ class Packer {
   NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves,
                         const std::function<void(int, double)>& shorter) {
     std::vector<PlacedShape> best = acceptedLayout_;
-    auto lengthOf = [&](const std::vector<PlacedShape>& layout) {
-      cInt length = 0;
-      for (const PlacedShape& s : layout) length = std::max(length, s.at.X + shapes_[s.part][s.shape].maxX);
-      return length;
-    };
     cInt bestLength = lengthOf(best);
     double shrink = kFirstShrink;
     int failures = 0;
@@ -435,7 +438,7 @@ class Packer {
             const IntPoint ca = centreOf(trial[a]), cb = centreOf(trial[b]);
             const auto lanes = lanesUpTo(bestLength);
             if (moveInto(trial[a], cb, lanes) && moveInto(trial[b], ca, lanes) &&
-                separate(trial, bestLength, kRounds, random, goOn, moves)) {
+                separate(trial, lanes, kRounds, random, goOn, moves)) {
               best = std::move(trial);
               bestLength = lengthOf(best);
             }
@@ -464,7 +467,7 @@ class Packer {
         fits = fits && moveInto(s, centreOf(s), lanes);
       }
       if (!fits) break;  // a part is as long as the strip
-      if (separate(trial, target, kRounds, random, goOn, moves)) {
+      if (separate(trial, lanes, kRounds, random, goOn, moves)) {
         best = std::move(trial);
         bestLength = lengthOf(best);
         failures = 0;
@@ -487,6 +490,13 @@ class Packer {
     }
     std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     return resultOf(placed, sheets);
+  }
+
+  cInt rightOf(const PlacedShape& s) const { return s.at.X + shapes_[s.part][s.shape].maxX; }
+  cInt lengthOf(const std::vector<PlacedShape>& layout) const {
+    cInt length = 0;
+    for (const PlacedShape& s : layout) length = std::max(length, rightOf(s));
+    return length;
   }
 
   // The last pack() becomes the sequence later calls compare with: its
@@ -517,9 +527,10 @@ class Packer {
   // two: a layout of many beds is then one layout. These give the x ranges
   // (lanes) of the beds in a row ending at `length` (in the strip: one),
   // and the bed that a part ending at `right` is on.
-  std::vector<std::pair<cInt, cInt>> lanesUpTo(cInt length) const {
+  using Lanes = std::vector<std::pair<cInt, cInt>>;
+  Lanes lanesUpTo(cInt length) const {
     if (options_.strip) return {{0, length}};
-    std::vector<std::pair<cInt, cInt>> lanes;
+    Lanes lanes;
     for (cInt start = 0; start < length; start += pitch_) lanes.emplace_back(start, std::min(start + width_, length));
     return lanes;
   }
@@ -535,7 +546,7 @@ class Packer {
   // last lane that starts left of `centre`, or the first before it that is
   // long enough for the part, in its rotation or else in the first other
   // that fits. False when none is.
-  bool moveInto(PlacedShape& p, IntPoint centre, const std::vector<std::pair<cInt, cInt>>& lanes) const {
+  bool moveInto(PlacedShape& p, IntPoint centre, const Lanes& lanes) const {
     size_t lane = 0;
     while (lane + 1 < lanes.size() && lanes[lane + 1].first <= centre.X) ++lane;
     for (size_t l = lane + 1; l-- > 0;) {
@@ -572,17 +583,23 @@ class Packer {
   // round, until nothing overlaps (true) or the rounds or the budget run out
   // (false). Moves stay near the part (within its own size) except one in
   // kGlobalEvery, which may go anywhere.
-  bool separate(std::vector<PlacedShape>& layout, cInt length, int rounds, std::mt19937& random,
+  bool separate(std::vector<PlacedShape>& layout, const Lanes& lanes, int rounds, std::mt19937& random,
                 const std::function<bool()>& goOn, int& moves) {
     const size_t n = layout.size();
     std::vector<double> weights(n * n, 1.0);
+    // Whether each pair overlaps, kept from round to round: only the pairs
+    // of a part that moved are checked again (checking all pairs took a
+    // third of the compaction's time).
+    std::vector<char> overlaps(n * n, 0), moved(n, 1);
     for (int round = 0; round < rounds && goOn(); ++round) {
       std::vector<std::pair<size_t, size_t>> pairs;
       for (size_t i = 0; i < n; ++i) {
         for (size_t j = i + 1; j < n; ++j) {
-          if (overlapping(layout[i], layout[j])) pairs.emplace_back(i, j);
+          if (moved[i] || moved[j]) overlaps[i * n + j] = penetrating(layout[i], layout[j]);
+          if (overlaps[i * n + j]) pairs.emplace_back(i, j);
         }
       }
+      std::fill(moved.begin(), moved.end(), 0);
       if (pairs.empty()) return true;
       // Pairs that overlap now weigh more; old conflicts fade, so that they
       // do not pin parts that have since moved apart.
@@ -595,7 +612,9 @@ class Packer {
       std::shuffle(overlapped.begin(), overlapped.end(), random);
       for (size_t i : overlapped) {
         if (!goOn()) return false;
-        moveToLeastPenetration(layout, i, length, weights, random, ++moves % kGlobalEvery != 0);
+        const PlacedShape before = layout[i];
+        moveToLeastPenetration(layout, i, lanes, weights, random, ++moves % kGlobalEvery != 0);
+        moved[i] = layout[i].shape != before.shape || layout[i].at != before.at;
       }
     }
     return false;
@@ -610,7 +629,7 @@ class Packer {
   // the places clear of all others or of all but one.
   // `local`: only places that keep the part's box centre within the part's
   // own size of where it is.
-  void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, cInt length,
+  void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, const Lanes& lanes,
                               const std::vector<double>& weights, std::mt19937& random, bool local) {
     const size_t n = layout.size();
     const int part = layout[i].part;
@@ -622,7 +641,6 @@ class Packer {
     const cInt reach = std::max(current.maxX - current.minX, current.maxY - current.minY);
     // The lanes (beds) to look in: where the part is, and for a move that
     // may go anywhere, one other chosen at random.
-    const auto lanes = lanesUpTo(length);
     const size_t here = static_cast<size_t>(sheetOf(layout[i].at.X + current.maxX));
     std::vector<size_t> looked{std::min(here, lanes.size() - 1)};
     if (!local && lanes.size() > 1) looked.push_back(random() % lanes.size());
@@ -718,9 +736,9 @@ class Packer {
     if (winding <= 0) return 0;
     double nearest = std::numeric_limits<double>::max();
     for (const Path& path : region) {
-      nearest = std::min(nearest, distanceToBoundary(path, static_cast<double>(p.X), static_cast<double>(p.Y)));
+      nearest = std::min(nearest, squaredDistanceToBoundary(path, static_cast<double>(p.X), static_cast<double>(p.Y)));
     }
-    return nearest;
+    return std::sqrt(nearest);
   }
 
   Point2 extentOf(size_t part) const {
@@ -998,6 +1016,24 @@ class Packer {
       if (perimeter > 0 && 2 * std::abs(ClipperLib::Area(piece)) / perimeter > kRoundingDepth) return true;
     }
     return false;
+  }
+
+  // For the compaction: whether `a` lies deeper in `b` than rounding, by
+  // the measure its moves minimise (penetration() of its reference point in
+  // their no-fit polygon: how far it must move to clear `b`). As exact as
+  // overlapping() below and, with the no-fit polygons kept, much cheaper than
+  // intersecting the shapes.
+  bool penetrating(const PlacedShape& a, const PlacedShape& b) {
+    const Shape& moving = shapes_[a.part][a.shape];
+    const Shape& fixed = shapes_[b.part][b.shape];
+    if (a.at.X + moving.grownMaxX <= b.at.X + fixed.grownMinX ||
+        b.at.X + fixed.grownMaxX <= a.at.X + moving.grownMinX ||
+        a.at.Y + moving.grownMaxY <= b.at.Y + fixed.grownMinY ||
+        b.at.Y + fixed.grownMaxY <= a.at.Y + moving.grownMinY) {
+      return false;
+    }
+    const Paths& region = wholeNoFitPolygon(a.part, a.shape, b.part, b.shape);
+    return penetration(region, {a.at.X - b.at.X, a.at.Y - b.at.Y}) > kRoundingDepth;
   }
 
   static Paths translatedPathsOf(const Paths& paths, IntPoint by) {
