@@ -311,6 +311,22 @@ class Packer {
         classOf_.back().push_back(it->second);
       }
     }
+    for (const auto& shapes : shapes_) {
+      quarterOf_.emplace_back();
+      shapeAtQuarter_.push_back({-1, -1, -1, -1});
+      for (size_t k = 0; k < shapes.size(); ++k) {
+        const double quarters = shapes[k].rotation / 90.0;
+        int quarter = -1;
+        if (std::abs(quarters - std::round(quarters)) < 1e-12) {
+          quarter = static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
+          if (shapeAtQuarter_.back()[quarter] < 0) shapeAtQuarter_.back()[quarter] = static_cast<int>(k);
+        }
+        quarterOf_.back().push_back(quarter);
+      }
+      const auto& at = shapeAtQuarter_.back();
+      firstQuarter_.push_back(
+          static_cast<int>(std::find_if(at.begin(), at.end(), [](int k) { return k >= 0; }) - at.begin()));
+    }
     width_ = options.strip ? stripBound() : toInt(options.width);
     height_ = toInt(options.height);
     if (!options.strip) pitch_ = width_ + toInt(options.spacing) + toInt(1.0);
@@ -671,7 +687,7 @@ class Packer {
                         q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
           if (!inArea(box)) continue;
           // The same pairs meet again and again: their whole no-fit polygons are kept.
-          Paths region = translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at);
+          Paths region = placedRegion(noFitPolygonOf(part, k, q.part, q.shape), q.at);
           if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
         }
         std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
@@ -797,6 +813,49 @@ class Packer {
       it = wholes_.emplace(key, unionOf({std::move(whole)})).first;
     }
     return it->second;
+  }
+
+  // Turning two shapes together turns their no-fit polygon: one is kept for
+  // the four quarter turns of a pair (a quarter of the work and memory: most
+  // panels are unique and allowed 0/90/180/270). `paths` is the no-fit
+  // polygon of the moving shape turned back by `turns` quarter turns against
+  // the placed part in its first quarter-turn rotation; turned by `turns`,
+  // it is the one asked for. Shapes built from turned outlines may differ
+  // from turned shapes by a grid unit, which kRoundingDepth and the exact
+  // checks absorb.
+  struct TurnedRegion {
+    const Paths* paths;
+    int turns;
+  };
+  TurnedRegion noFitPolygonOf(int movingPart, int movingShape, int placedPart, int placedShape) {
+    const int movingQuarter = quarterOf_[movingPart][movingShape], placedQuarter = quarterOf_[placedPart][placedShape];
+    if (movingQuarter >= 0 && placedQuarter >= 0) {
+      const int first = firstQuarter_[placedPart];
+      const int turns = (placedQuarter - first + 4) % 4;
+      const int moving = shapeAtQuarter_[movingPart][(movingQuarter - turns + 4) % 4];
+      if (moving >= 0) {
+        return {&wholeNoFitPolygon(movingPart, moving, placedPart, shapeAtQuarter_[placedPart][first]), turns};
+      }
+    }
+    return {&wholeNoFitPolygon(movingPart, movingShape, placedPart, placedShape), 0};
+  }
+  static IntPoint turned(IntPoint p, int turns) {
+    for (int t = 0; t < turns % 4; ++t) p = {-p.Y, p.X};
+    return p;
+  }
+  // The no-fit polygon for a placed part at `at`.
+  static Paths placedRegion(const TurnedRegion& region, IntPoint at) {
+    Paths out;
+    out.reserve(region.paths->size());
+    for (const Path& path : *region.paths) {
+      Path& placed = out.emplace_back();
+      placed.reserve(path.size());
+      for (const IntPoint& p : path) {
+        const IntPoint q = turned(p, region.turns);
+        placed.push_back({q.X + at.X, q.Y + at.Y});
+      }
+    }
+    return out;
   }
 
   void put(Sheet& sheet, const PlacedShape& spot) {
@@ -940,7 +999,7 @@ class Packer {
         // union of everything.
         if (classSize_[classOf_[part][k]] > 1 && classSize_[classOf_[q.part][q.shape]] > 1) {
           // Both shapes have copies: this no-fit polygon will be met again.
-          noFitPolygons.push_back(translatedPathsOf(sharedNoFitPolygon(part, k, q.part, q.shape), q.at));
+          noFitPolygons.push_back(placedRegion(noFitPolygonOf(part, k, q.part, q.shape), q.at));
           continue;
         }
         std::vector<Paths> sums;  // one per piece of the placed shape
@@ -960,7 +1019,7 @@ class Packer {
         if (!sums.empty()) noFitPolygons.push_back(unionOf(std::move(sums)));
         continue;
       }
-      noFitPolygons.push_back(translatedPathsOf(wholeNoFitPolygon(part, k, q.part, q.shape), q.at));
+      noFitPolygons.push_back(placedRegion(noFitPolygonOf(part, k, q.part, q.shape), q.at));
     }
     return unionOf(std::move(noFitPolygons));
   }
@@ -1032,15 +1091,8 @@ class Packer {
         b.at.Y + fixed.grownMaxY <= a.at.Y + moving.grownMinY) {
       return false;
     }
-    const Paths& region = wholeNoFitPolygon(a.part, a.shape, b.part, b.shape);
-    return penetration(region, {a.at.X - b.at.X, a.at.Y - b.at.Y}) > kRoundingDepth;
-  }
-
-  static Paths translatedPathsOf(const Paths& paths, IntPoint by) {
-    Paths out;
-    out.reserve(paths.size());
-    for (const Path& path : paths) out.push_back(translatedPath(path, by));
-    return out;
+    const TurnedRegion region = noFitPolygonOf(a.part, a.shape, b.part, b.shape);
+    return penetration(*region.paths, turned({a.at.X - b.at.X, a.at.Y - b.at.Y}, 4 - region.turns)) > kRoundingDepth;
   }
 
   const std::vector<NestingPart>& parts_;
@@ -1050,6 +1102,11 @@ class Packer {
   // Shapes that are exact copies share a class (one per part and rotation).
   std::vector<std::vector<int>> classOf_;
   std::vector<int> classSize_;
+  // Each shape's rotation in quarter turns (0-3; -1 when it is not one), and
+  // per part the shape at each quarter turn (-1: not allowed) and its first.
+  std::vector<std::vector<int>> quarterOf_;
+  std::vector<std::array<int, 4>> shapeAtQuarter_;
+  std::vector<int> firstQuarter_;
   std::map<std::pair<int, int>, Paths> shared_;  // (moving class, placed class) -> no-fit polygon
   size_t sharedPoints_ = 0;
   std::map<std::tuple<int, int, int, int>, Paths> wholes_;  // no-fit polygons without convex pieces
