@@ -329,7 +329,9 @@ class Packer {
     }
     width_ = options.strip ? stripBound() : toInt(options.width);
     height_ = toInt(options.height);
-    if (!options.strip) pitch_ = width_ + toInt(options.spacing) + toInt(1.0);
+    // Wider than what two grown shapes overhang their beds (spacing / 2 and
+    // the simplification each, with mitres), in any unit.
+    if (!options.strip) pitch_ = width_ + 2 * toInt(options.spacing) + toInt(1.0);
     for (size_t i = 0; i < parts.size(); ++i) {
       const bool fits = std::any_of(shapes_[i].begin(), shapes_[i].end(), [&](const Shape& s) {
         return s.maxX - s.minX <= width_ && s.maxY - s.minY <= height_;
@@ -487,7 +489,7 @@ class Packer {
         best = std::move(trial);
         bestLength = lengthOf(best);
         failures = 0;
-        shorter(sheetOf(bestLength) + 1, (bestLength - laneStartOf(bestLength)) / kScale);
+        shorter(bedsUsed(best), (bestLength - laneStartOf(bestLength)) / kScale);
       } else if (++failures == kTriesPerShrink) {
         shrink /= 2;
         failures = 0;
@@ -496,18 +498,29 @@ class Packer {
     acceptedLayout_ = best;
     // Back from the row of beds to each bed's own coordinates, in cutting
     // order: bed by bed, each in the order of the layout.
+    // A bed in the middle that the moves emptied is left out.
     std::vector<std::pair<int, PlacedShape>> placed;
-    int sheets = 1;
     for (PlacedShape s : best) {
-      const int sheet = sheetOf(s.at.X + shapes_[s.part][s.shape].maxX);
+      const int sheet = sheetOf(rightOf(s));
       s.at.X -= sheet * pitch_;
       placed.emplace_back(sheet, s);
-      sheets = std::max(sheets, sheet + 1);
     }
     std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    return resultOf(placed, sheets);
+    int sheets = 0;
+    for (size_t i = 0; i < placed.size(); ++i) {
+      const bool newBed = i == 0 || placed[i].first != placed[i - 1].first;
+      if (newBed) ++sheets;
+      placed[i].first = sheets - 1;
+    }
+    return resultOf(placed, std::max(sheets, 1));
   }
 
+  int bedsUsed(const std::vector<PlacedShape>& layout) const {
+    std::vector<int> beds;
+    for (const PlacedShape& s : layout) beds.push_back(sheetOf(rightOf(s)));
+    std::sort(beds.begin(), beds.end());
+    return static_cast<int>(std::unique(beds.begin(), beds.end()) - beds.begin());
+  }
   cInt rightOf(const PlacedShape& s) const { return s.at.X + shapes_[s.part][s.shape].maxX; }
   cInt lengthOf(const std::vector<PlacedShape>& layout) const {
     cInt length = 0;
@@ -820,9 +833,11 @@ class Packer {
   // panels are unique and allowed 0/90/180/270). `paths` is the no-fit
   // polygon of the moving shape turned back by `turns` quarter turns against
   // the placed part in its first quarter-turn rotation; turned by `turns`,
-  // it is the one asked for. Shapes built from turned outlines may differ
-  // from turned shapes by a grid unit, which kRoundingDepth and the exact
-  // checks absorb.
+  // it is the one asked for. Turned outlines are exact on the grid, but the
+  // grown shapes built from them may differ from turned grown shapes by up
+  // to kSimplifyTolerance (where CleanPolygon starts); both still hold the
+  // outline grown by half the spacing, so the final exact checks hold, and
+  // a pair may only look a little more or less apart than it is.
   struct TurnedRegion {
     const Paths* paths;
     int turns;
