@@ -36,7 +36,7 @@ constexpr double kScale = 1e4;
 // Outlines are simplified for nesting after being grown by this much, so the
 // simplified shape still contains the true one.
 constexpr double kSimplifyTolerance = 0.002;
-// Grid units (see Packer::overlapping).
+// Grid units (see Packer::penetrating).
 constexpr double kRoundingDepth = 1.5;
 
 cInt toInt(double value) { return static_cast<cInt>(std::llround(value * kScale)); }
@@ -90,16 +90,6 @@ struct Shape {
   cInt minX = 0, minY = 0, maxX = 0, maxY = 0;
   double rotation = 0;
 };
-
-double perimeterOf(const Path& path) {
-  double length = 0;
-  for (size_t i = 0; i < path.size(); ++i) {
-    const IntPoint& a = path[i];
-    const IntPoint& b = path[(i + 1) % path.size()];
-    length += std::hypot(static_cast<double>(b.X - a.X), static_cast<double>(b.Y - a.Y));
-  }
-  return length;
-}
 
 Box boxOf(const Path& path) {
   Box box{std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::min(),
@@ -1080,23 +1070,12 @@ class Packer {
   static bool overlapping(double area, const Shape& shape) {
     return area > 4.0 * static_cast<double>(shape.grown.size());
   }
-  // For the compaction: whether two placed shapes overlap more than a sliver
-  // of rounding (no-fit polygon vertices rounded to the grid reach up to a
-  // unit into a neighbour): some piece of their intersection is thicker
-  // (twice its area over its perimeter) than kRoundingDepth.
-  bool overlapping(const PlacedShape& a, const PlacedShape& b) const {
-    for (const Path& piece : common(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at)) {
-      const double perimeter = perimeterOf(piece);
-      if (perimeter > 0 && 2 * std::abs(ClipperLib::Area(piece)) / perimeter > kRoundingDepth) return true;
-    }
-    return false;
-  }
-
-  // For the compaction: whether `a` lies deeper in `b` than rounding, by
-  // the measure its moves minimise (penetration() of its reference point in
-  // their no-fit polygon: how far it must move to clear `b`). As exact as
-  // overlapping() below and, with the no-fit polygons kept, much cheaper than
-  // intersecting the shapes.
+  // For the compaction: whether `a` lies deeper in `b` than a sliver of
+  // rounding (no-fit polygon vertices rounded to the grid reach up to a unit
+  // into a neighbour), by the measure its moves minimise: penetration() of
+  // its reference point in their no-fit polygon, how far it must move to
+  // clear `b`. With the no-fit polygons kept, much cheaper than intersecting
+  // the shapes (the final layout is still checked exactly).
   bool penetrating(const PlacedShape& a, const PlacedShape& b) {
     const Shape& moving = shapes_[a.part][a.shape];
     const Shape& fixed = shapes_[b.part][b.shape];
