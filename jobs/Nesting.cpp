@@ -655,8 +655,7 @@ class Packer {
     PlacedShape best = layout[i];
     double bestScore = std::numeric_limits<double>::max();
     const Shape& current = shapes_[part][layout[i].shape];
-    const cInt centreX = layout[i].at.X + (current.minX + current.maxX) / 2;
-    const cInt centreY = layout[i].at.Y + (current.minY + current.maxY) / 2;
+    const IntPoint centre = centreOf(layout[i]);
     const cInt reach = std::max(current.maxX - current.minX, current.maxY - current.minY);
     // The lanes (beds) to look in: where the part is, and for a move that
     // may go anywhere, one other chosen at random.
@@ -670,7 +669,7 @@ class Packer {
         cInt x0 = lanes[lane].first - moving.minX, x1 = lanes[lane].second - moving.maxX, y0 = -moving.minY,
              y1 = height_ - moving.maxY;
         if (local) {
-          const cInt atX = centreX - (moving.minX + moving.maxX) / 2, atY = centreY - (moving.minY + moving.maxY) / 2;
+          const cInt atX = centre.X - (moving.minX + moving.maxX) / 2, atY = centre.Y - (moving.minY + moving.maxY) / 2;
           x0 = std::max(x0, atX - reach), x1 = std::min(x1, atX + reach);
           y0 = std::max(y0, atY - reach), y1 = std::min(y1, atY + reach);
         }
@@ -1048,12 +1047,15 @@ class Packer {
     return true;
   }
 
+  // Whether the boxes of two placed grown shapes are apart (touching counts as apart).
+  static bool boxesApart(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) {
+    return atA.X + a.grownMaxX <= atB.X + b.grownMinX || atB.X + b.grownMaxX <= atA.X + a.grownMinX ||
+           atA.Y + a.grownMaxY <= atB.Y + b.grownMinY || atB.Y + b.grownMaxY <= atA.Y + a.grownMinY;
+  }
+
   // What two placed grown shapes have in common (nothing when their boxes are apart).
   Paths common(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) const {
-    if (atA.X + a.grownMaxX <= atB.X + b.grownMinX || atB.X + b.grownMaxX <= atA.X + a.grownMinX ||
-        atA.Y + a.grownMaxY <= atB.Y + b.grownMinY || atB.Y + b.grownMaxY <= atA.Y + a.grownMinY) {
-      return {};
-    }
+    if (boxesApart(a, atA, b, atB)) return {};
     ClipperLib::Clipper clipper;
     clipper.AddPath(translatedPath(a.grown, atA), ClipperLib::ptSubject, true);
     clipper.AddPath(translatedPath(b.grown, atB), ClipperLib::ptClip, true);
@@ -1077,14 +1079,7 @@ class Packer {
   // clear `b`. With the no-fit polygons kept, much cheaper than intersecting
   // the shapes (the final layout is still checked exactly).
   bool penetrating(const PlacedShape& a, const PlacedShape& b) {
-    const Shape& moving = shapes_[a.part][a.shape];
-    const Shape& fixed = shapes_[b.part][b.shape];
-    if (a.at.X + moving.grownMaxX <= b.at.X + fixed.grownMinX ||
-        b.at.X + fixed.grownMaxX <= a.at.X + moving.grownMinX ||
-        a.at.Y + moving.grownMaxY <= b.at.Y + fixed.grownMinY ||
-        b.at.Y + fixed.grownMaxY <= a.at.Y + moving.grownMinY) {
-      return false;
-    }
+    if (boxesApart(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at)) return false;
     const TurnedRegion region = noFitPolygonOf(a.part, a.shape, b.part, b.shape);
     return penetration(*region.paths, turned({a.at.X - b.at.X, a.at.Y - b.at.Y}, 4 - region.turns)) > kRoundingDepth;
   }

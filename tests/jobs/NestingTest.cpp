@@ -127,6 +127,20 @@ TEST(Nesting, StripModeKeepsTheHeightAndPacksTheLength) {
   EXPECT_GT(result.stripLength, area / options.height) << "no denser than solid";
 }
 
+// One search with a cap on layouts (the same run on any machine), 1/16 in
+// spacing; the layout is checked exactly and its progress lines are kept.
+NestingResult cappedRun(const std::vector<NestingPart>& parts, NestingOptions options, int evaluations,
+                        std::vector<std::string>& lines) {
+  options.spacing = 0.0625;
+  options.seconds = 600;
+  options.evaluations = evaluations;
+  options.threads = 1;
+  options.progress = [&](const std::string& line) { lines.push_back(line); };
+  NestingResult result = nest(parts, options);
+  expectValid(parts, result, options);
+  return result;
+}
+
 TEST(Nesting, StripCompactionShortensTheStripAndKeepsTheSpacing) {
   // After the sequence search, the compaction shortens the strip by letting
   // parts overlap and moving them apart again; it reports each shorter strip
@@ -137,14 +151,8 @@ TEST(Nesting, StripCompactionShortensTheStripAndKeepsTheSpacing) {
   NestingOptions options;
   options.strip = true;
   options.height = 10;
-  options.spacing = 0.0625;
-  options.seconds = 600;
-  options.evaluations = 1000;
-  options.threads = 1;
   std::vector<std::string> lines;
-  options.progress = [&](const std::string& line) { lines.push_back(line); };
-  const NestingResult result = nest(parts, options);
-  expectValid(parts, result, options);
+  const NestingResult result = cappedRun(parts, options, 1000, lines);
   // "compacting: strip 12.34 long": the shortest strip reported is the one kept.
   double shortest = std::numeric_limits<double>::max();
   for (const std::string& line : lines) {
@@ -163,14 +171,8 @@ TEST(Nesting, BedCompactionShortensTheLastSheet) {
   NestingOptions options;
   options.width = 16;
   options.height = 10;
-  options.spacing = 0.0625;
-  options.seconds = 600;
-  options.evaluations = 200;
-  options.threads = 1;
   std::vector<std::string> lines;
-  options.progress = [&](const std::string& line) { lines.push_back(line); };
-  const NestingResult result = nest(parts, options);
-  expectValid(parts, result, options);
+  const NestingResult result = cappedRun(parts, options, 200, lines);
   // "compacting: 3 sheets, last sheet 3.10 in long" (or "1 sheet, ..."):
   // progress lines only report layouts better than the first.
   std::optional<std::pair<int, double>> best;
