@@ -36,8 +36,21 @@ constexpr double kScale = 1e4;
 // Outlines are simplified for nesting after being grown by this much, so the
 // simplified shape still contains the true one.
 constexpr double kSimplifyTolerance = 0.002;
-// Grid units (see Packer::penetrating).
-constexpr double kRoundingDepth = 1.5;
+// Poles per shape for the compaction's overlap proxy.
+constexpr size_t kMostPoles = 12;
+// Grid units that two grown shapes may overlap by in the compaction (see
+// Shape::core): far below layoutProblems' tolerance of 1e-3 in.
+constexpr ClipperLib::cInt kCollisionSlack = 3;
+// The compaction's sampled moves: places drawn per rotation near the part and
+// anywhere, and the share of the smaller largest pole within which poles
+// apart still count (see Packer::proxy).
+constexpr int kNearSamples = 25, kFarSamples = 50;
+constexpr size_t kDescents = 3;
+constexpr int kStaleRounds = 50, kStrikes = 3;
+constexpr double kWeightFade = 0.95;
+constexpr double kDistinctShare = 0.05;
+constexpr double kDecayShare = 0.01;
+constexpr double kNoLimit = std::numeric_limits<double>::max();
 
 cInt toInt(double value) { return static_cast<cInt>(std::llround(value * kScale)); }
 
@@ -86,6 +99,22 @@ struct Shape {
   // when the shape is too thin to hold one of the radius step.
   std::vector<IntPoint> centres;
   cInt radius = 0;
+  // Poles, as sparrow calls them: discs inside `grown`, the largest first,
+  // each the largest in what the earlier ones leave uncovered. The
+  // compaction's overlap proxy (Packer::proxy) weighs how deep two shapes'
+  // poles reach into each other.
+  struct Pole {
+    IntPoint centre;
+    double radius;
+  };
+  std::vector<Pole> poles;
+  double diameter = 0;  // of `grown`'s box
+  double size = 0;      // the square root of `grown`'s area
+  // `grown` shrunk by kCollisionSlack: the compaction's collision test finds
+  // where one shape's grown outline enters another's core, so that shapes
+  // placed touching, with no-fit polygon vertices rounded to the grid, are
+  // not taken for colliding.
+  Path core;
   cInt grownMinX = 0, grownMinY = 0, grownMaxX = 0, grownMaxY = 0;
   cInt minX = 0, minY = 0, maxX = 0, maxY = 0;
   double rotation = 0;
@@ -101,10 +130,8 @@ Box boxOf(const Path& path) {
   return box;
 }
 
-// The square of the distance from (x, y) to the polygon's boundary (squares:
-// the compaction asks this for every candidate place, and a square root per
-// edge took a fifth of its time).
-double squaredDistanceToBoundary(const Path& polygon, double x, double y) {
+// The distance from (x, y) to the polygon's boundary.
+double distanceToBoundary(const Path& polygon, double x, double y) {
   double best = std::numeric_limits<double>::max();
   for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
     const IntPoint& a = polygon[j];
@@ -116,11 +143,7 @@ double squaredDistanceToBoundary(const Path& polygon, double x, double y) {
     const double ex = x - (a.X + t * dx), ey = y - (a.Y + t * dy);
     best = std::min(best, ex * ex + ey * ey);
   }
-  return best;
-}
-
-double distanceToBoundary(const Path& polygon, double x, double y) {
-  return std::sqrt(squaredDistanceToBoundary(polygon, x, y));
+  return std::sqrt(best);
 }
 
 // The sizes of the sheet's `room` machinery, in proportion to the area's
@@ -188,6 +211,52 @@ std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radi
   return {radius, centres};
 }
 
+// The poles of a polygon (see Shape::poles): on a grid of points inside
+// it, greedily the one with the largest disc clear of the boundary and of
+// the discs so far, while that is at least a tenth of the first's radius.
+std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most) {
+  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
+  struct Inside {
+    IntPoint p;
+    double room;  // the largest disc here clear of the boundary and the poles so far
+  };
+  std::vector<Inside> inside;
+  constexpr int kSteps = 32;
+  for (int i = 0; i <= kSteps; ++i) {
+    for (int j = 0; j <= kSteps; ++j) {
+      const IntPoint p{minX + (maxX - minX) * i / kSteps, minY + (maxY - minY) * j / kSteps};
+      if (ClipperLib::PointInPolygon(p, polygon) != 1) continue;
+      inside.push_back({p, distanceToBoundary(polygon, static_cast<double>(p.X), static_cast<double>(p.Y))});
+    }
+  }
+  std::vector<Shape::Pole> poles;
+  while (poles.size() < most && !inside.empty()) {
+    const auto best = std::max_element(inside.begin(), inside.end(),
+                                       [](const Inside& a, const Inside& b) { return a.room < b.room; });
+    if (best->room < 1 || (!poles.empty() && best->room < 0.1 * poles.front().radius)) break;
+    const Shape::Pole pole{best->p, best->room};
+    poles.push_back(pole);
+    for (Inside& point : inside) {
+      const double apart =
+          std::hypot(static_cast<double>(point.p.X - pole.centre.X), static_cast<double>(point.p.Y - pole.centre.Y)) -
+          pole.radius;
+      point.room = std::min(point.room, apart);
+    }
+  }
+  // Too thin for the grid: one small pole at a point inside, so that
+  // containment is still found.
+  if (poles.empty()) {
+    for (size_t i = 0; i < polygon.size() && poles.empty(); ++i) {
+      const IntPoint& a = polygon[i];
+      const IntPoint& b = polygon[(i + 1) % polygon.size()];
+      const IntPoint& c = polygon[(i + 2) % polygon.size()];
+      const IntPoint mid{(a.X + b.X + c.X) / 3, (a.Y + b.Y + c.Y) / 3};
+      if (ClipperLib::PointInPolygon(mid, polygon) == 1) poles.push_back({mid, 1.0});
+    }
+  }
+  return poles;
+}
+
 Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep) {
   Shape shape;
   shape.rotation = rotation;
@@ -200,6 +269,20 @@ Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt r
   for (const IntPoint& p : shape.grown) shape.negated.push_back({-p.X, -p.Y});
   std::tie(shape.grownMinX, shape.grownMinY, shape.grownMaxX, shape.grownMaxY) = std::tuple_cat(boxOf(shape.grown));
   std::tie(shape.radius, shape.centres) = clearDiscs(shape.grown, radiusStep);
+  shape.poles = polesOf(shape.grown, kMostPoles);
+  shape.diameter = std::hypot(static_cast<double>(shape.grownMaxX - shape.grownMinX),
+                              static_cast<double>(shape.grownMaxY - shape.grownMinY));
+  shape.size = std::sqrt(std::abs(ClipperLib::Area(shape.grown)));
+  ClipperLib::ClipperOffset shrink(2.0);
+  shrink.AddPath(shape.grown, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  Paths cores;
+  shrink.Execute(cores, -static_cast<double>(kCollisionSlack));
+  shape.core = shape.grown;
+  double largest = 0;
+  for (Path& core : cores) {
+    if (std::abs(ClipperLib::Area(core)) > largest) largest = std::abs(ClipperLib::Area(core)), shape.core = core;
+  }
+  if (ClipperLib::Area(shape.core) < 0) std::reverse(shape.core.begin(), shape.core.end());
   if (auto pieces = convexPieces(shape.grown)) {
     shape.pieces = std::move(*pieces);
     for (const Path& piece : shape.pieces) {
@@ -265,16 +348,10 @@ struct Sheet {
 // region), and the grid rounds by a unit.
 constexpr cInt kRoomSlack = 4;
 
-// Strip compaction: the first shortening (2%), the least (0.1%), rounds of
-// moves per try, tries per shortening before it is halved, and the most
-// candidate places weighed per move and rotation. One move in kGlobalEvery
-// may take a part anywhere, the others keep it near where it is. The
-// candidates include the corners of the places clear of all others but one,
-// for the kMostSkipped heaviest. Chosen on jakobs2, shapes0, shapes1 and swim,
-// two seeds each, 60 s (docs/PERFORMANCE.md).
+// Strip compaction: the first shortening (2%), the least (0.1%), and tries
+// per shortening before it is halved (docs/PERFORMANCE.md).
 constexpr double kFirstShrink = 0.02, kLeastShrink = 0.001;
-constexpr int kRounds = 150, kTriesPerShrink = 5, kGlobalEvery = 4;
-constexpr size_t kMostCandidates = 3000, kMostSkipped = 1;
+constexpr int kTriesPerShrink = 5;
 // The kept no-fit polygons are dropped when they hold this many points (16 bytes each).
 constexpr size_t kMostSharedPoints = 8'000'000;
 
@@ -446,7 +523,7 @@ class Packer {
             const IntPoint ca = centreOf(trial[a]), cb = centreOf(trial[b]);
             const auto lanes = lanesUpTo(bestLength);
             if (moveInto(trial[a], cb, lanes) && moveInto(trial[b], ca, lanes) &&
-                separate(trial, lanes, kRounds, random, goOn, moves)) {
+                separate(trial, lanes, random, goOn, moves)) {
               best = std::move(trial);
               bestLength = lengthOf(best);
             }
@@ -475,7 +552,7 @@ class Packer {
         fits = fits && moveInto(s, centreOf(s), lanes);
       }
       if (!fits) break;  // a part is as long as the strip
-      if (separate(trial, lanes, kRounds, random, goOn, moves)) {
+      if (separate(trial, lanes, random, goOn, moves)) {
         best = std::move(trial);
         bestLength = lengthOf(best);
         failures = 0;
@@ -596,13 +673,17 @@ class Packer {
     return result;
   }
 
-  // Moves the parts of `layout` (inside `length` x the height) apart by
-  // guided local search: overlapping parts move one at a time to where they
-  // overlap least, the pairs that keep overlapping weighing more at every
-  // round, until nothing overlaps (true) or the rounds or the budget run out
-  // (false). Moves stay near the part (within its own size) except one in
-  // kGlobalEvery, which may go anywhere.
-  bool separate(std::vector<PlacedShape>& layout, const Lanes& lanes, int rounds, std::mt19937& random,
+  // Moves the parts of `layout` (on the lanes) apart by guided local search,
+  // as sparrow's separator does: every round, each overlapping part moves
+  // to where its weighted overlap is least (sampledMove), and the pairs
+  // still overlapping weigh more, the deeper the more (x1.2 to x2), while
+  // the others fade back towards 1. The layout of least overlap so far is
+  // kept; after kStaleRounds rounds without beating it by 2%, the moves
+  // start again from it (a strike, the weights kept), and after kStrikes
+  // strikes in a row that did not improve on it the separation fails
+  // (false), as it does when the budget runs out. True when nothing
+  // overlaps, checked exactly (apart()).
+  bool separate(std::vector<PlacedShape>& layout, const Lanes& lanes, std::mt19937& random,
                 const std::function<bool()>& goOn, int& moves) {
     const size_t n = layout.size();
     std::vector<double> weights(n * n, 1.0);
@@ -610,20 +691,44 @@ class Packer {
     // of a part that moved are checked again (checking all pairs took a
     // third of the compaction's time).
     std::vector<char> overlaps(n * n, 0), moved(n, 1);
-    for (int round = 0; round < rounds && goOn(); ++round) {
+    double leastLoss = kNoLimit, strikeLoss = kNoLimit;
+    std::vector<PlacedShape> leastLayout;
+    int stale = 0, strikes = 0;
+    while (goOn()) {
       std::vector<std::pair<size_t, size_t>> pairs;
       for (size_t i = 0; i < n; ++i) {
         for (size_t j = i + 1; j < n; ++j) {
-          if (moved[i] || moved[j]) overlaps[i * n + j] = penetrating(layout[i], layout[j]);
+          if (moved[i] || moved[j]) overlaps[i * n + j] = colliding(layout[i], layout[j]);
           if (overlaps[i * n + j]) pairs.emplace_back(i, j);
         }
       }
       std::fill(moved.begin(), moved.end(), 0);
-      if (pairs.empty()) return true;
-      // Pairs that overlap now weigh more; old conflicts fade, so that they
-      // do not pin parts that have since moved apart.
-      for (double& w : weights) w = std::max(1.0, w * 0.95);
-      for (const auto& [i, j] : pairs) weights[i * n + j] *= 1.4, weights[j * n + i] *= 1.4;
+      if (pairs.empty()) return apart(layout);
+      std::vector<double> depth;
+      for (const auto& [i, j] : pairs) {
+        const Shape& a = shapes_[layout[i].part][layout[i].shape];
+        const Shape& b = shapes_[layout[j].part][layout[j].shape];
+        depth.push_back(proxy(a, layout[i].at, b, layout[j].at));
+      }
+      const double loss = std::accumulate(depth.begin(), depth.end(), 0.0);
+      if (loss < leastLoss) {
+        if (loss < 0.98 * leastLoss) stale = 0;
+        leastLoss = loss, leastLayout = layout;
+      } else if (++stale == kStaleRounds) {
+        strikes = strikeLoss * 0.98 <= leastLoss ? strikes + 1 : 0;
+        if (strikes == kStrikes) return false;
+        strikeLoss = leastLoss, stale = 0;
+        layout = leastLayout;
+        std::fill(moved.begin(), moved.end(), 1);
+        continue;
+      }
+      for (double& w : weights) w = std::max(1.0, w * kWeightFade);
+      const double deepest = *std::max_element(depth.begin(), depth.end());
+      for (size_t p = 0; p < pairs.size(); ++p) {
+        const auto [i, j] = pairs[p];
+        const double grow = 1.2 + 0.8 * depth[p] / deepest;
+        weights[i * n + j] = weights[j * n + i] = weights[i * n + j] / kWeightFade * grow;
+      }
       std::vector<size_t> overlapped;
       for (const auto& [i, j] : pairs) overlapped.push_back(i), overlapped.push_back(j);
       std::sort(overlapped.begin(), overlapped.end());
@@ -632,131 +737,217 @@ class Packer {
       for (size_t i : overlapped) {
         if (!goOn()) return false;
         const PlacedShape before = layout[i];
-        moveToLeastPenetration(layout, i, lanes, weights, random, ++moves % kGlobalEvery != 0);
+        sampledMove(layout, i, lanes, weights, random);
+        ++moves;
         moved[i] = layout[i].shape != before.shape || layout[i].at != before.at;
       }
     }
     return false;
   }
 
-  // Moves layout[i] to the place and rotation, inside a strip of `length`,
-  // where its weighted penetration into the others is least. Penetration
-  // into part j at reference point p: 0 outside their no-fit polygon, else
-  // the distance from p to its boundary. Candidates: the inner-fit
-  // rectangle's corners, where the part is, the vertices of the no-fit
-  // polygons (where it touches one without entering it), and the corners of
-  // the places clear of all others or of all but one.
-  // `local`: only places that keep the part's box centre within the part's
-  // own size of where it is.
-  void moveToLeastPenetration(std::vector<PlacedShape>& layout, size_t i, const Lanes& lanes,
-                              const std::vector<double>& weights, std::mt19937& random, bool local) {
+  // Whether two placed grown shapes overlap, touching apart: an edge of
+  // one properly crosses an edge of the other, or a pole's centre (inside
+  // its shape) is inside the other. Misses overlaps whose every crossing is
+  // at a vertex; apart() has the last word.
+  bool colliding(const PlacedShape& a, const PlacedShape& b) const {
+    const Shape& sa = shapes_[a.part][a.shape];
+    const Shape& sb = shapes_[b.part][b.shape];
+    return shapesColliding(sa, a.at, sb, b.at);
+  }
+  static bool shapesColliding(const Shape& sa, IntPoint atA, const Shape& sb, IntPoint atB) {
+    if (boxesApart(sa, atA, sb, atB)) return false;
+    // In b's frame.
+    const IntPoint shift{atA.X - atB.X, atA.Y - atB.Y};
+    const cInt bx0 = sb.grownMinX + kCollisionSlack, by0 = sb.grownMinY + kCollisionSlack,
+               bx1 = sb.grownMaxX - kCollisionSlack, by1 = sb.grownMaxY - kCollisionSlack;
+    const auto side = [](IntPoint o, IntPoint p, IntPoint q) {
+      const cInt cross = (p.X - o.X) * (q.Y - o.Y) - (p.Y - o.Y) * (q.X - o.X);
+      return (cross > 0) - (cross < 0);
+    };
+    const Path& pa = sa.grown;
+    const Path& pb = sb.core;
+    for (size_t i = 0; i < pa.size(); ++i) {
+      const IntPoint p{pa[i].X + shift.X, pa[i].Y + shift.Y};
+      const IntPoint q{pa[(i + 1) % pa.size()].X + shift.X, pa[(i + 1) % pa.size()].Y + shift.Y};
+      const cInt ex0 = std::min(p.X, q.X), ex1 = std::max(p.X, q.X), ey0 = std::min(p.Y, q.Y), ey1 = std::max(p.Y, q.Y);
+      if (ex1 <= bx0 || ex0 >= bx1 || ey1 <= by0 || ey0 >= by1) continue;
+      for (size_t j = 0; j < pb.size(); ++j) {
+        const IntPoint& r = pb[j];
+        const IntPoint& t = pb[(j + 1) % pb.size()];
+        if (std::max(r.X, t.X) <= ex0 || std::min(r.X, t.X) >= ex1 || std::max(r.Y, t.Y) <= ey0 ||
+            std::min(r.Y, t.Y) >= ey1) {
+          continue;
+        }
+        if (side(p, q, r) * side(p, q, t) < 0 && side(r, t, p) * side(r, t, q) < 0) return true;
+      }
+    }
+    const IntPoint poleA{sa.poles.front().centre.X + shift.X, sa.poles.front().centre.Y + shift.Y};
+    if (ClipperLib::PointInPolygon(poleA, sb.core) == 1) return true;
+    const IntPoint poleB{sb.poles.front().centre.X - shift.X, sb.poles.front().centre.Y - shift.Y};
+    return ClipperLib::PointInPolygon(poleB, pa) == 1;
+  }
+
+  // How much two colliding shapes overlap (sparrow's quantification): over
+  // every pair of poles, how deep they reach into each other times the
+  // smaller radius; pairs apart or barely in still count a little,
+  // decaying with the distance, so that a collision the poles do not reach
+  // still has a way out. The square root, scaled by the shapes' sizes,
+  // keeps shallow and deep collisions comparable.
+  static double proxy(const Shape& sa, IntPoint atA, const Shape& sb, IntPoint atB) {
+    const double epsilon = kDecayShare * std::max(sa.diameter, sb.diameter);
+    double sum = 0;
+    for (const Shape::Pole& a : sa.poles) {
+      const double ax = static_cast<double>(a.centre.X + atA.X), ay = static_cast<double>(a.centre.Y + atA.Y);
+      for (const Shape::Pole& b : sb.poles) {
+        const double dx = ax - static_cast<double>(b.centre.X + atB.X),
+                     dy = ay - static_cast<double>(b.centre.Y + atB.Y);
+        const double depth = a.radius + b.radius - std::sqrt(dx * dx + dy * dy);
+        const double weighed = depth >= epsilon ? depth : epsilon * epsilon / (2 * epsilon - depth);
+        sum += weighed * std::min(a.radius, b.radius);
+      }
+    }
+    return std::sqrt(sum + epsilon * epsilon) * std::sqrt(sa.size * sb.size);
+  }
+
+  // The weighted overlap of layout[i] as shape `k` at `at` with the others,
+  // given up (returning at least `enough`) once it reaches `enough`.
+  double weightedOverlap(const std::vector<PlacedShape>& layout, size_t i, int k, IntPoint at,
+                         const std::vector<double>& weights, double enough) const {
     const size_t n = layout.size();
+    const Shape& moving = shapes_[layout[i].part][k];
+    double total = 0;
+    for (size_t j = 0; j < n && total < enough; ++j) {
+      if (j == i) continue;
+      const Shape& other = shapes_[layout[j].part][layout[j].shape];
+      if (!shapesColliding(moving, at, other, layout[j].at)) continue;
+      total += weights[i * n + j] * proxy(moving, at, other, layout[j].at);
+    }
+    return total;
+  }
+
+  // A place and rotation for a sampled move, and its weighted overlap.
+  struct Sample {
+    int shape;
+    IntPoint at;
+    double score;
+  };
+
+  // The compaction's move by sampling, as sparrow does: places drawn at
+  // random near the part (within its own size) and anywhere on its bed or
+  // another, in random rotations; the few best (and apart) refined by
+  // coordinate descent, the best of them once more with finer steps. The
+  // weighted overlap proxy decides. Each place costs a few microseconds,
+  // no no-fit polygon: those of unique panels, built for each pair met,
+  // held the moves to about 50 a second among 200 of them (3000 now).
+  void sampledMove(std::vector<PlacedShape>& layout, size_t i, const Lanes& lanes, const std::vector<double>& weights,
+                   std::mt19937& random) {
     const int part = layout[i].part;
-    PlacedShape best = layout[i];
-    double bestScore = std::numeric_limits<double>::max();
     const Shape& current = shapes_[part][layout[i].shape];
     const IntPoint centre = centreOf(layout[i]);
-    const cInt reach = std::max(current.maxX - current.minX, current.maxY - current.minY);
-    // The lanes (beds) to look in: where the part is, and for a move that
-    // may go anywhere, one other chosen at random.
-    const size_t here = static_cast<size_t>(sheetOf(layout[i].at.X + current.maxX));
-    std::vector<size_t> looked{std::min(here, lanes.size() - 1)};
-    if (!local && lanes.size() > 1) looked.push_back(random() % lanes.size());
-    if (looked.size() == 2 && looked[0] == looked[1]) looked.pop_back();
-    for (int k = 0; k < static_cast<int>(shapes_[part].size()); ++k) {
-      for (size_t lane : looked) {
-        const Shape& moving = shapes_[part][k];
-        cInt x0 = lanes[lane].first - moving.minX, x1 = lanes[lane].second - moving.maxX, y0 = -moving.minY,
-             y1 = height_ - moving.maxY;
-        if (local) {
-          const cInt atX = centre.X - (moving.minX + moving.maxX) / 2, atY = centre.Y - (moving.minY + moving.maxY) / 2;
-          x0 = std::max(x0, atX - reach), x1 = std::min(x1, atX + reach);
-          y0 = std::max(y0, atY - reach), y1 = std::min(y1, atY + reach);
+    const cInt halfX = (current.maxX - current.minX) / 2, halfY = (current.maxY - current.minY) / 2;
+    const size_t here = std::min(static_cast<size_t>(sheetOf(layout[i].at.X + current.maxX)), lanes.size() - 1);
+    // Where shape k's reference point may be on `lane`: its inner-fit rectangle.
+    const auto fitOn = [&](int k, size_t lane) {
+      const Shape& s = shapes_[part][k];
+      return Box{lanes[lane].first - s.minX, -s.minY, lanes[lane].second - s.maxX, height_ - s.maxY};
+    };
+    const auto laneOf = [&](int k, IntPoint at) {
+      return std::min(static_cast<size_t>(sheetOf(at.X + shapes_[part][k].maxX)), lanes.size() - 1);
+    };
+    std::vector<Sample> best;  // the kDescents best, at least kDistinct apart, best first
+    const cInt minSize = std::max<cInt>(1, std::min(current.maxX - current.minX, current.maxY - current.minY));
+    const auto bound = [&] { return best.size() < kDescents ? kNoLimit : best.back().score; };
+    const auto report = [&](const Sample& sample) {
+      for (auto it = best.begin(); it != best.end(); ++it) {
+        if (std::abs(it->at.X - sample.at.X) + std::abs(it->at.Y - sample.at.Y) < minSize * kDistinctShare &&
+            it->shape == sample.shape) {
+          if (sample.score < it->score) *it = sample;
+          std::sort(best.begin(), best.end(), [](const Sample& a, const Sample& b) { return a.score < b.score; });
+          return;
         }
-        if (x1 < x0 || y1 < y0) continue;
-        const auto inArea = [&](const Box& b) { return b[0] <= x1 && b[2] >= x0 && b[1] <= y1 && b[3] >= y0; };
-        struct Obstacle {
-          size_t other;
-          Paths region;
-          Box box;
-        };
-        std::vector<Obstacle> obstaclesOf;
-        for (size_t j = 0; j < n; ++j) {
-          if (j == i) continue;
-          const PlacedShape& q = layout[j];
-          const Shape& fixed = shapes_[q.part][q.shape];
-          const Box box{q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,
-                        q.at.X + fixed.grownMaxX - moving.grownMinX, q.at.Y + fixed.grownMaxY - moving.grownMinY};
-          if (!inArea(box)) continue;
-          // The same pairs meet again and again: their whole no-fit polygons are kept.
-          Paths region = placedRegion(noFitPolygonOf(part, k, q.part, q.shape), q.at);
-          if (!region.empty()) obstaclesOf.push_back({j, std::move(region), box});
+      }
+      if (best.size() == kDescents && sample.score >= best.back().score) return;
+      if (best.size() == kDescents) best.pop_back();
+      best.insert(std::upper_bound(best.begin(), best.end(), sample,
+                                   [](const Sample& a, const Sample& b) { return a.score < b.score; }),
+                  sample);
+    };
+    const int rotations = static_cast<int>(shapes_[part].size());
+    report(
+        {layout[i].shape, layout[i].at, weightedOverlap(layout, i, layout[i].shape, layout[i].at, weights, kNoLimit)});
+    if (best.front().score == 0) return;
+    for (int sample = 0; sample < kNearSamples + kFarSamples; ++sample) {
+      const int k = static_cast<int>(random() % rotations);
+      const bool near = sample < kNearSamples;
+      Box box = fitOn(k, near ? here : random() % lanes.size());
+      if (near) {
+        const Shape& s = shapes_[part][k];
+        const cInt atX = centre.X - (s.minX + s.maxX) / 2, atY = centre.Y - (s.minY + s.maxY) / 2;
+        box = {std::max(box[0], atX - halfX), std::max(box[1], atY - halfY), std::min(box[2], atX + halfX),
+               std::min(box[3], atY + halfY)};
+      }
+      if (box[2] < box[0] || box[3] < box[1]) continue;
+      const IntPoint p{std::uniform_int_distribution<cInt>(box[0], box[2])(random),
+                       std::uniform_int_distribution<cInt>(box[1], box[3])(random)};
+      report({k, p, weightedOverlap(layout, i, k, p, weights, bound())});
+    }
+    // Coordinate descent (sparrow's): two places, one step either way along
+    // a random axis; a place no worse is taken; a better one lengthens the
+    // step by a tenth, else it halves and the axis changes.
+    const auto descend = [&](Sample from, double firstShare, double lastShare) {
+      const Box fit = fitOn(from.shape, laneOf(from.shape, from.at));
+      double stepX = minSize * firstShare, stepY = stepX;
+      const double last = std::max(1.0, minSize * lastShare);
+      int axis = static_cast<int>(random() % 4);
+      while ((stepX >= last || stepY >= last) && from.score > 0) {
+        static constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+        const cInt dx = std::llround(kAxes[axis][0] * stepX), dy = std::llround(kAxes[axis][1] * stepY);
+        Sample tried[2];
+        for (int side = 0; side < 2; ++side) {
+          const int sign = side ? -1 : 1;
+          const IntPoint p{std::clamp(from.at.X + sign * dx, fit[0], fit[2]),
+                           std::clamp(from.at.Y + sign * dy, fit[1], fit[3])};
+          tried[side] = {from.shape, p, weightedOverlap(layout, i, from.shape, p, weights, from.score)};
         }
-        std::vector<IntPoint> candidates{{x0, y0}, {x1, y0}, {x0, y1}, {x1, y1}};
-        if (k == layout[i].shape && layout[i].at.X >= x0 && layout[i].at.X <= x1) candidates.push_back(layout[i].at);
-        for (const Obstacle& o : obstaclesOf) {
-          for (const Path& path : o.region) {
-            for (const IntPoint& p : path) {
-              if (p.X >= x0 && p.X <= x1 && p.Y >= y0 && p.Y <= y1) candidates.push_back(p);
-            }
-          }
-        }
-        // The corners of the places clear of all but at most one other part:
-        // where the no-fit polygons' boundaries cross.
-        const auto cornersClearOf = [&](size_t skip) {
-          ClipperLib::Clipper clipper;
-          clipper.AddPath(Path{{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, ClipperLib::ptSubject, true);
-          for (size_t o = 0; o < obstaclesOf.size(); ++o) {
-            if (o != skip) clipper.AddPaths(obstaclesOf[o].region, ClipperLib::ptClip, true);
-          }
-          Paths free;
-          clipper.Execute(ClipperLib::ctDifference, free, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-          for (const Path& path : free) candidates.insert(candidates.end(), path.begin(), path.end());
-        };
-        cornersClearOf(obstaclesOf.size());
-        // Skipping, in turn, the parts that weigh most (those the part keeps overlapping).
-        std::vector<size_t> heaviest(obstaclesOf.size());
-        std::iota(heaviest.begin(), heaviest.end(), 0);
-        const size_t skipped = std::min(heaviest.size(), kMostSkipped);
-        std::partial_sort(heaviest.begin(), heaviest.begin() + skipped, heaviest.end(), [&](size_t a, size_t b) {
-          return weights[i * n + obstaclesOf[a].other] > weights[i * n + obstaclesOf[b].other];
-        });
-        for (size_t o = 0; o < skipped; ++o) cornersClearOf(heaviest[o]);
-        if (candidates.size() > kMostCandidates) {  // a random sample, keeping the first few
-          std::shuffle(candidates.begin() + 5, candidates.end(), random);
-          candidates.resize(kMostCandidates);
-        }
-        for (const IntPoint& p : candidates) {
-          double score = 0;
-          for (const Obstacle& o : obstaclesOf) {
-            if (p.X <= o.box[0] || p.X >= o.box[2] || p.Y <= o.box[1] || p.Y >= o.box[3]) continue;
-            double depth = penetration(o.region, p);
-            if (depth <= kRoundingDepth) depth = 0;
-            score += weights[i * n + o.other] * depth;
-            if (score >= bestScore) break;
-          }
-          if (score < bestScore) bestScore = score, best = {part, k, p};
+        const Sample& pick = tried[1].score < tried[0].score ? tried[1] : tried[0];
+        const bool better = pick.score < from.score;
+        if (pick.score <= from.score) from = pick;
+        const double factor = better ? 1.1 : 0.5;
+        if (axis == 0)
+          stepX *= factor;
+        else if (axis == 1)
+          stepY *= factor;
+        else
+          stepX *= std::sqrt(factor), stepY *= std::sqrt(factor);
+        if (!better) axis = static_cast<int>(random() % 4);
+      }
+      return from;
+    };
+    for (const Sample& start : std::vector<Sample>(best)) report(descend(start, 0.25, 0.02));
+    const Sample chosen = descend(best.front(), 0.01, 0.001);
+    layout[i] = {part, chosen.shape, chosen.at};
+  }
+
+  // The exact check that ends a sampled separation: no grown shape enters
+  // another's core (colliding() misses overlaps whose every crossing is at
+  // a vertex).
+  bool apart(const std::vector<PlacedShape>& layout) const {
+    for (size_t i = 0; i < layout.size(); ++i) {
+      const Shape& a = shapes_[layout[i].part][layout[i].shape];
+      for (size_t j = 0; j < layout.size(); ++j) {
+        const Shape& b = shapes_[layout[j].part][layout[j].shape];
+        if (i == j || boxesApart(a, layout[i].at, b, layout[j].at)) continue;
+        ClipperLib::Clipper clipper;
+        clipper.AddPath(translatedPath(a.grown, layout[i].at), ClipperLib::ptSubject, true);
+        clipper.AddPath(translatedPath(b.core, layout[j].at), ClipperLib::ptClip, true);
+        Paths common;
+        clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+        for (const Path& path : common) {
+          if (std::abs(ClipperLib::Area(path)) > 1.0) return false;
         }
       }
     }
-    layout[i] = best;
-  }
-
-  // How deep `p` lies inside `region` (outer contours and holes): 0 outside
-  // or on the boundary, else the distance to the nearest edge.
-  static double penetration(const Paths& region, IntPoint p) {
-    int winding = 0;
-    for (const Path& path : region) {
-      const int inside = ClipperLib::PointInPolygon(p, path);
-      if (inside == -1) return 0;  // on the boundary: touching
-      if (inside == 1) winding += ClipperLib::Orientation(path) ? 1 : -1;
-    }
-    if (winding <= 0) return 0;
-    double nearest = std::numeric_limits<double>::max();
-    for (const Path& path : region) {
-      nearest = std::min(nearest, squaredDistanceToBoundary(path, static_cast<double>(p.X), static_cast<double>(p.Y)));
-    }
-    return std::sqrt(nearest);
+    return true;
   }
 
   Point2 extentOf(size_t part) const {
@@ -1072,18 +1263,6 @@ class Packer {
   static bool overlapping(double area, const Shape& shape) {
     return area > 4.0 * static_cast<double>(shape.grown.size());
   }
-  // For the compaction: whether `a` lies deeper in `b` than a sliver of
-  // rounding (no-fit polygon vertices rounded to the grid reach up to a unit
-  // into a neighbour), by the measure its moves minimise: penetration() of
-  // its reference point in their no-fit polygon, how far it must move to
-  // clear `b`. With the no-fit polygons kept, much cheaper than intersecting
-  // the shapes (the final layout is still checked exactly).
-  bool penetrating(const PlacedShape& a, const PlacedShape& b) {
-    if (boxesApart(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at)) return false;
-    const TurnedRegion region = noFitPolygonOf(a.part, a.shape, b.part, b.shape);
-    return penetration(*region.paths, turned({a.at.X - b.at.X, a.at.Y - b.at.Y}, 4 - region.turns)) > kRoundingDepth;
-  }
-
   const std::vector<NestingPart>& parts_;
   const NestingOptions& options_;
   const RoomScale roomScale_;
