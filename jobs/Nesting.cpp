@@ -38,17 +38,24 @@ constexpr double kScale = 1e4;
 constexpr double kSimplifyTolerance = 0.002;
 // Poles per shape for the compaction's overlap proxy.
 constexpr size_t kMostPoles = 12;
-// Grid units that two grown shapes may overlap by in the compaction (see
-// Shape::core): far below layoutProblems' tolerance of 1e-3 in.
+// Grid units by which each of two grown shapes may reach into the other in
+// the compaction (see Shape::core): together far below layoutProblems'
+// tolerance of 1e-3 in (10 units).
 constexpr ClipperLib::cInt kCollisionSlack = 3;
-// The compaction's sampled moves: places drawn per rotation near the part and
-// anywhere, and the share of the smaller largest pole within which poles
-// apart still count (see Packer::proxy).
+// The compaction's sampled moves (Packer::sampledMove), with sparrow's
+// settings: places drawn near the part and anywhere, how many of the best
+// are refined, and how far apart (a share of the part's smaller side) two
+// must be to count as two.
 constexpr int kNearSamples = 25, kFarSamples = 50;
 constexpr size_t kDescents = 3;
-constexpr int kStaleRounds = 50, kStrikes = 3;
-constexpr double kWeightFade = 0.95;
 constexpr double kDistinctShare = 0.05;
+// Its separation (Packer::separate): rounds without progress before a
+// strike, strikes before it gives up, how fast the weight of a pair that no
+// longer overlaps fades back to 1, and the most a weight can grow to.
+constexpr int kStaleRounds = 50, kStrikes = 3;
+constexpr double kWeightFade = 0.95, kHeaviest = 1e9;
+// Its overlap proxy (Packer::proxy): within this share of the larger
+// shape's diameter, poles apart still count a little.
 constexpr double kDecayShare = 0.01;
 constexpr double kNoLimit = std::numeric_limits<double>::max();
 
@@ -110,11 +117,13 @@ struct Shape {
   std::vector<Pole> poles;
   double diameter = 0;  // of `grown`'s box
   double size = 0;      // the square root of `grown`'s area
-  // `grown` shrunk by kCollisionSlack: the compaction's collision test finds
-  // where one shape's grown outline enters another's core, so that shapes
-  // placed touching, with no-fit polygon vertices rounded to the grid, are
-  // not taken for colliding.
+  // `grown` shrunk by kCollisionSlack: the compaction's collision test asks
+  // whether two cores overlap, so that shapes placed touching, with no-fit
+  // polygon vertices rounded to the grid, are not taken for colliding. One
+  // piece: grown by at least kSimplifyTolerance (20 units) on each side, a
+  // shape has no neck that shrinking by 3 units could cut.
   Path core;
+  Box coreBox{};
   cInt grownMinX = 0, grownMinY = 0, grownMaxX = 0, grownMaxY = 0;
   cInt minX = 0, minY = 0, maxX = 0, maxY = 0;
   double rotation = 0;
@@ -244,7 +253,7 @@ std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most) {
     }
   }
   // Too thin for the grid: one small pole at a point inside, so that
-  // containment is still found.
+  // containment is still found (failing that, on a vertex: never empty).
   if (poles.empty()) {
     for (size_t i = 0; i < polygon.size() && poles.empty(); ++i) {
       const IntPoint& a = polygon[i];
@@ -254,6 +263,7 @@ std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most) {
       if (ClipperLib::PointInPolygon(mid, polygon) == 1) poles.push_back({mid, 1.0});
     }
   }
+  if (poles.empty()) poles.push_back({polygon.front(), 1.0});
   return poles;
 }
 
@@ -283,6 +293,7 @@ Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt r
     if (std::abs(ClipperLib::Area(core)) > largest) largest = std::abs(ClipperLib::Area(core)), shape.core = core;
   }
   if (ClipperLib::Area(shape.core) < 0) std::reverse(shape.core.begin(), shape.core.end());
+  shape.coreBox = boxOf(shape.core);
   if (auto pieces = convexPieces(shape.grown)) {
     shape.pieces = std::move(*pieces);
     for (const Path& piece : shape.pieces) {
@@ -494,15 +505,15 @@ class Packer {
   // Compaction by overlap minimisation, after the sequence search (in the
   // spirit of Umetani et al. 2009 and sparrow): shorten the strip a little by
   // taking out a slice, then move the parts apart (separate()) until nothing
-  // overlaps (a shorter layout: keep it, shorten again) or the rounds run out
-  // (go back; after a few such tries, shorten by less).
+  // overlaps (a shorter layout: keep it, shorten again) or it gives up (go
+  // back; after a few such tries, shorten by less).
   // On beds, the beds lie side by side in one row (see pitch_) and the slice
   // comes out of the last bed: what it holds moves to the earlier beds, which
   // fill up, until the last bed is empty and one bed fewer is used.
   // `goOn` says whether the budget allows another move; `moves` counts them;
   // `shorter` hears of each better layout kept (beds, last bed's length in
   // inches). The layout is exact: a try succeeds only when no two grown
-  // shapes overlap beyond rounding.
+  // shapes reach into each other by more than kCollisionSlack each.
   NestingResult compact(std::mt19937& random, const std::function<bool()>& goOn, int& moves,
                         const std::function<void(int, double)>& shorter) {
     std::vector<PlacedShape> best = acceptedLayout_;
@@ -678,18 +689,18 @@ class Packer {
   // to where its weighted overlap is least (sampledMove), and the pairs
   // still overlapping weigh more, the deeper the more (x1.2 to x2), while
   // the others fade back towards 1. The layout of least overlap so far is
-  // kept; after kStaleRounds rounds without beating it by 2%, the moves
-  // start again from it (a strike, the weights kept), and after kStrikes
-  // strikes in a row that did not improve on it the separation fails
-  // (false), as it does when the budget runs out. True when nothing
-  // overlaps, checked exactly (apart()).
+  // kept. A round that does not beat it counts towards kStaleRounds, one
+  // that beats it by 2% starts the count again; when the count is full,
+  // the moves start again from that layout (a strike, the weights kept).
+  // After kStrikes strikes in a row, each ending less than 2% below where
+  // it began, the separation fails (false), as it does when the budget runs
+  // out. True when nothing overlaps, checked exactly (apart()).
   bool separate(std::vector<PlacedShape>& layout, const Lanes& lanes, std::mt19937& random,
                 const std::function<bool()>& goOn, int& moves) {
     const size_t n = layout.size();
     std::vector<double> weights(n * n, 1.0);
     // Whether each pair overlaps, kept from round to round: only the pairs
-    // of a part that moved are checked again (checking all pairs took a
-    // third of the compaction's time).
+    // of a part that moved are checked again.
     std::vector<char> overlaps(n * n, 0), moved(n, 1);
     double leastLoss = kNoLimit, strikeLoss = kNoLimit;
     std::vector<PlacedShape> leastLayout;
@@ -711,6 +722,7 @@ class Packer {
         depth.push_back(proxy(a, layout[i].at, b, layout[j].at));
       }
       const double loss = std::accumulate(depth.begin(), depth.end(), 0.0);
+      if (leastLoss == kNoLimit) strikeLoss = loss;
       if (loss < leastLoss) {
         if (loss < 0.98 * leastLoss) stale = 0;
         leastLoss = loss, leastLayout = layout;
@@ -722,12 +734,16 @@ class Packer {
         std::fill(moved.begin(), moved.end(), 1);
         continue;
       }
-      for (double& w : weights) w = std::max(1.0, w * kWeightFade);
+      std::vector<char> grows(n * n, 0);
       const double deepest = *std::max_element(depth.begin(), depth.end());
       for (size_t p = 0; p < pairs.size(); ++p) {
         const auto [i, j] = pairs[p];
-        const double grow = 1.2 + 0.8 * depth[p] / deepest;
-        weights[i * n + j] = weights[j * n + i] = weights[i * n + j] / kWeightFade * grow;
+        const double grown = std::min(kHeaviest, weights[i * n + j] * (1.2 + 0.8 * depth[p] / deepest));
+        weights[i * n + j] = weights[j * n + i] = grown;
+        grows[i * n + j] = grows[j * n + i] = 1;
+      }
+      for (size_t k = 0; k < n * n; ++k) {
+        if (!grows[k]) weights[k] = std::max(1.0, weights[k] * kWeightFade);
       }
       std::vector<size_t> overlapped;
       for (const auto& [i, j] : pairs) overlapped.push_back(i), overlapped.push_back(j);
@@ -745,46 +761,94 @@ class Packer {
     return false;
   }
 
-  // Whether two placed grown shapes overlap, touching apart: an edge of
-  // one properly crosses an edge of the other, or a pole's centre (inside
-  // its shape) is inside the other. Misses overlaps whose every crossing is
-  // at a vertex; apart() has the last word.
+  // Whether two placed shapes collide: their cores (see Shape::core)
+  // overlap, touching apart. An edge of one properly crosses an edge of the
+  // other, or a pole's centre of one is inside the other's core. The same
+  // both ways round. Can miss overlaps whose every crossing is at a vertex
+  // or along a shared line; apart() has the last word.
   bool colliding(const PlacedShape& a, const PlacedShape& b) const {
-    const Shape& sa = shapes_[a.part][a.shape];
-    const Shape& sb = shapes_[b.part][b.shape];
-    return shapesColliding(sa, a.at, sb, b.at);
+    return shapesColliding(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at);
   }
   static bool shapesColliding(const Shape& sa, IntPoint atA, const Shape& sb, IntPoint atB) {
-    if (boxesApart(sa, atA, sb, atB)) return false;
-    // In b's frame.
+    // In b's frame; only edges that meet both cores' boxes can cross.
     const IntPoint shift{atA.X - atB.X, atA.Y - atB.Y};
-    const cInt bx0 = sb.grownMinX + kCollisionSlack, by0 = sb.grownMinY + kCollisionSlack,
-               bx1 = sb.grownMaxX - kCollisionSlack, by1 = sb.grownMaxY - kCollisionSlack;
+    const Box window{std::max(sa.coreBox[0] + shift.X, sb.coreBox[0]), std::max(sa.coreBox[1] + shift.Y, sb.coreBox[1]),
+                     std::min(sa.coreBox[2] + shift.X, sb.coreBox[2]),
+                     std::min(sa.coreBox[3] + shift.Y, sb.coreBox[3])};
+    if (window[0] >= window[2] || window[1] >= window[3]) return false;
+    // Closed: an edge on the window's border (the edge that makes a core's
+    // box) still counts.
+    const auto meets = [](const Box& box, IntPoint p, IntPoint q) {
+      return std::max(p.X, q.X) >= box[0] && std::min(p.X, q.X) <= box[2] && std::max(p.Y, q.Y) >= box[1] &&
+             std::min(p.Y, q.Y) <= box[3];
+    };
     const auto side = [](IntPoint o, IntPoint p, IntPoint q) {
       const cInt cross = (p.X - o.X) * (q.Y - o.Y) - (p.Y - o.Y) * (q.X - o.X);
       return (cross > 0) - (cross < 0);
     };
-    const Path& pa = sa.grown;
+    std::array<std::pair<IntPoint, IntPoint>, 64> near;  // b's edges in the window (most shapes: all fit)
+    size_t nearCount = 0;
+    bool overflow = false;
     const Path& pb = sb.core;
+    for (size_t j = 0; j < pb.size(); ++j) {
+      const IntPoint& r = pb[j];
+      const IntPoint& t = pb[(j + 1) % pb.size()];
+      if (!meets(window, r, t)) continue;
+      if (nearCount == near.size()) {
+        overflow = true;
+        break;
+      }
+      near[nearCount++] = {r, t};
+    }
+    const Path& pa = sa.core;
     for (size_t i = 0; i < pa.size(); ++i) {
       const IntPoint p{pa[i].X + shift.X, pa[i].Y + shift.Y};
       const IntPoint q{pa[(i + 1) % pa.size()].X + shift.X, pa[(i + 1) % pa.size()].Y + shift.Y};
-      const cInt ex0 = std::min(p.X, q.X), ex1 = std::max(p.X, q.X), ey0 = std::min(p.Y, q.Y), ey1 = std::max(p.Y, q.Y);
-      if (ex1 <= bx0 || ex0 >= bx1 || ey1 <= by0 || ey0 >= by1) continue;
-      for (size_t j = 0; j < pb.size(); ++j) {
-        const IntPoint& r = pb[j];
-        const IntPoint& t = pb[(j + 1) % pb.size()];
-        if (std::max(r.X, t.X) <= ex0 || std::min(r.X, t.X) >= ex1 || std::max(r.Y, t.Y) <= ey0 ||
-            std::min(r.Y, t.Y) >= ey1) {
-          continue;
+      if (!meets(window, p, q)) continue;
+      const Box edge{std::min(p.X, q.X), std::min(p.Y, q.Y), std::max(p.X, q.X), std::max(p.Y, q.Y)};
+      const auto crosses = [&](IntPoint r, IntPoint t) {
+        return meets(edge, r, t) && side(p, q, r) * side(p, q, t) < 0 && side(r, t, p) * side(r, t, q) < 0;
+      };
+      if (!overflow) {
+        for (size_t j = 0; j < nearCount; ++j) {
+          if (crosses(near[j].first, near[j].second)) return true;
         }
-        if (side(p, q, r) * side(p, q, t) < 0 && side(r, t, p) * side(r, t, q) < 0) return true;
+      } else {
+        for (size_t j = 0; j < pb.size(); ++j) {
+          if (crosses(pb[j], pb[(j + 1) % pb.size()])) return true;
+        }
       }
     }
-    const IntPoint poleA{sa.poles.front().centre.X + shift.X, sa.poles.front().centre.Y + shift.Y};
-    if (ClipperLib::PointInPolygon(poleA, sb.core) == 1) return true;
-    const IntPoint poleB{sb.poles.front().centre.X - shift.X, sb.poles.front().centre.Y - shift.Y};
-    return ClipperLib::PointInPolygon(poleB, pa) == 1;
+    // No crossing: one may still lie in the other, or their boundaries
+    // meet only along shared lines and at vertices (parts pushed against
+    // the same side of the strip, or two copies side by side). A point of
+    // one strictly inside the other's core then gives it away: a pole's
+    // centre, a vertex or the middle of an edge, in the window.
+    const auto inWindow = [&](IntPoint c) {
+      return c.X >= window[0] && c.X <= window[2] && c.Y >= window[1] && c.Y <= window[3];
+    };
+    // Points in b's frame: inside b's core, or (shifted back) inside a's.
+    const auto inB = [&](IntPoint c) { return inWindow(c) && ClipperLib::PointInPolygon(c, pb) == 1; };
+    const auto inA = [&](IntPoint c) {
+      return inWindow(c) && ClipperLib::PointInPolygon({c.X - shift.X, c.Y - shift.Y}, pa) == 1;
+    };
+    for (const Shape::Pole& pole : sa.poles) {
+      if (inB({pole.centre.X + shift.X, pole.centre.Y + shift.Y})) return true;
+    }
+    for (const Shape::Pole& pole : sb.poles) {
+      if (inA(pole.centre)) return true;
+    }
+    for (size_t i = 0; i < pa.size(); ++i) {
+      const IntPoint p{pa[i].X + shift.X, pa[i].Y + shift.Y};
+      const IntPoint q{pa[(i + 1) % pa.size()].X + shift.X, pa[(i + 1) % pa.size()].Y + shift.Y};
+      if (inB(p) || inB({(p.X + q.X) / 2, (p.Y + q.Y) / 2})) return true;
+    }
+    for (size_t j = 0; j < pb.size(); ++j) {
+      const IntPoint& r = pb[j];
+      const IntPoint& t = pb[(j + 1) % pb.size()];
+      if (inA(r) || inA({(r.X + t.X) / 2, (r.Y + t.Y) / 2})) return true;
+    }
+    return false;
   }
 
   // How much two colliding shapes overlap (sparrow's quantification): over
@@ -854,7 +918,7 @@ class Packer {
     const auto laneOf = [&](int k, IntPoint at) {
       return std::min(static_cast<size_t>(sheetOf(at.X + shapes_[part][k].maxX)), lanes.size() - 1);
     };
-    std::vector<Sample> best;  // the kDescents best, at least kDistinct apart, best first
+    std::vector<Sample> best;  // the kDescents best, apart by kDistinctShare of minSize, best first
     const cInt minSize = std::max<cInt>(1, std::min(current.maxX - current.minX, current.maxY - current.minY));
     const auto bound = [&] { return best.size() < kDescents ? kNoLimit : best.back().score; };
     const auto report = [&](const Sample& sample) {
@@ -896,29 +960,30 @@ class Packer {
     // step by a tenth, else it halves and the axis changes.
     const auto descend = [&](Sample from, double firstShare, double lastShare) {
       const Box fit = fitOn(from.shape, laneOf(from.shape, from.at));
-      double stepX = minSize * firstShare, stepY = stepX;
+      // Steps never longer than the room to move in (a run of successes would grow them without end).
+      const double widest = std::max<double>(1, fit[2] - fit[0]), tallest = std::max<double>(1, fit[3] - fit[1]);
+      double stepX = std::min(widest, minSize * firstShare), stepY = std::min(tallest, minSize * firstShare);
       const double last = std::max(1.0, minSize * lastShare);
       int axis = static_cast<int>(random() % 4);
       while ((stepX >= last || stepY >= last) && from.score > 0) {
         static constexpr int kAxes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
         const cInt dx = std::llround(kAxes[axis][0] * stepX), dy = std::llround(kAxes[axis][1] * stepY);
-        Sample tried[2];
-        for (int side = 0; side < 2; ++side) {
-          const int sign = side ? -1 : 1;
-          const IntPoint p{std::clamp(from.at.X + sign * dx, fit[0], fit[2]),
-                           std::clamp(from.at.Y + sign * dy, fit[1], fit[3])};
-          tried[side] = {from.shape, p, weightedOverlap(layout, i, from.shape, p, weights, from.score)};
+        bool better = false;
+        if (dx != 0 || dy != 0) {  // a step rounded to nothing is a failed one
+          Sample tried[2];
+          for (int side = 0; side < 2; ++side) {
+            const int sign = side ? -1 : 1;
+            const IntPoint p{std::clamp(from.at.X + sign * dx, fit[0], fit[2]),
+                             std::clamp(from.at.Y + sign * dy, fit[1], fit[3])};
+            tried[side] = {from.shape, p, weightedOverlap(layout, i, from.shape, p, weights, from.score)};
+          }
+          const Sample& pick = tried[1].score < tried[0].score ? tried[1] : tried[0];
+          better = pick.score < from.score;
+          if (pick.score <= from.score) from = pick;
         }
-        const Sample& pick = tried[1].score < tried[0].score ? tried[1] : tried[0];
-        const bool better = pick.score < from.score;
-        if (pick.score <= from.score) from = pick;
         const double factor = better ? 1.1 : 0.5;
-        if (axis == 0)
-          stepX *= factor;
-        else if (axis == 1)
-          stepY *= factor;
-        else
-          stepX *= std::sqrt(factor), stepY *= std::sqrt(factor);
+        if (axis != 1) stepX = std::min(widest, stepX * (axis == 0 ? factor : std::sqrt(factor)));
+        if (axis != 0) stepY = std::min(tallest, stepY * (axis == 1 ? factor : std::sqrt(factor)));
         if (!better) axis = static_cast<int>(random() % 4);
       }
       return from;
@@ -928,17 +993,16 @@ class Packer {
     layout[i] = {part, chosen.shape, chosen.at};
   }
 
-  // The exact check that ends a sampled separation: no grown shape enters
-  // another's core (colliding() misses overlaps whose every crossing is at
-  // a vertex).
+  // The exact check that ends a sampled separation: no two cores overlap
+  // (colliding() misses overlaps whose every crossing is at a vertex).
   bool apart(const std::vector<PlacedShape>& layout) const {
     for (size_t i = 0; i < layout.size(); ++i) {
       const Shape& a = shapes_[layout[i].part][layout[i].shape];
-      for (size_t j = 0; j < layout.size(); ++j) {
+      for (size_t j = i + 1; j < layout.size(); ++j) {
         const Shape& b = shapes_[layout[j].part][layout[j].shape];
-        if (i == j || boxesApart(a, layout[i].at, b, layout[j].at)) continue;
+        if (boxesApart(a, layout[i].at, b, layout[j].at)) continue;
         ClipperLib::Clipper clipper;
-        clipper.AddPath(translatedPath(a.grown, layout[i].at), ClipperLib::ptSubject, true);
+        clipper.AddPath(translatedPath(a.core, layout[i].at), ClipperLib::ptSubject, true);
         clipper.AddPath(translatedPath(b.core, layout[j].at), ClipperLib::ptClip, true);
         Paths common;
         clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
@@ -1009,8 +1073,8 @@ class Packer {
   }
 
   // Turning two shapes together turns their no-fit polygon: one is kept for
-  // the four quarter turns of a pair (a quarter of the work and memory: most
-  // panels are unique and allowed 0/90/180/270). `paths` is the no-fit
+  // the four quarter turns of a pair (a quarter of the work and memory for
+  // the shapes with copies, which obstacles() meets again and again). `paths` is the no-fit
   // polygon of the moving shape turned back by `turns` quarter turns against
   // the placed part in its first quarter-turn rotation; turned by `turns`,
   // it is the one asked for. Turned outlines are exact on the grid, but the
@@ -1455,8 +1519,9 @@ NestingResult searchLayout(const std::vector<NestingPart>& parts, const NestingO
                                                             sheets == 1 ? "" : "s", length));
     };
     NestingResult compacted = packer.compact(random, goOn, evaluations, shorter);
-    // The compaction allows slivers of rounding between grown shapes; the
-    // layout is kept only if the true outlines keep the spacing exactly.
+    // The compaction lets grown shapes reach into each other by a few grid
+    // units; the layout is kept only if the true outlines keep the spacing
+    // (within layoutProblems' tolerance).
     if (cost(compacted, parts) < cost(best, parts) && layoutProblems(parts, compacted, options).empty()) {
       best = std::move(compacted);
     }
