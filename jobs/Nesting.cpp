@@ -54,8 +54,9 @@ constexpr double kDistinctShare = 0.05;
 // longer overlaps fades back to 1, and the most a weight can grow to.
 constexpr int kStaleRounds = 50, kStrikes = 3;
 constexpr double kWeightFade = 0.95, kHeaviest = 1e9;
-// Its overlap proxy (Packer::proxy): within this share of the larger
-// shape's diameter, poles apart still count a little.
+// Its overlap proxy (Packer::proxy): poles that reach into each other by
+// less than this share of the larger shape's diameter (or are apart) count
+// by a decaying amount instead of their depth.
 constexpr double kDecayShare = 0.01;
 constexpr double kNoLimit = std::numeric_limits<double>::max();
 
@@ -119,9 +120,10 @@ struct Shape {
   double size = 0;      // the square root of `grown`'s area
   // `grown` shrunk by kCollisionSlack: the compaction's collision test asks
   // whether two cores overlap, so that shapes placed touching, with no-fit
-  // polygon vertices rounded to the grid, are not taken for colliding. One
-  // piece: grown by at least kSimplifyTolerance (20 units) on each side, a
-  // shape has no neck that shrinking by 3 units could cut.
+  // polygon vertices rounded to the grid, are not taken for colliding. Only
+  // the largest piece is kept: a part would need a neck under about 6
+  // units (0.0006 in) wide to be cut in two, and the final layoutProblems
+  // check would still refuse any overlap there.
   Path core;
   Box coreBox{};
   cInt grownMinX = 0, grownMinY = 0, grownMaxX = 0, grownMaxY = 0;
@@ -763,9 +765,10 @@ class Packer {
 
   // Whether two placed shapes collide: their cores (see Shape::core)
   // overlap, touching apart. An edge of one properly crosses an edge of the
-  // other, or a pole's centre of one is inside the other's core. The same
-  // both ways round. Can miss overlaps whose every crossing is at a vertex
-  // or along a shared line; apart() has the last word.
+  // other, or a point of one (a pole's centre, a vertex, the middle of an
+  // edge) is strictly inside the other's core. The same both ways round.
+  // Can miss overlaps whose every crossing is at a vertex or along a shared
+  // line and that hold none of those points; apart() has the last word.
   bool colliding(const PlacedShape& a, const PlacedShape& b) const {
     return shapesColliding(shapes_[a.part][a.shape], a.at, shapes_[b.part][b.shape], b.at);
   }
@@ -832,16 +835,19 @@ class Packer {
     const auto inA = [&](IntPoint c) {
       return inWindow(c) && ClipperLib::PointInPolygon({c.X - shift.X, c.Y - shift.Y}, pa) == 1;
     };
+    // Only poles wider than the slack: their centres are inside their own core.
     for (const Shape::Pole& pole : sa.poles) {
-      if (inB({pole.centre.X + shift.X, pole.centre.Y + shift.Y})) return true;
+      if (pole.radius > kCollisionSlack + 1 && inB({pole.centre.X + shift.X, pole.centre.Y + shift.Y})) return true;
     }
     for (const Shape::Pole& pole : sb.poles) {
-      if (inA(pole.centre)) return true;
+      if (pole.radius > kCollisionSlack + 1 && inA(pole.centre)) return true;
     }
+    // Middles rounded in each shape's own frame, so that both ways round test the same points.
     for (size_t i = 0; i < pa.size(); ++i) {
-      const IntPoint p{pa[i].X + shift.X, pa[i].Y + shift.Y};
-      const IntPoint q{pa[(i + 1) % pa.size()].X + shift.X, pa[(i + 1) % pa.size()].Y + shift.Y};
-      if (inB(p) || inB({(p.X + q.X) / 2, (p.Y + q.Y) / 2})) return true;
+      const IntPoint& p = pa[i];
+      const IntPoint& q = pa[(i + 1) % pa.size()];
+      if (inB({p.X + shift.X, p.Y + shift.Y}) || inB({(p.X + q.X) / 2 + shift.X, (p.Y + q.Y) / 2 + shift.Y}))
+        return true;
     }
     for (size_t j = 0; j < pb.size(); ++j) {
       const IntPoint& r = pb[j];
@@ -957,7 +963,8 @@ class Packer {
     }
     // Coordinate descent (sparrow's): two places, one step either way along
     // a random axis; a place no worse is taken; a better one lengthens the
-    // step by a tenth, else it halves and the axis changes.
+    // step by a tenth, else it halves and the axis changes (on a diagonal,
+    // each of its two steps by the square root of that).
     const auto descend = [&](Sample from, double firstShare, double lastShare) {
       const Box fit = fitOn(from.shape, laneOf(from.shape, from.at));
       // Steps never longer than the room to move in (a run of successes would grow them without end).
