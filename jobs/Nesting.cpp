@@ -80,16 +80,21 @@ Polygon2 rotated(const Polygon2& polygon, double degrees) {
 // The boundary is grown too, as a line: a needle or slit in the outline (a
 // cut out and back along one line) encloses no area, and growing the polygon
 // alone would drop it, though the laser cuts it and neighbours must keep clear.
+// The piece of largest area, or `otherwise` when there is none.
+Path largestOf(const Paths& pieces, const Path& otherwise) {
+  if (pieces.empty()) return otherwise;
+  return *std::max_element(pieces.begin(), pieces.end(), [](const Path& a, const Path& b) {
+    return std::abs(ClipperLib::Area(a)) < std::abs(ClipperLib::Area(b));
+  });
+}
+
 Path grown(const Path& path, double by, ClipperLib::JoinType join) {
   ClipperLib::ClipperOffset offset(2.0, 0.25 * kScale * 0.001);
   offset.AddPath(path, join, ClipperLib::etClosedPolygon);
   offset.AddPath(path, ClipperLib::jtRound, ClipperLib::etClosedLine);
   Paths out;
   offset.Execute(out, by * kScale);
-  if (out.empty()) return path;
-  return *std::max_element(out.begin(), out.end(), [](const Path& a, const Path& b) {
-    return std::abs(ClipperLib::Area(a)) < std::abs(ClipperLib::Area(b));
-  });
+  return largestOf(out, path);
 }
 
 // One part in one rotation: its outline grown by half the spacing (for no-fit
@@ -171,6 +176,21 @@ RoomScale roomScaleFor(cInt height) {
   return {h / 350, h / 70, static_cast<double>(h) / 17500};
 }
 
+// The points of a (steps + 1) x (steps + 1) grid over the polygon's box that
+// lie strictly inside it, with their distance to its boundary.
+std::vector<std::pair<IntPoint, double>> gridInside(const Path& polygon, int steps) {
+  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
+  std::vector<std::pair<IntPoint, double>> inside;
+  for (int i = 0; i <= steps; ++i) {
+    for (int j = 0; j <= steps; ++j) {
+      const IntPoint p{minX + (maxX - minX) * i / steps, minY + (maxY - minY) * j / steps};
+      if (ClipperLib::PointInPolygon(p, polygon) != 1) continue;
+      inside.emplace_back(p, distanceToBoundary(polygon, static_cast<double>(p.X), static_cast<double>(p.Y)));
+    }
+  }
+  return inside;
+}
+
 // Discs of one radius inside a polygon. The largest: a grid search for the
 // point farthest from the boundary, refined around the best point, its radius
 // the distance from there rounded down to `radiusStep`. Then up to
@@ -179,23 +199,18 @@ RoomScale roomScaleFor(cInt height) {
 // away. Every radius is a true distance to the boundary, so every disc is inside.
 std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radiusStep, int maxDiscs = 5) {
   const auto [minX, minY, maxX, maxY] = boxOf(polygon);
-  std::vector<std::pair<IntPoint, double>> inside;  // grid points and their distance to the boundary
+  constexpr int kSteps = 24;
+  const auto inside = gridInside(polygon, kSteps);
   IntPoint best{(minX + maxX) / 2, (minY + maxY) / 2};
   double bestDistance = -1;
+  for (const auto& [p, d] : inside) {
+    if (d > bestDistance) bestDistance = d, best = p;
+  }
   auto consider = [&](cInt x, cInt y) {
-    if (ClipperLib::PointInPolygon({x, y}, polygon) != 1) return -1.0;
+    if (ClipperLib::PointInPolygon({x, y}, polygon) != 1) return;
     const double d = distanceToBoundary(polygon, static_cast<double>(x), static_cast<double>(y));
     if (d > bestDistance) bestDistance = d, best = {x, y};
-    return d;
   };
-  constexpr int kSteps = 24;
-  for (int i = 0; i <= kSteps; ++i) {
-    for (int j = 0; j <= kSteps; ++j) {
-      const IntPoint p{minX + (maxX - minX) * i / kSteps, minY + (maxY - minY) * j / kSteps};
-      const double d = consider(p.X, p.Y);
-      if (d > 0) inside.emplace_back(p, d);
-    }
-  }
   for (double step = std::max(maxX - minX, maxY - minY) / (2.0 * kSteps); step >= 1; step /= 2) {
     const IntPoint at = best;
     for (int dx = -1; dx <= 1; ++dx) {
@@ -226,32 +241,19 @@ std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radi
 // it, greedily the one with the largest disc clear of the boundary and of
 // the discs so far, while that is at least a tenth of the first's radius.
 std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most) {
-  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
-  struct Inside {
-    IntPoint p;
-    double room;  // the largest disc here clear of the boundary and the poles so far
-  };
-  std::vector<Inside> inside;
-  constexpr int kSteps = 32;
-  for (int i = 0; i <= kSteps; ++i) {
-    for (int j = 0; j <= kSteps; ++j) {
-      const IntPoint p{minX + (maxX - minX) * i / kSteps, minY + (maxY - minY) * j / kSteps};
-      if (ClipperLib::PointInPolygon(p, polygon) != 1) continue;
-      inside.push_back({p, distanceToBoundary(polygon, static_cast<double>(p.X), static_cast<double>(p.Y))});
-    }
-  }
+  // Grid points and the largest disc at each clear of the boundary and of the poles so far.
+  auto inside = gridInside(polygon, 32);
   std::vector<Shape::Pole> poles;
   while (poles.size() < most && !inside.empty()) {
     const auto best = std::max_element(inside.begin(), inside.end(),
-                                       [](const Inside& a, const Inside& b) { return a.room < b.room; });
-    if (best->room < 1 || (!poles.empty() && best->room < 0.1 * poles.front().radius)) break;
-    const Shape::Pole pole{best->p, best->room};
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (best->second < 1 || (!poles.empty() && best->second < 0.1 * poles.front().radius)) break;
+    const Shape::Pole pole{best->first, best->second};
     poles.push_back(pole);
-    for (Inside& point : inside) {
+    for (auto& [p, room] : inside) {
       const double apart =
-          std::hypot(static_cast<double>(point.p.X - pole.centre.X), static_cast<double>(point.p.Y - pole.centre.Y)) -
-          pole.radius;
-      point.room = std::min(point.room, apart);
+          std::hypot(static_cast<double>(p.X - pole.centre.X), static_cast<double>(p.Y - pole.centre.Y)) - pole.radius;
+      room = std::min(room, apart);
     }
   }
   // Too thin for the grid: one small pole at a point inside, so that
@@ -289,11 +291,7 @@ Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt r
   shrink.AddPath(shape.grown, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
   Paths cores;
   shrink.Execute(cores, -static_cast<double>(kCollisionSlack));
-  shape.core = shape.grown;
-  double largest = 0;
-  for (Path& core : cores) {
-    if (std::abs(ClipperLib::Area(core)) > largest) largest = std::abs(ClipperLib::Area(core)), shape.core = core;
-  }
+  shape.core = largestOf(cores, shape.grown);
   if (ClipperLib::Area(shape.core) < 0) std::reverse(shape.core.begin(), shape.core.end());
   shape.coreBox = boxOf(shape.core);
   if (auto pieces = convexPieces(shape.grown)) {
@@ -915,7 +913,6 @@ class Packer {
     const Shape& current = shapes_[part][layout[i].shape];
     const IntPoint centre = centreOf(layout[i]);
     const cInt halfX = (current.maxX - current.minX) / 2, halfY = (current.maxY - current.minY) / 2;
-    const size_t here = std::min(static_cast<size_t>(sheetOf(layout[i].at.X + current.maxX)), lanes.size() - 1);
     // Where shape k's reference point may be on `lane`: its inner-fit rectangle.
     const auto fitOn = [&](int k, size_t lane) {
       const Shape& s = shapes_[part][k];
@@ -924,6 +921,7 @@ class Packer {
     const auto laneOf = [&](int k, IntPoint at) {
       return std::min(static_cast<size_t>(sheetOf(at.X + shapes_[part][k].maxX)), lanes.size() - 1);
     };
+    const size_t here = laneOf(layout[i].shape, layout[i].at);
     std::vector<Sample> best;  // the kDescents best, apart by kDistinctShare of minSize, best first
     const cInt minSize = std::max<cInt>(1, std::min(current.maxX - current.minX, current.maxY - current.minY));
     const auto bound = [&] { return best.size() < kDescents ? kNoLimit : best.back().score; };
@@ -1008,12 +1006,7 @@ class Packer {
       for (size_t j = i + 1; j < layout.size(); ++j) {
         const Shape& b = shapes_[layout[j].part][layout[j].shape];
         if (boxesApart(a, layout[i].at, b, layout[j].at)) continue;
-        ClipperLib::Clipper clipper;
-        clipper.AddPath(translatedPath(a.core, layout[i].at), ClipperLib::ptSubject, true);
-        clipper.AddPath(translatedPath(b.core, layout[j].at), ClipperLib::ptClip, true);
-        Paths common;
-        clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-        for (const Path& path : common) {
+        for (const Path& path : intersectionOf(a.core, layout[i].at, b.core, layout[j].at)) {
           if (std::abs(ClipperLib::Area(path)) > 1.0) return false;
         }
       }
@@ -1318,9 +1311,12 @@ class Packer {
   // What two placed grown shapes have in common (nothing when their boxes are apart).
   Paths common(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) const {
     if (boxesApart(a, atA, b, atB)) return {};
+    return intersectionOf(a.grown, atA, b.grown, atB);
+  }
+  static Paths intersectionOf(const Path& a, IntPoint atA, const Path& b, IntPoint atB) {
     ClipperLib::Clipper clipper;
-    clipper.AddPath(translatedPath(a.grown, atA), ClipperLib::ptSubject, true);
-    clipper.AddPath(translatedPath(b.grown, atB), ClipperLib::ptClip, true);
+    clipper.AddPath(translatedPath(a, atA), ClipperLib::ptSubject, true);
+    clipper.AddPath(translatedPath(b, atB), ClipperLib::ptClip, true);
     Paths out;
     clipper.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
     return out;
