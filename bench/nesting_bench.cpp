@@ -8,9 +8,10 @@
 // bound ceil(part area / usable bed area) and the utilisation of every sheet but the last (target: at least 75%),
 // beside the same parts through libnest2d in convex-hull mode (bench/Libnest2dBaseline.h): we must use fewer sheets.
 //
-//   build/rotafab_nest_bench [SECONDS [SVG_DIR]]
+//   build/rotafab_nest_bench [SECONDS [SVG_DIR [ONLY]]]
 //     SECONDS: improvement budget per instance (default 60); SVG_DIR: also
-//     draw each layout there (NAME.svg), to look at.
+//     draw each layout there (NAME.svg), to look at; ONLY: run only the
+//     instances whose name holds it (e.g. "strips").
 
 #include <fmt/format.h>
 
@@ -21,6 +22,8 @@
 #include <numbers>
 #include <random>
 #include <string>
+
+#include <clipper.hpp>
 
 #include "bench/Libnest2dBaseline.h"
 #include "jobs/LayoutSvg.h"
@@ -80,6 +83,22 @@ Polygon2 wavyStrip(std::mt19937& random) {
   return p;
 }
 
+// The area of a part grown by `by` on every side (round corners): what it
+// takes of a bed with the spacing, half of it on each of two neighbours.
+double grownArea(const Polygon2& outline, double by) {
+  constexpr double kScale = 1e4;
+  ClipperLib::Path path;
+  for (const Point2& p : outline) path.emplace_back(std::llround(p.x() * kScale), std::llround(p.y() * kScale));
+  ClipperLib::ClipperOffset offset;
+  offset.ArcTolerance = 1;
+  offset.AddPath(path, ClipperLib::jtRound, ClipperLib::etClosedPolygon);
+  ClipperLib::Paths out;
+  offset.Execute(out, by * kScale);
+  double area = 0;
+  for (const auto& p : out) area += ClipperLib::Area(p);
+  return std::abs(area) / (kScale * kScale);
+}
+
 void run(const std::string& name, const std::vector<NestingPart>& parts, double seconds, const char* svgDir) {
   NestingOptions options;  // the workshop bed: 31.5 x 17.5 usable, 1/16 in spacing
   options.seconds = seconds;
@@ -106,6 +125,12 @@ void run(const std::string& name, const std::vector<NestingPart>& parts, double 
              100 * (result.sheets > 1 ? worst : areaOnSheet[0] / usable), elapsed, result.evaluations,
              problems.empty() ? "" : " INVALID: " + problems.front());
   fmt::print("  per sheet: {}\n", perSheet);
+  // What the spacing costs: at 75% of a bed in parts, the parts grown by
+  // half the spacing cover this much of it.
+  double grown = 0;
+  for (const auto& p : parts) grown += grownArea(p.outline, options.spacing / 2);
+  fmt::print("  grown by half the spacing, the parts take {:.1f}% more area: 75% in parts is {:.1f}% of the bed\n",
+             100 * (grown / result.partArea - 1), 75 * grown / result.partArea);
   const auto baseline = rotafab::bench::nestWithLibnest2d(parts, options);
   std::string baselineSheets;
   for (size_t s = 0; s < baseline.sheetArea.size(); ++s) {
@@ -129,8 +154,10 @@ int main(int argc, char** argv) {
   for (int i = 0; i < 200; ++i)
     panels.push_back({fmt::format("panel {}", i + 1), vertexPanel(random), {0, 90, 180, 270}, i});
   const char* svgDir = argc > 2 ? argv[2] : nullptr;
-  run("200 vertex panels", panels, seconds, svgDir);
-  run("100 wavy strips", strips, seconds, svgDir);
-  run("200 spiky stars", stars, seconds, svgDir);
+  const std::string only = argc > 3 ? argv[3] : "";
+  for (const auto& [name, parts] : {std::pair{"200 vertex panels", &panels}, std::pair{"100 wavy strips", &strips},
+                                    std::pair{"200 spiky stars", &stars}}) {
+    if (std::string(name).find(only) != std::string::npos) run(name, *parts, seconds, svgDir);
+  }
   return 0;
 }
