@@ -1,0 +1,191 @@
+#include "geometry/PanelUnfolding.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rotafab::geometry {
+
+double signedArea(const std::vector<Point2>& polygon) {
+  double twice = 0;
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[(i + 1) % polygon.size()];
+    twice += a.x() * b.y() - b.x() * a.y();
+  }
+  return twice / 2;
+}
+
+namespace {
+
+double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// The point at distances `fromP` and `fromQ` from p and q, on the other side
+// of the line pq from `away`.
+Point2 apex(const Point2& p, const Point2& q, double fromP, double fromQ, const Point2& away) {
+  const Point2 base = q - p;
+  const double length = base.norm();
+  const Point2 along = base / length, normal(-along.y(), along.x());
+  const double x = (fromP * fromP - fromQ * fromQ + length * length) / (2 * length);
+  const double h = std::sqrt(std::max(0.0, fromP * fromP - x * x));
+  const double side = cross(base, away - p) > 0 ? -1.0 : 1.0;
+  return p + x * along + side * h * normal;
+}
+
+// Develops `band` from its side on the panel's vertex band (its two points
+// already placed in `points`), triangle by triangle from that end.
+void develop(const EdgeBand& band, bool fromA, std::vector<Point2>& points, const Point2& inside) {
+  const auto triangles = band.triangles();
+  const int count = static_cast<int>(triangles.size());
+  std::vector<char> placed(points.size(), 0);
+  const int k = band.segments();
+  placed[fromA ? 0 : k] = placed[fromA ? k + 1 : 2 * k + 1] = 1;
+  Point2 away = inside;
+  std::array<int, 3> previous{-1, -1, -1};
+  for (int step = 0; step < count; ++step) {
+    const std::array<int, 3>& t = triangles[fromA ? step : count - 1 - step];
+    int fresh = -1;
+    std::vector<int> shared;
+    for (int i : t) {
+      if (placed[i]) {
+        shared.push_back(i);
+      } else {
+        fresh = i;
+      }
+    }
+    if (previous[0] >= 0) {
+      for (int i : previous) {
+        if (i != shared[0] && i != shared[1]) away = points[i];
+      }
+    }
+    const int p = shared[0], q = shared[1];
+    points[fresh] = apex(points[p], points[q], (band.point(fresh) - band.point(p)).norm(),
+                         (band.point(fresh) - band.point(q)).norm(), away);
+    placed[fresh] = 1;
+    previous = t;
+  }
+}
+
+// Whether segments ab and cd cross at a point inside both (touching and
+// collinear overlaps excluded: pieces of a panel meet along shared sides and at shared corners).
+bool properlyCross(const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  const double scale = 1e-12 * std::max((b - a).squaredNorm(), (d - c).squaredNorm());
+  return ((d1 > scale && d2 < -scale) || (d1 < -scale && d2 > scale)) &&
+         ((d3 > scale && d4 < -scale) || (d3 < -scale && d4 > scale));
+}
+
+bool inside(const std::vector<Point2>& polygon, const Point2& p) {
+  bool in = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+bool outlinesCross(const std::vector<Point2>& a, const std::vector<Point2>& b) {
+  for (size_t i = 0; i < a.size(); ++i) {
+    for (size_t j = 0; j < b.size(); ++j) {
+      if (properlyCross(a[i], a[(i + 1) % a.size()], b[j], b[(j + 1) % b.size()])) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decomposition,
+                      const std::vector<EdgeBand>& bands, int face) {
+  FlatPanel panel;
+  panel.face = face;
+  const VertexBand& vb = decomposition.vertexBands[face];
+  panel.origin = vb.centroid;
+  panel.xAxis = (vb.corners[1] - vb.corners[0]).normalized();
+  panel.yAxis = vb.normal.cross(panel.xAxis).normalized();
+  for (const Point3& p : vb.corners) {
+    panel.vertexBand.emplace_back((p - panel.origin).dot(panel.xAxis), (p - panel.origin).dot(panel.yAxis));
+  }
+  const int sides = static_cast<int>(vb.corners.size());
+  Dart d = rs.faceDart(face);
+  for (int side = 0; side < sides; ++side, d = rs.faceNext(d)) {
+    const Point2& from = panel.vertexBand[side];
+    const Point2& to = panel.vertexBand[(side + 1) % sides];
+    const int e = RotationSystem::edgeOf(d);
+    panel.outline.push_back(from);
+    if (rs.isBoundaryEdge(e)) {
+      panel.bandOfSide.push_back(-1);
+      continue;
+    }
+    const EdgeBand& band = bands[e];
+    const int k = band.segments();
+    FlatBand flat;
+    flat.edge = e;
+    flat.fromA = d == 2 * e;
+    flat.points.resize(2 * k + 2);
+    // On face A the side runs u -> v (rail U from `from`); on face B, v -> u.
+    if (flat.fromA) {
+      flat.points[0] = from, flat.points[k + 1] = to;
+    } else {
+      flat.points[2 * k + 1] = from, flat.points[k] = to;
+    }
+    const Point2 along = to - from;
+    develop(band, flat.fromA, flat.points, (from + to) / 2 + Point2(-along.y(), along.x()));
+    // From `from` out along its rail, across the far end, back along the other rail.
+    const auto railPoint = [&](bool railU, int i) { return flat.points[railU ? i : k + 1 + i]; };
+    const bool outRailU = flat.fromA;
+    std::vector<int> out(k + 1);
+    for (int i = 0; i <= k; ++i) out[i] = flat.fromA ? i : k - i;
+    flat.outline.push_back(from);
+    for (int i = 1; i <= k; ++i) flat.outline.push_back(railPoint(outRailU, out[i]));
+    for (int i = k; i >= 0; --i) flat.outline.push_back(railPoint(!outRailU, out[i]));
+    // Closed by the side from `to` back to `from`: counter-clockwise, as the panel's outline runs.
+    panel.outline.insert(panel.outline.end(), flat.outline.begin() + 1, flat.outline.end() - 1);
+    panel.bandOfSide.push_back(static_cast<int>(panel.bands.size()));
+    panel.bands.push_back(std::move(flat));
+  }
+  return panel;
+}
+
+std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel, const std::vector<EdgeBand>& bands) {
+  std::vector<std::pair<int, int>> result;
+  const int n = static_cast<int>(panel.bands.size());
+  // A band folded over: a developed triangle turned the other way round.
+  for (int i = 0; i < n; ++i) {
+    const FlatBand& flat = panel.bands[i];
+    bool folded = false;
+    for (const auto& t : bands[flat.edge].triangles()) {
+      // The triangles run clockwise on every panel (see DevelopableBands.h).
+      folded = folded || cross(flat.points[t[1]] - flat.points[t[0]], flat.points[t[2]] - flat.points[t[0]]) >= 0;
+    }
+    const auto& o = flat.outline;
+    bool selfCrossing = false;
+    for (size_t a = 0; a < o.size() && !selfCrossing; ++a) {
+      for (size_t b = a + 2; b < o.size() && !selfCrossing; ++b) {
+        if (a == 0 && b + 1 == o.size()) continue;
+        selfCrossing = properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()]);
+      }
+    }
+    if (folded || selfCrossing) result.emplace_back(i, i);
+  }
+  const auto piece = [&](int i) -> const std::vector<Point2>& {
+    return i < 0 ? panel.vertexBand : panel.bands[i].outline;
+  };
+  const auto middle = [&](int i) {
+    const auto& o = piece(i);
+    return i < 0 ? Point2((o[0] + o[1] + o[2]) / 3) : Point2((o[o.size() / 2] + o[o.size() / 2 - 1]) / 2);
+  };
+  for (int i = -1; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      if (outlinesCross(piece(i), piece(j)) || inside(piece(i), middle(j)) || inside(piece(j), middle(i))) {
+        result.emplace_back(i, j);
+      }
+    }
+  }
+  return result;
+}
+
+}  // namespace rotafab::geometry
