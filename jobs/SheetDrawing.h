@@ -4,7 +4,7 @@
 // each path tagged with its operation and listed in cutting order. The EPS,
 // SVG and DXF writers turn a SheetDrawing into files that describe exactly the
 // same geometry. The planner (nesting, kerf, ordering) produces it; labels
-// arrive already turned into single-stroke polylines (HersheyFont.h).
+// arrive already turned into single-stroke polylines (geometry/HersheyFont.h).
 
 #include <Eigen/Core>
 #include <map>

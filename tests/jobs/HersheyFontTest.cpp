@@ -2,7 +2,7 @@
 // ASCII, scaled to the capital height, set along any direction; and the mark
 // that tells 6 from 9 on a panel seen upside down.
 
-#include "jobs/HersheyFont.h"
+#include "geometry/HersheyFont.h"
 
 #include <gtest/gtest.h>
 
@@ -12,6 +12,8 @@
 
 namespace rotafab::jobs::test {
 namespace {
+
+using namespace rotafab::geometry;  // the font is geometry's (SPEC: single-stroke labels)
 
 const HersheyFont& font() { return HersheyFont::simplex(); }
 

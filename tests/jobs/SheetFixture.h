@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "TestSupport.h"
-#include "jobs/HersheyFont.h"
+#include "geometry/HersheyFont.h"
 #include "jobs/SheetDrawing.h"
 
 namespace rotafab::jobs::test {
@@ -68,7 +68,7 @@ inline SheetDrawing sampleSheet() {
       {Operation::Cut, {{10.1234567, 2.5}, {13.6543219, 2.5}, {13.6543219, 6.25}, {10.1234567, 6.25}}, true});
   sheet.paths.push_back({Operation::Score, {{16.2, 3.3}, {20.7, 8.1}, {22.05, 3.9}}, false});
   sheet.paths.push_back({Operation::Score, {{16.0, 12.0}, {24.5, 14.75}}, false});
-  for (auto& stroke : HersheyFont::simplex().strokes("12", Point2(3.0, 12.0), 0.5, 0.0))
+  for (auto& stroke : geometry::HersheyFont::simplex().strokes("12", Point2(3.0, 12.0), 0.5, 0.0))
     sheet.paths.push_back({Operation::Etch, stroke, false});
   sheet.paths.push_back({Operation::Outline, {{0.5, 0.75}, {27.3, 0.75}, {27.3, 16.9}, {0.5, 16.9}}, true});
   return sheet;

@@ -1,4 +1,4 @@
-#include "jobs/HersheyFont.h"
+#include "geometry/HersheyFont.h"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <stdexcept>
 
-namespace rotafab::jobs {
+namespace rotafab::geometry {
 namespace {
 
 constexpr int kFirstCharacter = 32;  // the first record is the space
@@ -184,4 +184,4 @@ std::vector<Polyline> labelStrokes(const HersheyFont& font, std::string_view lab
   return font.strokes(labelText(label), origin, height, angleRadians);
 }
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::geometry

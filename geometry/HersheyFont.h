@@ -37,7 +37,7 @@
 #include <string_view>
 #include <vector>
 
-namespace rotafab::jobs {
+namespace rotafab::geometry {
 
 using Point2 = Eigen::Vector2d;  // as in SheetDrawing.h: inches
 using Polyline = std::vector<Point2>;
@@ -94,4 +94,4 @@ std::string labelText(std::string_view label);
 std::vector<Polyline> labelStrokes(const HersheyFont& font, std::string_view label, Point2 origin, double height,
                                    double angleRadians = 0);
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::geometry
