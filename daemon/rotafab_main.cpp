@@ -7,6 +7,7 @@
 
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
+#include "daemon/MakeCommand.h"
 #include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
 
@@ -20,6 +21,7 @@ int main(int argc, char** argv) {
       "examples/bunny.obj");
   int status = kSuccess;
   addInspectCommand(app, status);
+  addMakeCommand(app, status);
   addNestCommand(app, status);
   addProfilesCommand(app, status);
   try {

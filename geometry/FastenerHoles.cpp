@@ -1,0 +1,167 @@
+#include "geometry/FastenerHoles.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+
+namespace rotafab::geometry {
+
+Point3 BandPoint::inSpace(const EdgeBand& band) const {
+  return weights[0] * band.point(corners[0]) + weights[1] * band.point(corners[1]) +
+         weights[2] * band.point(corners[2]);
+}
+
+Point2 BandPoint::onPanel(const FlatBand& copy) const {
+  return weights[0] * copy.points[corners[0]] + weights[1] * copy.points[corners[1]] +
+         weights[2] * copy.points[corners[2]];
+}
+
+const FlatBand* bandCopy(const FlatPanel& panel, int edge) {
+  for (const FlatBand& band : panel.bands) {
+    if (band.edge == edge) return &band;
+  }
+  return nullptr;
+}
+
+double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p) {
+  double nearest = std::numeric_limits<double>::max();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[(i + 1) % polygon.size()];
+    const Point2 ab = b - a;
+    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (a + t * ab - p).norm());
+  }
+  return nearest;
+}
+
+bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p) {
+  bool in = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
+namespace {
+
+// The band point at (s, t) of a flat copy: s from the first face's side
+// (0) to the second's (1) along the rails, t from rail U (0) to rail V (1).
+std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, double s, double t) {
+  const int k = band.segments();
+  const double x = s * k;
+  const int i = std::min(static_cast<int>(x), k - 1);
+  const double along = x - i;
+  const Point2 u = (1 - along) * copy.points[i] + along * copy.points[i + 1];
+  const Point2 v = (1 - along) * copy.points[k + 1 + i] + along * copy.points[k + 2 + i];
+  const Point2 p = (1 - t) * u + t * v;
+  std::optional<BandPoint> best;
+  double bestLeast = -1e-9;
+  for (const auto& tri : band.triangles()) {
+    const Point2 a = copy.points[tri[0]], b = copy.points[tri[1]], c = copy.points[tri[2]];
+    const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+    if (std::abs(area) < 1e-18) continue;
+    const double wb = ((p - a).x() * (c - a).y() - (p - a).y() * (c - a).x()) / area;
+    const double wc = ((b - a).x() * (p - a).y() - (b - a).y() * (p - a).x()) / area;
+    const Eigen::Vector3d w(1 - wb - wc, wb, wc);
+    if (w.minCoeff() > bestLeast) {
+      bestLeast = w.minCoeff();
+      best = BandPoint{tri, w};
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
+                                          double diameter) {
+  std::vector<BandHoles> result(bands.size());
+  std::vector<std::vector<Point2>> holesOn(panels.size());  // centres placed so far, per panel
+  const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
+  for (const EdgeBand& band : bands) {
+    if (band.edge < 0) continue;
+    const FlatBand* copies[2] = {bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)};
+    const int faces[2] = {band.faceA, band.faceB};
+    const FlatBand& flat = copies[0]->fromA ? *copies[0] : *copies[1];
+    const int k = band.segments();
+    const double length =
+        ((flat.points[0] + flat.points[k + 1]) / 2 - (flat.points[k] + flat.points[2 * k + 1]) / 2).norm();
+    const double width =
+        ((flat.points[k + 1] - flat.points[0]).norm() + (flat.points[2 * k + 1] - flat.points[k]).norm()) / 2;
+    // The least clearance of a set of holes on both copies (negative: one is off the panel).
+    const auto clearance = [&](const std::vector<BandPoint>& holes) {
+      double least = std::numeric_limits<double>::max();
+      for (int c = 0; c < 2; ++c) {
+        const FlatPanel& panel = panels[faces[c]];
+        for (size_t h = 0; h < holes.size(); ++h) {
+          const Point2 at = holes[h].onPanel(*copies[c]);
+          if (!insidePolygon(panel.outline, at)) return -1.0;
+          least = std::min(least, distanceToOutline(panel.outline, at) / fromOutline);
+          for (const Point2& other : holesOn[faces[c]]) least = std::min(least, (other - at).norm() / fromHole);
+          for (size_t g = 0; g < h; ++g) least = std::min(least, (holes[g].onPanel(*copies[c]) - at).norm() / fromHole);
+        }
+      }
+      return least;  // >= 1: every distance kept
+    };
+    const auto layout = [&](HoleLayout kind, double spread) {
+      std::vector<BandPoint> holes;
+      const auto add = [&](double s, double t) {
+        if (auto p = locate(band, flat, s, t)) holes.push_back(*p);
+      };
+      if (kind == HoleLayout::Along) add(0.5 - spread, 0.5), add(0.5 + spread, 0.5);
+      if (kind == HoleLayout::Across) add(0.5, 0.5 - spread), add(0.5, 0.5 + spread);
+      if (kind == HoleLayout::Single) add(0.5, 0.5);
+      return holes;
+    };
+    const HoleLayout preferred = length >= width ? HoleLayout::Along : HoleLayout::Across;
+    const HoleLayout other = preferred == HoleLayout::Along ? HoleLayout::Across : HoleLayout::Along;
+    BandHoles& placed = result[band.edge];
+    placed.edge = band.edge;
+    for (HoleLayout kind : {preferred, other}) {
+      for (double spread : {0.3, 0.25, 0.2, 0.15, 0.1}) {
+        auto holes = layout(kind, spread);
+        if (holes.size() == 2 && clearance(holes) >= 1) {
+          placed.layout = kind, placed.holes = std::move(holes);
+          break;
+        }
+      }
+      if (!placed.holes.empty()) break;
+    }
+    if (placed.holes.empty()) {
+      // One hole: the middle, or the point of most clearance on a grid over the band.
+      double most = -1;
+      for (double s = 0.2; s <= 0.801; s += 0.05) {
+        for (double t = 0.2; t <= 0.801; t += 0.05) {
+          std::vector<BandPoint> holes;
+          if (auto p = locate(band, flat, s, t)) holes = {*p};
+          if (holes.empty()) continue;
+          const double c = clearance(holes) - 1e-3 * (std::abs(s - 0.5) + std::abs(t - 0.5));  // the middle on a tie
+          if (c > most) most = c, placed.holes = holes;
+        }
+      }
+      placed.layout = HoleLayout::Single;
+      placed.clearance = std::min(kClearance, most * kClearance);
+      if (most < kLeastClearance / kClearance) {
+        throw std::invalid_argument(fmt::format(
+            "edge {}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole even {} diameters "
+            "from every outline; use a smaller --fastener or a larger --size",
+            band.edge, length, width, diameter, kLeastClearance));
+      }
+    }
+    for (int c = 0; c < 2; ++c) {
+      for (const BandPoint& h : placed.holes) holesOn[faces[c]].push_back(h.onPanel(*copies[c]));
+    }
+  }
+  return result;
+}
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,64 @@
+#pragma once
+// Fastener holes on the edge bands (dissertation V.5). The two copies of a
+// band overlap in the structure and are fastened through holes of the
+// fastener's diameter, placed adaptively: two along a long thin band, two
+// across a wide short one, one on a band too small for two.
+//
+// A hole is a point of the band's surface, its triangle and barycentric
+// coordinates: both copies are developments of the same triangles
+// (PanelUnfolding.h), so the hole is at the same place in space on both,
+// and the holes of a band are the same distance apart on both panels.
+//
+// Clearance: every hole's centre at least kClearance diameters from the cut
+// outline of each panel it is on, and from any other hole's centre on that
+// panel at least that plus one diameter (the same 1.5 diameters of material
+// between their rims). Among the layouts that keep it, the one that spreads
+// the holes widest. A band too narrow for that (at the default scale, a
+// mean edge of 2 in, a few of the bunny's 5511 bands and every band of a
+// cube are about 1/3 in wide, under 3 diameters of a 1/8 in fastener) gets
+// one hole where it keeps the most clearance, if that is at least
+// kLeastClearance diameters; the caller warns (BandHoles::clearance).
+
+#include <array>
+#include <vector>
+
+#include "geometry/PanelUnfolding.h"
+
+namespace rotafab::geometry {
+
+constexpr double kClearance = 1.5, kLeastClearance = 0.75;
+
+// A point of an edge band: a triangle (EdgeBand::triangles() indices) and weights.
+struct BandPoint {
+  std::array<int, 3> corners{};
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+
+  [[nodiscard]] Point3 inSpace(const EdgeBand& band) const;
+  [[nodiscard]] Point2 onPanel(const FlatBand& copy) const;
+};
+
+enum class HoleLayout { Along, Across, Single };
+
+struct BandHoles {
+  int edge = -1;
+  HoleLayout layout = HoleLayout::Single;
+  std::vector<BandPoint> holes;   // one fastener each
+  double clearance = kClearance;  // diameters kept from the outlines, when less than kClearance
+};
+
+// One entry per edge (boundary edges: edge -1, no holes). `panels` indexed
+// by face. Throws std::invalid_argument naming the edge when not even one
+// hole keeps kLeastClearance.
+std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
+                                          double diameter);
+
+// The copy of edge `edge`'s band on `panel`, or nullptr.
+const FlatBand* bandCopy(const FlatPanel& panel, int edge);
+
+// The distance from `p` to the nearest side of a closed polygon.
+double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p);
+
+// Whether `p` is inside a closed polygon (even-odd).
+bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p);
+
+}  // namespace rotafab::geometry

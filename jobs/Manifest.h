@@ -1,0 +1,40 @@
+#pragma once
+// The assembly manifest (SPEC "manifest.json", version 1): what the builders
+// follow, step by step in flood-fill order (dissertation V.5), and what the
+// cutter's operator needs, sheet by sheet. Built from a band structure and
+// its sheet plan; printed as text (manifest.txt, `rotafab manifest`).
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "geometry/BandStructure.h"
+#include "jobs/Part.h"
+#include "jobs/SheetPlanner.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::jobs {
+
+struct MeshCounts {
+  int vertices = 0, edges = 0, faces = 0;
+  std::optional<int> genus;
+};
+
+// The band panels as parts for the planner: outline, holes (polygons of
+// kHoleSides sides through the circle's points, so the fastener still
+// passes), labels to etch, folds to score; assembly order = panel id - 1.
+constexpr int kHoleSides = 32;
+std::vector<Part> bandParts(const geometry::BandStructure& structure);
+
+// `files[s]`: the files written for sheet s + 1.
+nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, const MeshCounts& mesh,
+                                    const profiles::Bed& bed, const SheetPlan& plan,
+                                    const std::vector<std::vector<std::string>>& files);
+
+// The assembly steps as text: for each panel in flood-fill order, its sheet,
+// the panels already placed that it joins and the edge numbers to fasten
+// with the fasteners of each; totals at the end. Throws
+// std::invalid_argument naming the first key that is missing or wrong.
+std::string manifestText(const nlohmann::json& manifest);
+
+}  // namespace rotafab::jobs

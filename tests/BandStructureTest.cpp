@@ -1,0 +1,217 @@
+// Band structures end to end in geometry (dissertation V.5): fastener holes,
+// labels and flood-fill numbering on the panels of buildBandStructure().
+
+#include "geometry/BandStructure.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include "geometry/BandDecomposition.h"
+#include "geometry/DevelopableBands.h"
+#include "geometry/FastenerHoles.h"
+#include "geometry/FloodFill.h"
+#include "geometry/MeshAnalysis.h"
+#include "geometry/MeshImport.h"
+#include "geometry/PanelUnfolding.h"
+#include "geometry/Primitives.h"
+
+namespace rotafab::geometry {
+namespace {
+
+PolygonMesh atConstructionSize(PolygonMesh mesh) {
+  analyzeMesh(mesh);
+  const double scale = constructionScale(mesh, std::nullopt, std::nullopt);
+  for (Point3& p : mesh.positions) p *= scale;
+  return mesh;
+}
+
+std::map<std::string, PolygonMesh> meshes() {
+  return {{"soccer ball", atConstructionSize(truncatedIcosahedron())},
+          {"torus", atConstructionSize(torus(10, 6))},
+          {"genus 2", atConstructionSize(genusTwoSlab())},
+          {"disc", atConstructionSize(disc(7))},
+          {"bunny", atConstructionSize(importMesh(std::string(ROTAFAB_SOURCE_DIR) + "/examples/bunny.obj").mesh)}};
+}
+
+// Both copies of every band carry its holes: the same number, the same
+// distances apart, and at the same points in space.
+TEST(BandStructure, HolesOfBothCopiesCoincideInSpace) {
+  for (auto& [name, mesh] : meshes()) {
+    const RotationSystem rs = RotationSystem::fromMesh(mesh);
+    const BandDecomposition decomposition = bandDecomposition(mesh, rs);
+    const auto bands = developableBands(rs, decomposition);
+    std::vector<FlatPanel> panels;
+    for (int f = 0; f < mesh.faceCount(); ++f) panels.push_back(unfoldPanel(rs, decomposition, bands, f));
+    const auto holes = placeFastenerHoles(bands, panels, 0.125);
+    for (const EdgeBand& band : bands) {
+      if (band.edge < 0) continue;
+      const BandHoles& h = holes[band.edge];
+      ASSERT_FALSE(h.holes.empty()) << name << ": edge " << band.edge;
+      const FlatBand* a = bandCopy(panels[band.faceA], band.edge);
+      const FlatBand* b = bandCopy(panels[band.faceB], band.edge);
+      ASSERT_TRUE(a && b);
+      for (size_t i = 0; i < h.holes.size(); ++i) {
+        // In space the hole is one point of the band; on each panel it lies
+        // where that point unfolds to: as far from its triangle's corners as in space.
+        const Point2 onA = h.holes[i].onPanel(*a), onB = h.holes[i].onPanel(*b);
+        const Point3 point = h.holes[i].inSpace(band);
+        for (int corner : h.holes[i].corners) {
+          const double inSpace = (band.point(corner) - point).norm();
+          EXPECT_NEAR((a->points[corner] - onA).norm(), inSpace, 1e-9) << name << ": edge " << band.edge;
+          EXPECT_NEAR((b->points[corner] - onB).norm(), inSpace, 1e-9) << name << ": edge " << band.edge;
+        }
+        for (size_t j = 0; j < i; ++j) {
+          const double onPanelA = (h.holes[j].onPanel(*a) - onA).norm();
+          const double onPanelB = (h.holes[j].onPanel(*b) - onB).norm();
+          const double inSpace = (h.holes[j].inSpace(band) - point).norm();
+          EXPECT_NEAR(onPanelA, onPanelB, 1e-9) << name << ": edge " << band.edge;
+          // Within a flat band the straight distance in space is at most the flat one.
+          EXPECT_LE(inSpace, onPanelA + 1e-9) << name;
+        }
+        // Each hole's distances to the band's four corner points are the same on both copies.
+        const int k = band.segments();
+        for (int corner : {0, k, k + 1, 2 * k + 1}) {
+          EXPECT_NEAR((a->points[corner] - onA).norm(), (b->points[corner] - onB).norm(), 1e-9) << name;
+        }
+      }
+    }
+  }
+}
+
+TEST(BandStructure, HolesKeepTheirClearanceAndTheBandsTheirFasteners) {
+  for (auto& [name, mesh] : meshes()) {
+    BandOptions options;
+    const BandStructure s = buildBandStructure(mesh, options);
+    ASSERT_EQ(s.panels.size(), static_cast<size_t>(mesh.faceCount())) << name;
+    std::map<int, std::vector<std::pair<int, std::vector<Point2>>>> holesOfEdge;  // edge -> (panel, holes)
+    int holes = 0;
+    for (const Panel& panel : s.panels) {
+      std::map<int, std::vector<Point2>> mine;
+      for (const PanelHole& hole : panel.holes) {
+        mine[hole.edge].push_back(hole.xy);
+        ++holes;
+        EXPECT_TRUE(insidePolygon(panel.outline, hole.xy)) << name << ": panel " << panel.id;
+        EXPECT_GE(distanceToOutline(panel.outline, hole.xy), kLeastClearance * options.fastener - 1e-9)
+            << name << ": panel " << panel.id << ", edge " << hole.edge;
+      }
+      for (auto& [edge, points] : mine) holesOfEdge[edge].emplace_back(panel.id, points);
+    }
+    EXPECT_EQ(holes, 2 * s.fasteners) << name;
+    EXPECT_EQ(static_cast<int>(holesOfEdge.size()), s.interiorEdges) << name;
+    for (const auto& [edge, copies] : holesOfEdge) {
+      ASSERT_EQ(copies.size(), 2u) << name << ": edge " << edge;
+      ASSERT_EQ(copies[0].second.size(), copies[1].second.size()) << name << ": edge " << edge;
+      if (copies[0].second.size() == 2) {
+        EXPECT_NEAR((copies[0].second[0] - copies[0].second[1]).norm(),
+                    (copies[1].second[0] - copies[1].second[1]).norm(), 1e-9)
+            << name << ": edge " << edge;
+      }
+    }
+  }
+}
+
+// Wide enough bands (the soccer ball's and the torus's at 2 in edges) all get
+// two holes, 1.5 diameters clear: fasteners = 2 x interior edges.
+TEST(BandStructure, WideBandsGetTwoHolesWithTheFullClearance) {
+  for (const char* name : {"soccer ball", "torus"}) {
+    const PolygonMesh mesh = meshes()[name];
+    BandOptions options;
+    const BandStructure s = buildBandStructure(mesh, options);
+    EXPECT_EQ(s.fasteners, 2 * s.interiorEdges) << name;
+    for (const Panel& panel : s.panels) {
+      for (const PanelHole& hole : panel.holes) {
+        EXPECT_GE(distanceToOutline(panel.outline, hole.xy), kClearance * options.fastener - 1e-9) << name;
+        for (const PanelHole& other : panel.holes) {
+          if (&other != &hole) {
+            EXPECT_GE((other.xy - hole.xy).norm(), (kClearance + 1) * options.fastener - 1e-9) << name;
+          }
+        }
+      }
+    }
+    EXPECT_TRUE(s.warnings.empty()) << name << ": " << s.warnings.front();
+  }
+}
+
+// A cube at 2 in edges has bands 1/3 in wide: one hole each, reported.
+TEST(BandStructure, NarrowBandsGetOneHoleAndAWarning) {
+  BandOptions options;
+  const BandStructure s = buildBandStructure(atConstructionSize(cube()), options);
+  EXPECT_EQ(s.fasteners, s.interiorEdges);
+  ASSERT_FALSE(s.warnings.empty());
+  EXPECT_NE(s.warnings.front().find("12 bands are too narrow"), std::string::npos) << s.warnings.front();
+  options.fastener = 0.5;  // no room even for one
+  EXPECT_THROW(buildBandStructure(atConstructionSize(cube()), options), std::invalid_argument);
+}
+
+TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
+  for (auto& [name, mesh] : meshes()) {
+    BandOptions options;
+    const BandStructure s = buildBandStructure(mesh, options);
+    for (const Panel& panel : s.panels) {
+      std::set<int> edgeLabels;
+      for (const PanelLabel& label : panel.labels) {
+        for (const Point2& corner : label.box.corners()) {
+          EXPECT_TRUE(insidePolygon(panel.outline, corner)) << name << ": panel " << panel.id << " " << label.text;
+        }
+        for (const auto& stroke : label.strokes) {
+          for (const Point2& p : stroke) EXPECT_TRUE(insidePolygon(panel.outline, p)) << name;
+        }
+        for (const PanelHole& hole : panel.holes) {
+          EXPECT_GE(label.box.distanceTo(hole.xy), hole.diameter / 2) << name << ": panel " << panel.id;
+        }
+        if (label.role == "edge") edgeLabels.insert(label.edge);
+        if (label.role == "panel") {
+          EXPECT_EQ(label.text, labelText(std::to_string(panel.id)));
+        }
+      }
+      if (name != "bunny") {  // a few of the bunny's bands are too small (reported)
+        EXPECT_EQ(edgeLabels.size(), panel.edges.size()) << name << ": panel " << panel.id;
+      }
+    }
+  }
+  const BandStructure ball = buildBandStructure(meshes()["soccer ball"], BandOptions{});
+  EXPECT_EQ(ball.panels[5].labels.back().text, "6.");  // panel 6 is marked against reading as 9
+}
+
+// Flood fill: panel 1 is the lowest face; each later panel joins one
+// numbered before it; numbers are a breadth-first order.
+TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
+  for (auto& [name, mesh] : meshes()) {
+    BandOptions options;
+    const BandStructure s = buildBandStructure(mesh, options);
+    EXPECT_EQ(s.panels.front().face, mesh.sourceFaceIndex(lowestFace(mesh, 1))) << name;
+    int previousParent = 0;
+    for (const Panel& panel : s.panels) {
+      if (panel.id == 1) continue;
+      const int parent = *std::min_element(panel.neighbors.begin(), panel.neighbors.end());
+      EXPECT_LT(parent, panel.id) << name << ": panel " << panel.id << " joins no panel placed before it";
+      EXPECT_GE(parent, previousParent) << name << ": not breadth-first at panel " << panel.id;
+      previousParent = parent;
+    }
+    options.start = s.panels[3].face;
+    EXPECT_EQ(buildBandStructure(mesh, options).panels.front().face, options.start) << name;
+  }
+  BandOptions bad;
+  bad.start = 100000;
+  EXPECT_THROW(buildBandStructure(meshes()["torus"], bad), std::invalid_argument);
+}
+
+TEST(BandStructure, UnfoldingKeepsTheArea) {
+  for (auto& [name, mesh] : meshes()) {
+    const BandStructure s = buildBandStructure(mesh, BandOptions{});
+    for (const Panel& panel : s.panels) {
+      double flat = 0;
+      for (size_t i = 0; i < panel.outline.size(); ++i) {
+        const Point2& a = panel.outline[i];
+        const Point2& b = panel.outline[(i + 1) % panel.outline.size()];
+        flat += (a.x() * b.y() - b.x() * a.y()) / 2;
+      }
+      EXPECT_NEAR(flat, panel.area, 1e-6 * panel.area) << name << ": panel " << panel.id;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rotafab::geometry

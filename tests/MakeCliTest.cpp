@@ -1,0 +1,186 @@
+// `rotafab make MESH --structure band` and `rotafab manifest` through the
+// built program: the files of SPEC, manifest.json as SPEC describes it,
+// sheets Ghostscript reads, exit statuses and one-line errors.
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include "TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+const std::string kCli = ROTAFAB_CLI;
+const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
+
+// A path in single quotes, for the shell.
+std::string quoted(const std::filesystem::path& path) {
+  std::string text = "'";
+  text += path.string();
+  text += '\'';
+  return text;
+}
+
+// One make of the soccer ball for the tests that only read its output.
+const std::filesystem::path& soccerBall() {
+  static TempDir dir;
+  static const bool made = [] {
+    const CommandResult result = run(kCli + " make '" + (kSource / "examples/soccer-ball.obj").string() +
+                                     "' --structure band --time 0.5 --out '" + dir.path().string() + "/out'");
+    EXPECT_EQ(result.status, 0) << result.err;
+    return true;
+  }();
+  EXPECT_TRUE(made);
+  static const auto out = dir.path() / "out";
+  return out;
+}
+
+TEST(MakeCli, WritesEveryFileOfSpec) {
+  const auto out = soccerBall();
+  const nlohmann::json manifest = nlohmann::json::parse(readFile(out / "manifest.json"));
+  const int sheets = static_cast<int>(manifest.at("sheets").size());
+  ASSERT_GE(sheets, 1);
+  for (int s = 1; s <= sheets; ++s) {
+    for (const char* extension : {"eps", "svg", "dxf"}) {
+      char name[32];
+      std::snprintf(name, sizeof name, "sheet-%03d.%s", s, extension);
+      EXPECT_TRUE(std::filesystem::is_regular_file(out / name)) << name;
+    }
+  }
+  for (const char* name : {"manifest.txt", "structure.obj"}) EXPECT_TRUE(std::filesystem::is_regular_file(out / name));
+  // Ghostscript reads every sheet, and its bounding box is the bed, in points.
+  for (int s = 1; s <= sheets; ++s) {
+    char name[32];
+    std::snprintf(name, sizeof name, "sheet-%03d.eps", s);
+    const CommandResult gs = run("gs -q -dNOPAUSE -dBATCH -sDEVICE=bbox '" + (out / name).string() + "'");
+    ASSERT_EQ(gs.status, 0) << gs.err;
+    std::smatch box;
+    ASSERT_TRUE(std::regex_search(gs.err, box, std::regex(R"(%%BoundingBox: (\d+) (\d+) (\d+) (\d+))"))) << gs.err;
+    // (the bbox device rounds outwards, and a hairline reaches half its width past its path)
+    EXPECT_LE(std::stoi(box[3]), 32 * 72 + 1);
+    EXPECT_LE(std::stoi(box[4]), 18 * 72 + 1);
+  }
+  // structure.obj: the 3D panels, a vertex band and the bands' triangles each.
+  const std::string obj = readFile(out / "structure.obj");
+  EXPECT_GT(std::count(obj.begin(), obj.end(), 'f'), 32 * 6);
+}
+
+TEST(MakeCli, ManifestIsSpecsVersionOne) {
+  const nlohmann::json m = nlohmann::json::parse(readFile(soccerBall() / "manifest.json"));
+  EXPECT_EQ(m.at("version"), 1);
+  EXPECT_EQ(m.at("structure"), "band");
+  EXPECT_EQ(m.at("units"), "in");
+  EXPECT_EQ(m.at("mesh"), nlohmann::json::parse(R"({"vertices":60,"edges":90,"faces":32,"genus":0})"));
+  EXPECT_EQ(m.at("bed"), nlohmann::json::parse(R"({"width":32.0,"height":18.0,"margin":0.25})"));
+  EXPECT_EQ(m.at("fasteners"), 180);  // two per band: 2 x 90 interior edges
+  const auto& panels = m.at("panels");
+  ASSERT_EQ(panels.size(), 32u);
+  std::map<int, std::vector<int>> holesOfEdge;  // edge -> hole count per panel
+  std::set<int> faces, onSheets;
+  for (const auto& sheet : m.at("sheets")) {
+    for (const auto& id : sheet.at("panels")) onSheets.insert(id.get<int>());
+  }
+  EXPECT_EQ(onSheets.size(), 32u);
+  for (size_t i = 0; i < panels.size(); ++i) {
+    const auto& p = panels[i];
+    EXPECT_EQ(p.at("id"), static_cast<int>(i) + 1);
+    faces.insert(p.at("source").at("face").get<int>());
+    // The outline: local, counter-clockwise, not closed; placed inside the bed's margins.
+    const auto& outline = p.at("outline");
+    ASSERT_GE(outline.size(), 3u);
+    EXPECT_NE(outline.front(), outline.back());
+    double twice = 0;
+    const double x = p.at("placement").at("x"), y = p.at("placement").at("y");
+    const double turn = p.at("placement").at("rotation").get<double>() * M_PI / 180;
+    for (size_t k = 0; k < outline.size(); ++k) {
+      const double ax = outline[k][0], ay = outline[k][1];
+      const double bx = outline[(k + 1) % outline.size()][0], by = outline[(k + 1) % outline.size()][1];
+      twice += ax * by - bx * ay;
+      const double sx = x + ax * std::cos(turn) - ay * std::sin(turn),
+                   sy = y + ax * std::sin(turn) + ay * std::cos(turn);
+      EXPECT_GE(sx, 0.25 - 1e-3);
+      EXPECT_LE(sx, 32 - 0.25 + 1e-3);
+      EXPECT_GE(sy, 0.25 - 1e-3);
+      EXPECT_LE(sy, 18 - 0.25 + 1e-3);
+    }
+    EXPECT_GT(twice, 0) << "panel " << p.at("id") << " is not counter-clockwise";
+    EXPECT_NEAR(twice / 2, p.at("area").get<double>(), 1e-6 * p.at("area").get<double>());
+    std::map<int, int> mine;
+    for (const auto& hole : p.at("holes")) {
+      ++mine[hole.at("edge").get<int>()];
+      EXPECT_EQ(hole.at("diameter"), 0.125);
+    }
+    for (auto [edge, count] : mine) holesOfEdge[edge].push_back(count);
+    EXPECT_EQ(p.at("neighbors").size(), p.at("edges").size());
+    int edgeLabels = 0;
+    for (const auto& label : p.at("labels")) edgeLabels += label.at("role") == "edge";
+    EXPECT_EQ(edgeLabels, static_cast<int>(p.at("edges").size()));
+  }
+  EXPECT_EQ(faces.size(), 32u);
+  EXPECT_EQ(holesOfEdge.size(), 90u);
+  for (const auto& [edge, counts] : holesOfEdge) {
+    ASSERT_EQ(counts.size(), 2u) << "edge " << edge;
+    EXPECT_EQ(counts[0], counts[1]) << "edge " << edge;
+  }
+}
+
+TEST(MakeCli, ManifestCommandPrintsTheSteps) {
+  const CommandResult text = run(kCli + " manifest '" + soccerBall().string() + "'");
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("step    1: panel 1 (sheet "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("180 fasteners in all"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out, readFile(soccerBall() / "manifest.txt"));
+  const CommandResult json = run(kCli + " manifest '" + soccerBall().string() + "' --format json");
+  ASSERT_EQ(json.status, 0) << json.err;
+  EXPECT_EQ(nlohmann::json::parse(json.out), nlohmann::json::parse(readFile(soccerBall() / "manifest.json")));
+  TempDir dir;
+  const CommandResult missing = run(kCli + " manifest '" + dir.path().string() + "'");
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("manifest.json: cannot read it"), std::string::npos) << missing.err;
+}
+
+TEST(MakeCli, JsonSummaryAndErrors) {
+  TempDir dir;
+  const std::string mesh = quoted(kSource / "examples/soccer-ball.obj");
+  const CommandResult ok =
+      run(kCli + " make " + mesh + " --structure band --time 0 --json --out '" + dir.path().string() + "/a'");
+  ASSERT_EQ(ok.status, 0) << ok.err;
+  const auto summary = nlohmann::json::parse(ok.out);
+  EXPECT_EQ(summary.at("panels"), 32);
+  EXPECT_EQ(summary.at("fasteners"), 180);
+  for (const char* phase : {"import", "geometry", "nesting", "writing"})
+    EXPECT_TRUE(summary.at("seconds").contains(phase));
+
+  const auto fails = [&](const std::string& args, int status, const std::string& says) {
+    const CommandResult r = run(kCli + " make " + args + " --out '" + dir.path().string() + "/bad'");
+    EXPECT_EQ(r.status, status) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    // One error line (progress lines before it are "make: ..."), no stack trace.
+    int errors = 0, others = 0;
+    std::istringstream lines(r.err);
+    for (std::string line; std::getline(lines, line);) {
+      if (line.starts_with("error: "))
+        ++errors;
+      else if (!line.starts_with("make: ") && !line.starts_with("Run `rotafab"))
+        ++others;
+    }
+    EXPECT_EQ(errors, 1) << args << ": " << r.err;
+    EXPECT_EQ(others, 0) << args << ": " << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "bad")) << args << " left files behind";
+  };
+  fails(mesh + " --structure weave", 1, "--structure weave");
+  fails(mesh + " --structure band --tension 1.5", 1, "tension");
+  fails(mesh + " --structure band --start 32", 1, "--start 32");
+  fails(mesh + " --structure band --fastener 2in", 1, "no room for a 2.000 in fastener hole");
+  fails(mesh + " --structure band --fastener big", 1, "--fastener big");
+  fails(quoted(dir.path() / "none.obj") + " --structure band", 1, "none.obj");
+  fails(mesh + " --structure pleat", 2, "--structure");
+}
+
+}  // namespace
+}  // namespace rotafab::test
