@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "geometry/FastenerHoles.h"
 
@@ -51,18 +52,23 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
                                const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
                                const std::vector<Point2>& candidates) {
   const Point2 along(std::cos(angle), std::sin(angle)), up(-along.y(), along.x());
-  // Each candidate's room, whatever the height: a box centred there needs
-  // half its height and the gap between its centre and the outline.
-  std::vector<double> room;
-  for (const Point2& centre : candidates) {
-    room.push_back(insidePolygon(region, centre) && insidePolygon(outline, centre) ? distanceToOutline(outline, centre)
-                                                                                   : -1.0);
-  }
+  // Each candidate's room, whatever the height (worked out when first
+  // needed): a box centred there needs half its height and the gap between
+  // its centre and the outline.
+  std::vector<double> room(candidates.size(), std::numeric_limits<double>::quiet_NaN());
+  const auto roomAt = [&](size_t c) {
+    if (std::isnan(room[c])) {
+      const Point2& centre = candidates[c];
+      room[c] = insidePolygon(region, centre) && insidePolygon(outline, centre) ? distanceToOutline(outline, centre)
+                                                                                : -1.0;
+    }
+    return room[c];
+  };
   for (double height = kLargestLabel; height >= kSmallestLabel - 1e-12; height *= 0.85) {
     const double width = font.advance(text, height);
     const double gap = std::max(kLabelGap, height / 4);
     for (size_t c = 0; c < candidates.size(); ++c) {
-      if (room[c] < height / 2 + gap) continue;
+      if (roomAt(c) < height / 2 + gap) continue;
       const Point2& centre = candidates[c];
       TextBox box{centre - width / 2 * along - height / 2 * up, angle, width, height};
       // The cheap tests first: holes, the corners, then the other labels and the whole perimeter.
