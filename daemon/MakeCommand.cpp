@@ -240,7 +240,8 @@ int runManifest(const std::string& folder, const std::string& format) {
       std::cout << manifest.dump(1) << '\n';
     } else {
       try {
-        std::cout << jobs::manifestText(manifest);
+        std::cout << (format == "html" ? jobs::manifestHtml(manifest, file.parent_path())
+                                       : jobs::manifestText(manifest));
       } catch (const std::invalid_argument& error) {
         throw UserError(fmt::format("{}: {}", file.string(), error.what()));
       }
@@ -306,9 +307,14 @@ void addMakeCommand(CLI::App& app, int& status) {
   auto format = std::make_shared<std::string>("text");
   CLI::App* manifest = app.add_subcommand("manifest", "Print the assembly manifest of a `make` output folder");
   manifest->add_option("DIR", *folder, "The output folder of `rotafab make` (or its manifest.json)")->required();
-  manifest->add_option("--format", *format, "text or json")
+  manifest
+      ->add_option("--format", *format, "text (the steps), json (manifest.json) or html (steps and sheets, to print)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"text", "json"}));
+      ->check(CLI::IsMember({"text", "json", "html"}));
+  manifest->footer(
+      "Examples:\n"
+      "  rotafab manifest bunny-band/\n"
+      "  rotafab manifest bunny-band/ --format html > bunny.html");
   manifest->callback([folder, format, &status] { status = runManifest(*folder, *format); });
 }
 

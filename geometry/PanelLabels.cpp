@@ -9,16 +9,16 @@
 namespace rotafab::geometry {
 
 std::vector<Point2> TextBox::corners() const {
-  const Point2 along(std::cos(angle), std::sin(angle)), up(-along.y(), along.x());
+  const Point2 up(-along.y(), along.x());
   return {origin, origin + width * along, origin + width * along + height * up, origin + height * up};
 }
 
 double TextBox::distanceTo(const Point2& p) const {
-  const Point2 along(std::cos(angle), std::sin(angle)), up(-along.y(), along.x());
+  const Point2 up(-along.y(), along.x());
   const Point2 local((p - origin).dot(along), (p - origin).dot(up));
   const double dx = std::max({0.0, -local.x(), local.x() - width});
   const double dy = std::max({0.0, -local.y(), local.y() - height});
-  return std::hypot(dx, dy);
+  return std::sqrt(dx * dx + dy * dy);
 }
 
 namespace {
@@ -52,36 +52,56 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
                                const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
                                const std::vector<Point2>& candidates) {
   const Point2 along(std::cos(angle), std::sin(angle)), up(-along.y(), along.x());
-  // Each candidate's room, whatever the height (worked out when first
-  // needed): a box centred there needs half its height and the gap between
-  // its centre and the outline.
-  std::vector<double> room(candidates.size(), std::numeric_limits<double>::quiet_NaN());
-  const auto roomAt = [&](size_t c) {
-    if (std::isnan(room[c])) {
-      const Point2& centre = candidates[c];
-      room[c] = insidePolygon(region, centre) && insidePolygon(outline, centre) ? distanceToOutline(outline, centre)
-                                                                                : -1.0;
+  // Only the outline's sides within the largest gap of the region can come
+  // near a box inside it (and the region lies inside the outline).
+  Point2 low = region.front(), high = region.front();
+  for (const Point2& p : region) low = low.cwiseMin(p), high = high.cwiseMax(p);
+  const double reach = std::max(kLabelGap, kLargestLabel / 4);
+  low -= Point2(reach, reach), high += Point2(reach, reach);
+  std::vector<std::pair<Point2, Point2>> sides;
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Point2& a = outline[i];
+    const Point2& b = outline[(i + 1) % outline.size()];
+    if (std::max(a.x(), b.x()) < low.x() || std::min(a.x(), b.x()) > high.x() || std::max(a.y(), b.y()) < low.y() ||
+        std::min(a.y(), b.y()) > high.y()) {
+      continue;
     }
-    return room[c];
+    sides.emplace_back(a, b);
+  }
+  const auto distanceToSides = [&](const Point2& p) {
+    double nearest = std::numeric_limits<double>::max();
+    for (const auto& [a, b] : sides) {
+      const Point2 ab = b - a;
+      const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+      nearest = std::min(nearest, (a + t * ab - p).squaredNorm());
+    }
+    return std::sqrt(nearest);
   };
-  for (double height = kLargestLabel; height >= kSmallestLabel - 1e-12; height *= 0.85) {
+  // Each candidate's room, whatever the height: a box centred there needs
+  // half its height and the gap (at least a quarter of the height) between
+  // its centre and the outline, so no box is taller than the most room / 0.75.
+  std::vector<double> room;
+  double most = 0;
+  for (const Point2& centre : candidates) {
+    room.push_back(insidePolygon(region, centre) ? distanceToSides(centre) : -1.0);
+    most = std::max(most, room.back());
+  }
+  const auto clear = [&](const Point2& p, double gap) { return insidePolygon(region, p) && distanceToSides(p) >= gap; };
+  for (double height = std::min(kLargestLabel, most / 0.75); height >= kSmallestLabel - 1e-12; height *= 0.85) {
     const double width = font.advance(text, height);
     const double gap = std::max(kLabelGap, height / 4);
     for (size_t c = 0; c < candidates.size(); ++c) {
-      if (roomAt(c) < height / 2 + gap) continue;
+      if (room[c] < height / 2 + gap) continue;
       const Point2& centre = candidates[c];
-      TextBox box{centre - width / 2 * along - height / 2 * up, angle, width, height};
+      TextBox box{centre - width / 2 * along - height / 2 * up, angle, width, height, along};
       // The cheap tests first: holes, the corners, then the other labels and the whole perimeter.
-      const auto clear = [&](const Point2& p) {
-        return insidePolygon(region, p) && insidePolygon(outline, p) && distanceToOutline(outline, p) >= gap;
-      };
       bool fits = true;
       for (size_t i = 0; fits && i < holes.size(); ++i) fits = box.distanceTo(holes[i].centre) >= holes[i].radius + gap;
-      for (const Point2& corner : box.corners()) fits = fits && clear(corner);
+      for (const Point2& corner : box.corners()) fits = fits && clear(corner, gap);
       for (size_t i = 0; fits && i < taken.size(); ++i) fits = boxesApart(box, taken[i], gap);
       if (!fits) continue;
       for (const Point2& p : perimeter(box, gap)) {
-        if (!clear(p)) {
+        if (!clear(p, gap)) {
           fits = false;
           break;
         }

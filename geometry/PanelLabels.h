@@ -23,6 +23,7 @@ struct TextBox {
   Point2 origin;
   double angle = 0;  // radians, counter-clockwise from +x
   double width = 0, height = 0;
+  Point2 along{1, 0};  // (cos angle, sin angle), kept to spare the trigonometry in the fitting
 
   [[nodiscard]] std::vector<Point2> corners() const;
   // The distance from p to the box (0 inside).
@@ -34,8 +35,9 @@ struct Circle {
   double radius = 0;
 };
 
-// The largest box of `text` (already marked) that fits inside `region`, inside
-// `outline` and clear of it, of `holes` and of `taken`, reading along `angle`,
+// The largest box of `text` (already marked) that fits inside `region` (a
+// piece of the panel, inside `outline`), clear of `outline`, of `holes` and
+// of `taken`, reading along `angle`,
 // its centre tried at `candidates` in turn for each height. Nothing if none
 // fits at kSmallestLabel.
 std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text, double angle,

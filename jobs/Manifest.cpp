@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -97,38 +98,155 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
   return manifest;
 }
 
+namespace {
+
+// One assembly step: a panel, its sheet, and the panels placed before it
+// that it joins, with the edge and the fasteners of each.
+struct Join {
+  int panel = 0, edge = 0, fasteners = 0;
+};
+struct Step {
+  int panel = 0, sheet = 0;
+  std::vector<Join> joins;
+};
+
+std::vector<Step> stepsOf(const nlohmann::json& manifest) {
+  std::map<int, const nlohmann::json*> byId;
+  for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
+  std::vector<Step> steps;
+  for (const auto& [id, panel] : byId) {
+    const auto& neighbors = panel->at("neighbors");
+    const auto& edges = panel->at("edges");
+    std::map<int, int> holesOfEdge;
+    for (const auto& hole : panel->at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
+    Step step{id, panel->at("sheet").get<int>(), {}};
+    for (size_t j = 0; j < neighbors.size(); ++j) {
+      const int other = neighbors[j].get<int>(), edge = edges.at(j).get<int>();
+      if (other < id) step.joins.push_back({other, edge, holesOfEdge[edge]});
+    }
+    steps.push_back(std::move(step));
+  }
+  return steps;
+}
+
+std::string describeJoins(const Step& step) {
+  if (step.joins.empty()) return "start here, the base";
+  std::string text = "join to ";
+  for (size_t j = 0; j < step.joins.size(); ++j) {
+    const Join& join = step.joins[j];
+    text += fmt::format("{}panel {} at edge {} ({} fastener{})", j ? ", " : "", join.panel, join.edge, join.fasteners,
+                        join.fasteners == 1 ? "" : "s");
+  }
+  return text;
+}
+
+std::string headline(const nlohmann::json& manifest) {
+  const size_t sheets = manifest.at("sheets").size();
+  return fmt::format("{} structure, {} panels on {} sheet{}, {} fasteners", manifest.at("structure").get<std::string>(),
+                     manifest.at("panels").size(), sheets, sheets == 1 ? "" : "s", manifest.at("fasteners").get<int>());
+}
+
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string manifestText(const nlohmann::json& manifest) {
   try {
-    const auto& panels = manifest.at("panels");
-    std::map<int, const nlohmann::json*> byId;
-    for (const auto& panel : panels) byId[panel.at("id").get<int>()] = &panel;
     std::string text = fmt::format(
-        "Assembly manifest: {} structure, {} panels on {} sheet{}, {} fasteners\n"
+        "Assembly manifest: {}\n"
         "Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band\n"
         "with the same number on the panel named; fasten them through their holes.\n\n",
-        manifest.at("structure").get<std::string>(), panels.size(), manifest.at("sheets").size(),
-        manifest.at("sheets").size() == 1 ? "" : "s", manifest.at("fasteners").get<int>());
+        headline(manifest));
     int total = 0;
-    for (const auto& [id, panel] : byId) {
-      const auto& neighbors = panel->at("neighbors");
-      const auto& edges = panel->at("edges");
-      std::map<int, int> holesOfEdge;
-      for (const auto& hole : panel->at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
-      std::string joins;
-      int fasteners = 0;
-      for (size_t j = 0; j < neighbors.size(); ++j) {
-        const int other = neighbors[j].get<int>(), edge = edges.at(j).get<int>();
-        if (other >= id) continue;
-        joins += fmt::format("{}panel {} at edge {} ({} fastener{})", joins.empty() ? "" : ", ", other, edge,
-                             holesOfEdge[edge], holesOfEdge[edge] == 1 ? "" : "s");
-        fasteners += holesOfEdge[edge];
-      }
-      total += fasteners;
-      text += fmt::format("step {:>4}: panel {} (sheet {}): {}\n", id, id, panel->at("sheet").get<int>(),
-                          joins.empty() ? "start here, the base" : "join to " + joins);
+    for (const Step& step : stepsOf(manifest)) {
+      for (const Join& join : step.joins) total += join.fasteners;
+      text +=
+          fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.panel, step.panel, step.sheet, describeJoins(step));
     }
     text += fmt::format("\n{} fasteners in all\n", total);
     return text;
+  } catch (const nlohmann::json::exception& error) {
+    throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", error.what()));
+  }
+}
+
+std::string manifestHtml(const nlohmann::json& manifest, const std::filesystem::path& folder) {
+  try {
+    std::string html = fmt::format(R"(<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>Assembly manifest: {0}</title>
+<style>
+body {{ font-family: sans-serif; margin: 2em; }}
+table {{ border-collapse: collapse; }}
+td, th {{ border: 1px solid #999; padding: 0.2em 0.6em; text-align: left; vertical-align: top; }}
+section.sheet {{ break-before: page; }}
+section.sheet svg {{ width: 100%; height: auto; border: 1px solid #ccc; }}
+section.sheet svg path {{ vector-effect: non-scaling-stroke; stroke-width: 1px; }}
+section.sheet svg #etch path {{ stroke: #a0522d; }}
+@media print {{ body {{ margin: 0; }} }}
+</style>
+</head>
+<body>
+<h1>Assembly manifest</h1>
+<p>{0}. Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band with
+the same number on the panel named; fasten them through their holes.</p>
+<table>
+<tr><th>step</th><th>panel</th><th>sheet</th><th>joins</th><th>fasteners</th></tr>
+)",
+                                   escaped(headline(manifest)));
+    int total = 0;
+    for (const Step& step : stepsOf(manifest)) {
+      int fasteners = 0;
+      for (const Join& join : step.joins) fasteners += join.fasteners;
+      total += fasteners;
+      html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.panel, step.panel,
+                          step.sheet, escaped(describeJoins(step)), fasteners);
+    }
+    html += fmt::format("</table>\n<p>{} fasteners in all.</p>\n", total);
+    for (const auto& sheet : manifest.at("sheets")) {
+      std::string svgFile;
+      for (const auto& file : sheet.at("files")) {
+        const auto name = file.get<std::string>();
+        if (name.ends_with(".svg")) svgFile = name;
+      }
+      std::string panels;
+      for (const auto& id : sheet.at("panels")) panels += (panels.empty() ? "" : ", ") + std::to_string(id.get<int>());
+      html += fmt::format("<section class=\"sheet\">\n<h2>Sheet {}</h2>\n<p>Panels, in cutting order: {}</p>\n",
+                          sheet.at("index").get<int>(), panels);
+      if (!svgFile.empty()) {
+        std::ifstream in(folder / svgFile);
+        if (!in) throw std::invalid_argument(fmt::format("{}: cannot read it", (folder / svgFile).string()));
+        std::string svg{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        if (svg.starts_with("<?xml")) svg.erase(0, svg.find('\n') + 1);  // no declaration inside HTML
+        html += svg;
+      }
+      html += "</section>\n";
+    }
+    html += "</body>\n</html>\n";
+    return html;
   } catch (const nlohmann::json::exception& error) {
     throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", error.what()));
   }

@@ -4,6 +4,7 @@
 // cutter's operator needs, sheet by sheet. Built from a band structure and
 // its sheet plan; printed as text (manifest.txt, `rotafab manifest`).
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -36,5 +37,11 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
 // with the fasteners of each; totals at the end. Throws
 // std::invalid_argument naming the first key that is missing or wrong.
 std::string manifestText(const nlohmann::json& manifest);
+
+// The same as one HTML page, fit to print: the steps as a table, then each
+// sheet (its SVG file from `folder`, inlined) on a page of its own, with
+// the panels it holds in cutting order. Throws std::invalid_argument as
+// manifestText(), or naming a sheet's SVG file that cannot be read.
+std::string manifestHtml(const nlohmann::json& manifest, const std::filesystem::path& folder);
 
 }  // namespace rotafab::jobs

@@ -138,6 +138,19 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
   const CommandResult json = run(kCli + " manifest '" + soccerBall().string() + "' --format json");
   ASSERT_EQ(json.status, 0) << json.err;
   EXPECT_EQ(nlohmann::json::parse(json.out), nlohmann::json::parse(readFile(soccerBall() / "manifest.json")));
+  // HTML: the steps, then every sheet inlined as SVG, a page each.
+  const CommandResult html = run(kCli + " manifest '" + soccerBall().string() + "' --format html");
+  ASSERT_EQ(html.status, 0) << html.err;
+  const nlohmann::json manifest = nlohmann::json::parse(readFile(soccerBall() / "manifest.json"));
+  EXPECT_TRUE(html.out.starts_with("<!DOCTYPE html>"));
+  size_t sections = 0, svgs = 0;
+  for (size_t at = 0; (at = html.out.find("<section class=\"sheet\">", at)) != std::string::npos; ++at) ++sections;
+  for (size_t at = 0; (at = html.out.find("<svg ", at)) != std::string::npos; ++at) ++svgs;
+  EXPECT_EQ(sections, manifest.at("sheets").size());
+  EXPECT_EQ(svgs, manifest.at("sheets").size());
+  EXPECT_EQ(html.out.find("<?xml"), std::string::npos);
+  EXPECT_NE(html.out.find("<tr><td>2</td><td>2</td>"), std::string::npos);
+  EXPECT_TRUE(html.out.ends_with("</html>\n"));
   TempDir dir;
   const CommandResult missing = run(kCli + " manifest '" + dir.path().string() + "'");
   EXPECT_EQ(missing.status, 1);
