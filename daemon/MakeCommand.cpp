@@ -2,12 +2,15 @@
 
 #include <fmt/format.h>
 
+#include <unistd.h>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <regex>
 
 #include "daemon/ExitCode.h"
 #include "geometry/BandStructure.h"
@@ -60,6 +63,9 @@ double lengthOption(const std::string& text, const char* option) {
 // loop's own walk (so that the cap is oriented like the faces around it).
 void capBoundaryLoops(geometry::PolygonMesh& mesh) {
   const auto rs = geometry::RotationSystem::fromMesh(mesh);
+  if (mesh.sourceFace.empty()) {
+    for (int f = 0; f < mesh.faceCount(); ++f) mesh.sourceFace.push_back(f);
+  }
   std::vector<char> walked(rs.dartCount(), 0);
   for (geometry::Dart d = 0; d < rs.dartCount(); ++d) {
     if (!rs.isBoundary(d) || walked[d]) continue;
@@ -69,7 +75,7 @@ void capBoundaryLoops(geometry::PolygonMesh& mesh) {
       cap.push_back(rs.origin(e));
     }
     mesh.faces.push_back(std::move(cap));
-    if (!mesh.sourceFace.empty()) mesh.sourceFace.push_back(-1);
+    mesh.sourceFace.push_back(-1);  // no face of the file: the manifest says "cap"
   }
 }
 
@@ -101,18 +107,26 @@ int runMake(const MakeOptions& options) {
     } catch (const geometry::InvalidMeshError& error) {
       throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
     }
-    const geometry::MeshTopology topology = analysis.topology;
-    if (topology.boundaryLoops > 0) {
+    if (analysis.topology.boundaryLoops > 0) {
+      const int loops = analysis.topology.boundaryLoops;
       if (options.holes == "error") {
         throw UserError(fmt::format("{}: the surface is open ({} boundary loop{}); --holes keep or fill builds it",
-                                    options.mesh, topology.boundaryLoops, topology.boundaryLoops == 1 ? "" : "s"));
+                                    options.mesh, loops, loops == 1 ? "" : "s"));
       }
       if (options.holes == "fill") {
         capBoundaryLoops(mesh);
         analysis = geometry::analyzeMesh(mesh);
-        geometry::requireUsable(analysis);
+        try {
+          geometry::requireUsable(analysis);
+        } catch (const geometry::InvalidMeshError& error) {
+          throw UserError(fmt::format("{}: with its {} hole{} filled: {}", options.mesh, loops, loops == 1 ? "" : "s",
+                                      error.what()));
+        }
+        progress(fmt::format("filled {} hole{} with one face each", loops, loops == 1 ? "" : "s"));
       }
     }
+    // The mesh as built (after --holes fill): one panel per face.
+    const geometry::MeshTopology topology = analysis.topology;
     const double scale = geometry::constructionScale(
         mesh, options.size.empty() ? std::nullopt : std::optional(lengthOption(options.size, "--size")), options.scale);
     if (!(scale > 0) || !std::isfinite(scale)) throw UserError("--scale: expected a positive number");
@@ -163,7 +177,24 @@ int runMake(const MakeOptions& options) {
         options.out.empty() ? std::filesystem::path(std::filesystem::path(options.mesh).stem().string() + "-band")
                             : std::filesystem::path(options.out);
     progress(fmt::format("writing {} sheets to {}", sheets.sheets.size(), out.string()));
-    const auto files = jobs::writeSheets(sheets, out);
+    // Everything goes to a folder beside `out` first, and moves in only when
+    // all is written: a failure leaves no partial set, and a set made before
+    // into the same folder loses its files (so no stale sheet-009.eps stays
+    // beside a new 8-sheet job).
+    std::filesystem::path target = out;
+    if (target.filename().empty()) target = target.parent_path();  // "dir/"
+    const std::filesystem::path staging =
+        target.parent_path() / fmt::format(".{}.partial-{}", target.filename().string(), ::getpid());
+    std::filesystem::remove_all(staging);
+    std::filesystem::create_directories(staging);
+    struct Cleanup {
+      std::filesystem::path folder;
+      ~Cleanup() {
+        std::error_code ignored;
+        std::filesystem::remove_all(folder, ignored);
+      }
+    } cleanup{staging};
+    const auto files = jobs::writeSheets(sheets, staging);
     geometry::PolygonMesh surface;
     for (const geometry::Panel& panel : structure.panels) {
       for (const auto& polygon : panel.surface) {
@@ -175,15 +206,25 @@ int runMake(const MakeOptions& options) {
         surface.faces.push_back(std::move(face));
       }
     }
-    jobs::writeFileAtomically(out / "structure.obj", [&](std::ostream& stream) {
+    jobs::writeFileAtomically(staging / "structure.obj", [&](std::ostream& stream) {
       geometry::writeObj(
           stream, surface,
           fmt::format("rotafab band structure of {}: {} panels, inches", options.mesh, structure.panels.size()));
     });
     const nlohmann::ordered_json manifest = jobs::bandManifest(
         structure, {topology.vertices, topology.edges, topology.faces, topology.genus}, machine.bed, sheets, files);
-    jobs::writeFileAtomically(out / "manifest.json", manifest.dump(1) + "\n");
-    jobs::writeFileAtomically(out / "manifest.txt", jobs::manifestText(manifest));
+    jobs::writeFileAtomically(staging / "manifest.json", manifest.dump(1) + "\n");
+    jobs::writeFileAtomically(staging / "manifest.txt", jobs::manifestText(manifest));
+    std::filesystem::create_directories(target);
+    static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
+    for (const auto& entry : std::filesystem::directory_iterator(target)) {
+      if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours)) {
+        std::filesystem::remove(entry.path());
+      }
+    }
+    for (const auto& entry : std::filesystem::directory_iterator(staging)) {
+      std::filesystem::rename(entry.path(), target / entry.path().filename());
+    }
     const double writingSeconds = seconds();
 
     if (options.json) {

@@ -68,7 +68,16 @@ BandDecomposition bandDecomposition(const PolygonMesh& mesh, const RotationSyste
       cornerDart.insert(cornerDart.end(), {-1, -1, -1});
     }
     const int sides = static_cast<int>(polygon.size());
-    const Eigen::MatrixXd weights = cornerCuttingWeights(sides, tension.value_or(dooSabinTension(sides)));
+    // An interior vertex of valence 2 (two faces sharing two sides in a row)
+    // has a dual polygon of two corners: eq. 5.2 needs three, so each corner
+    // moves a share 1 - a towards the other (Doo-Sabin's a for N = 2).
+    Eigen::MatrixXd weights(sides, sides);
+    if (sides == 2) {
+      const double a = tension.value_or(dooSabinTension(2));
+      weights << a, 1 - a, 1 - a, a;
+    } else {
+      weights = cornerCuttingWeights(sides, tension.value_or(dooSabinTension(sides)));
+    }
     for (int n = 0; n < sides; ++n) {
       if (cornerDart[n] < 0) continue;
       Point3 p = Point3::Zero();

@@ -10,9 +10,10 @@
 // x's dual face (the centroids of the faces around x, in rotation order):
 // sum_m a_{n,m} c_m, eq. 5.1 with the weights of eq. 5.2 for that dual face.
 // The vertex band is then projected onto its least-squares plane (V.2), with
-// the plane's normal on the side of f's own normal, so that every band is
-// counter-clockwise seen from outside: choosing the normal's sign from the
-// eigenvector alone would mirror some bands.
+// the plane's normal on the side about which the band's corners turn
+// counter-clockwise (its Newell normal; the face's when the band has no
+// area), so that every band is counter-clockwise seen from outside: the
+// eigenvector's sign alone would mirror some bands.
 //
 // Open meshes (SPEC `--holes keep`): a boundary vertex has no closed dual
 // face; its dual polygon is the fan's centroids closed through the

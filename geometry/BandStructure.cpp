@@ -68,7 +68,13 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   const BandDecomposition decomposition = bandDecomposition(mesh, rs, options.tension);
   const std::vector<EdgeBand> bands = developableBands(rs, decomposition, options.samples);
   std::vector<FlatPanel> flat;
-  for (int f = 0; f < mesh.faceCount(); ++f) flat.push_back(unfoldPanel(rs, decomposition, bands, f));
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    try {
+      flat.push_back(unfoldPanel(rs, decomposition, bands, f));
+    } catch (const std::invalid_argument& error) {
+      throw std::invalid_argument(fmt::format("face {}: {}", mesh.sourceFaceIndex(f), error.what()));
+    }
+  }
 
   int start = -1;
   if (options.start) {
@@ -84,14 +90,22 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   }
   const FloodFillOrder order = floodFill(mesh, rs, start, options.up);
 
+  // Edges as a user finds them in the file: by their two vertices.
+  const auto edgeName = [&](int e) {
+    return fmt::format("the edge between vertices {} and {}", mesh.sourceVertexIndex(rs.origin(2 * e)),
+                       mesh.sourceVertexIndex(rs.target(2 * e)));
+  };
   for (int f = 0; f < mesh.faceCount(); ++f) {
-    const auto overlaps = overlappingPieces(flat[f], bands);
+    const auto overlaps = overlappingPieces(flat[f]);
     if (!overlaps.empty()) {
       const auto [i, j] = overlaps.front();
+      const int piece = j >= 0 ? j : i;
       throw std::invalid_argument(fmt::format(
-          "panel {} (face {}) would overlap itself when unfolded (the band of input edge {}); splitting such "
-          "panels is not supported yet: try another --tension",
-          order.panelOfFace[f] + 1, mesh.sourceFaceIndex(f), flat[f].bands[j >= 0 ? j : i].edge));
+          "panel {} (face {}) would overlap itself when unfolded ({}); splitting such panels is not supported "
+          "yet: try another --tension",
+          order.panelOfFace[f] + 1, mesh.sourceFaceIndex(f),
+          piece < 0 ? std::string("its vertex band crosses itself")
+                    : "the band of " + edgeName(flat[f].bands[piece].edge)));
     }
   }
 
@@ -108,7 +122,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   }
 
   say(options, fmt::format("fastener holes on {} bands", result.interiorEdges));
-  const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener);
+  const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener, edgeName);
   int narrow = 0, narrowest = -1;
   for (const BandHoles& h : holes) {
     result.fasteners += static_cast<int>(h.holes.size());

@@ -83,7 +83,7 @@ std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, doub
 }  // namespace
 
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
-                                          double diameter) {
+                                          double diameter, const std::function<std::string(int)>& edgeName) {
   std::vector<BandHoles> result(bands.size());
   std::vector<std::vector<Point2>> holesOn(panels.size());  // centres placed so far, per panel
   const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
@@ -149,12 +149,19 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
         }
       }
       placed.layout = HoleLayout::Single;
-      placed.clearance = std::min(kClearance, most * kClearance);
+      // What it keeps from the outlines alone, in diameters (the ratio above also weighs the other holes).
+      double fromOutlines = std::numeric_limits<double>::max();
+      for (int c = 0; c < 2 && !placed.holes.empty(); ++c) {
+        fromOutlines =
+            std::min(fromOutlines,
+                     distanceToOutline(panels[faces[c]].outline, placed.holes.front().onPanel(*copies[c])) / diameter);
+      }
+      placed.clearance = std::min(kClearance, fromOutlines);
       if (most < kLeastClearance / kClearance) {
-        throw std::invalid_argument(fmt::format(
-            "edge {}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole even {} diameters "
-            "from every outline; use a smaller --fastener or a larger --size",
-            band.edge, length, width, diameter, kLeastClearance));
+        throw std::invalid_argument(
+            fmt::format("{}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole even {} diameters "
+                        "from every outline; use a smaller --fastener or a larger --size",
+                        edgeName(band.edge), length, width, diameter, kLeastClearance));
       }
     }
     for (int c = 0; c < 2; ++c) {

@@ -20,6 +20,8 @@
 // kLeastClearance diameters; the caller warns (BandHoles::clearance).
 
 #include <array>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "geometry/PanelUnfolding.h"
@@ -47,10 +49,11 @@ struct BandHoles {
 };
 
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed
-// by face. Throws std::invalid_argument naming the edge when not even one
-// hole keeps kLeastClearance.
-std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
-                                          double diameter);
+// by face. Throws std::invalid_argument naming the edge (by `edgeName`)
+// when not even one hole keeps kLeastClearance.
+std::vector<BandHoles> placeFastenerHoles(
+    const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels, double diameter,
+    const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); });
 
 // The copy of edge `edge`'s band on `panel`, or nullptr.
 const FlatBand* bandCopy(const FlatPanel& panel, int edge);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace rotafab::geometry {
 
@@ -24,6 +25,7 @@ double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * 
 Point2 apex(const Point2& p, const Point2& q, double fromP, double fromQ, const Point2& away) {
   const Point2 base = q - p;
   const double length = base.norm();
+  if (!(length > 0)) throw std::invalid_argument("a band has a side of zero length");
   const Point2 along = base / length, normal(-along.y(), along.x());
   const double x = (fromP * fromP - fromQ * fromQ + length * length) / (2 * length);
   const double h = std::sqrt(std::max(0.0, fromP * fromP - x * x));
@@ -104,7 +106,14 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
   panel.face = face;
   const VertexBand& vb = decomposition.vertexBands[face];
   panel.origin = vb.centroid;
-  panel.xAxis = (vb.corners[1] - vb.corners[0]).normalized();
+  // The frame's x along the vertex band's longest side (a side can be
+  // nearly nothing where corner cutting squeezes a corner).
+  size_t longest = 0;
+  for (size_t i = 0; i < vb.corners.size(); ++i) {
+    const auto side = [&](size_t k) { return (vb.corners[(k + 1) % vb.corners.size()] - vb.corners[k]).norm(); };
+    if (side(i) > side(longest)) longest = i;
+  }
+  panel.xAxis = (vb.corners[(longest + 1) % vb.corners.size()] - vb.corners[longest]).normalized();
   panel.yAxis = vb.normal.cross(panel.xAxis).normalized();
   for (const Point3& p : vb.corners) {
     panel.vertexBand.emplace_back((p - panel.origin).dot(panel.xAxis), (p - panel.origin).dot(panel.yAxis));
@@ -150,26 +159,23 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
   return panel;
 }
 
-std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel, const std::vector<EdgeBand>& bands) {
+std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
   std::vector<std::pair<int, int>> result;
   const int n = static_cast<int>(panel.bands.size());
-  // A band folded over: a developed triangle turned the other way round.
-  for (int i = 0; i < n; ++i) {
-    const FlatBand& flat = panel.bands[i];
-    bool folded = false;
-    for (const auto& t : bands[flat.edge].triangles()) {
-      // The triangles run clockwise on every panel (see DevelopableBands.h).
-      folded = folded || cross(flat.points[t[1]] - flat.points[t[0]], flat.points[t[2]] - flat.points[t[0]]) >= 0;
-    }
-    const auto& o = flat.outline;
-    bool selfCrossing = false;
-    for (size_t a = 0; a < o.size() && !selfCrossing; ++a) {
-      for (size_t b = a + 2; b < o.size() && !selfCrossing; ++b) {
+  // A piece that crosses itself: a vertex band projected from a twisted face,
+  // or a band whose development curls over itself (V.4).
+  const auto crossesItself = [](const std::vector<Point2>& o) {
+    for (size_t a = 0; a < o.size(); ++a) {
+      for (size_t b = a + 2; b < o.size(); ++b) {
         if (a == 0 && b + 1 == o.size()) continue;
-        selfCrossing = properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()]);
+        if (properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()])) return true;
       }
     }
-    if (folded || selfCrossing) result.emplace_back(i, i);
+    return false;
+  };
+  if (crossesItself(panel.vertexBand)) result.emplace_back(-1, -1);
+  for (int i = 0; i < n; ++i) {
+    if (crossesItself(panel.bands[i].outline)) result.emplace_back(i, i);
   }
   const auto piece = [&](int i) -> const std::vector<Point2>& {
     return i < 0 ? panel.vertexBand : panel.bands[i].outline;

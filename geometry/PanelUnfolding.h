@@ -36,6 +36,7 @@ struct FlatPanel {
   std::vector<Point2> outline;     // the cut contour, counter-clockwise, not closed
 };
 
+// Throws std::invalid_argument if a band has a side of zero length (a degenerate face).
 FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decomposition,
                       const std::vector<EdgeBand>& bands, int face);
 
@@ -43,8 +44,10 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
 double signedArea(const std::vector<Point2>& polygon);
 
 // Pairs of the panel's pieces that overlap: -1 for the vertex band, else an
-// index into bands. Empty when the outline is a simple polygon and no band
-// is folded over (every developed triangle keeps its orientation).
-std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel, const std::vector<EdgeBand>& bands);
+// index into bands; (i, i) for a piece that crosses itself. Empty when no
+// two pieces' outlines cross, none holds another's middle, and none
+// crosses itself. (Developed triangles never turn over: each goes on the
+// far side of the edge it shares, so a fold shows only as crossing outlines.)
+std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel);
 
 }  // namespace rotafab::geometry

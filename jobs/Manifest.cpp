@@ -18,10 +18,12 @@ std::vector<Part> bandParts(const geometry::BandStructure& structure) {
     part.order = panel.id - 1;
     part.outline = panel.outline;
     for (const geometry::PanelHole& hole : panel.holes) {
+      // The polygon around the circle (its sides touch it), so the fastener passes.
+      const double radius = hole.diameter / 2 / std::cos(std::numbers::pi / kHoleSides);
       Polygon2 circle;
       for (int i = 0; i < kHoleSides; ++i) {
         const double a = 2 * std::numbers::pi * i / kHoleSides;
-        circle.push_back(hole.xy + hole.diameter / 2 * Point2(std::cos(a), std::sin(a)));
+        circle.push_back(hole.xy + radius * Point2(std::cos(a), std::sin(a)));
       }
       part.holes.push_back(std::move(circle));
     }
@@ -71,7 +73,9 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
     entry["id"] = panel.id;
     entry["order"] = placed.cuttingIndex + 1;  // its place in the cutting order
     entry["sheet"] = placed.sheet;
-    entry["source"] = {{"face", panel.face}};
+    // A cap of --holes fill has no face in the file.
+    entry["source"] = panel.face >= 0 ? nlohmann::ordered_json{{"face", panel.face}}
+                                      : nlohmann::ordered_json{{"face", nullptr}, {"cap", true}};
     entry["outline"] = nlohmann::ordered_json::array();
     for (const Point2& p : panel.outline) entry["outline"].push_back(point(p));
     entry["placement"] = {{"x", placed.x}, {"y", placed.y}, {"rotation", placed.rotation}};
@@ -116,13 +120,22 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
   std::vector<Step> steps;
   for (const auto& [id, panel] : byId) {
     const auto& neighbors = panel->at("neighbors");
-    const auto& edges = panel->at("edges");
     std::map<int, int> holesOfEdge;
     for (const auto& hole : panel->at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
     Step step{id, panel->at("sheet").get<int>(), {}};
     for (size_t j = 0; j < neighbors.size(); ++j) {
-      const int other = neighbors[j].get<int>(), edge = edges.at(j).get<int>();
-      if (other < id) step.joins.push_back({other, edge, holesOfEdge[edge]});
+      const int other = neighbors[j].get<int>();
+      if (other >= id) continue;
+      // The joining edge: our extension "edges", or else the edge whose holes both panels carry.
+      int edge = 0;
+      if (panel->contains("edges")) {
+        edge = panel->at("edges").at(j).get<int>();
+      } else if (byId.count(other)) {
+        for (const auto& hole : byId.at(other)->at("holes")) {
+          if (holesOfEdge.count(hole.at("edge").get<int>())) edge = hole.at("edge").get<int>();
+        }
+      }
+      step.joins.push_back({other, edge, holesOfEdge[edge]});
     }
     steps.push_back(std::move(step));
   }

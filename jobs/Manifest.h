@@ -22,8 +22,8 @@ struct MeshCounts {
 };
 
 // The band panels as parts for the planner: outline, holes (polygons of
-// kHoleSides sides through the circle's points, so the fastener still
-// passes), labels to etch, folds to score; assembly order = panel id - 1.
+// kHoleSides sides around the circle, so the fastener still passes), labels
+// to etch, folds to score; assembly order = panel id - 1.
 constexpr int kHoleSides = 32;
 std::vector<Part> bandParts(const geometry::BandStructure& structure);
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -217,7 +218,7 @@ TEST(BandDecomposition, NoBandIsFlippedAtSaddles) {
       EXPECT_GT(saddleBands, 0) << name << " has no saddle: the test would prove nothing";
     }
     for (const FlatPanel& panel : s.panels) {
-      for (const auto& [i, j] : overlappingPieces(panel, s.bands)) {
+      for (const auto& [i, j] : overlappingPieces(panel)) {
         if (i == j) {
           ADD_FAILURE() << name << ": face " << panel.face << ": the band of edge " << panel.bands[i].edge
                         << " folds over";
@@ -227,12 +228,27 @@ TEST(BandDecomposition, NoBandIsFlippedAtSaddles) {
   }
 }
 
-// Every band is one of V.3's three cases; Hermite rails start and end on the
-// vertex bands' planes, leaving them along the planes.
+// V.3's cases: a flat disc has parallel planes everywhere (case 1); a cube's
+// faces meet along lines parallel to the bands' sides (case 2); the bunny
+// has all three. Hermite rails start and end on the vertex bands' planes,
+// leaving them along the planes.
 TEST(BandDecomposition, HermiteBandsAreTangentToBothVertexBands) {
   int hermite = 0;
   for (auto& [name, mesh] : testMeshes()) {
     const Structure s = build(mesh);
+    std::map<BandCase, int> kinds;
+    for (const EdgeBand& band : s.bands) kinds[band.kind] += band.edge >= 0;
+    if (name == "disc") {
+      EXPECT_EQ(kinds[BandCase::ParallelPlanes], 9) << name;  // its 9 spokes, all in one plane
+    }
+    if (name == "cube") {
+      EXPECT_EQ(kinds[BandCase::AlongIntersection], 12) << name;
+    }
+    if (name == "bunny") {
+      EXPECT_GT(kinds[BandCase::ParallelPlanes], 0);
+      EXPECT_GT(kinds[BandCase::AlongIntersection], 0);
+      EXPECT_GT(kinds[BandCase::Bilinear], 0);
+    }
     for (const EdgeBand& band : s.bands) {
       if (band.edge < 0 || band.kind == BandCase::Bilinear) continue;
       ++hermite;
@@ -253,11 +269,49 @@ TEST(BandDecomposition, HermiteBandsAreTangentToBothVertexBands) {
 
 TEST(BandDecomposition, PanelsOfTheTestMeshesDoNotOverlapThemselves) {
   for (auto& [name, mesh] : testMeshes()) {
-    if (name == "bunny") continue;  // measured below
     const Structure s = build(mesh);
     for (const FlatPanel& panel : s.panels) {
-      EXPECT_TRUE(overlappingPieces(panel, s.bands).empty()) << name << ": face " << panel.face;
+      EXPECT_TRUE(overlappingPieces(panel).empty()) << name << ": face " << panel.face;
     }
+  }
+}
+
+// The overlap check is not blind: a band laid across the vertex band, and a
+// vertex band that crosses itself, are both found.
+TEST(BandDecomposition, OverlapsAreFound) {
+  Structure s = build(cube());
+  FlatPanel panel = s.panels.front();
+  ASSERT_TRUE(overlappingPieces(panel).empty());
+  FlatPanel crossed = panel;
+  for (Point2& p : crossed.bands[0].outline) p = -p;  // turned half round about the centre: across the others
+  EXPECT_FALSE(overlappingPieces(crossed).empty());
+  FlatPanel twisted = panel;
+  std::swap(twisted.vertexBand[0], twisted.vertexBand[1]);
+  const auto found = overlappingPieces(twisted);
+  EXPECT_NE(std::find(found.begin(), found.end(), std::pair{-1, -1}), found.end());
+}
+
+// An interior vertex of valence 2 (a cube with one edge split in two: its two
+// faces share two sides in a row) has a dual polygon of two corners.
+TEST(BandDecomposition, ValenceTwoVerticesAreBuilt) {
+  PolygonMesh mesh = cube();
+  const int a = mesh.faces[0][0], b = mesh.faces[0][1];
+  const int middle = mesh.vertexCount();
+  mesh.positions.push_back((mesh.positions[a] + mesh.positions[b]) / 2);
+  for (auto& face : mesh.faces) {
+    for (size_t i = 0; i < face.size(); ++i) {
+      const int p = face[i], q = face[(i + 1) % face.size()];
+      if ((p == a && q == b) || (p == b && q == a)) {
+        face.insert(face.begin() + static_cast<long>(i) + 1, middle);
+        break;
+      }
+    }
+  }
+  const Structure s = build(mesh);
+  EXPECT_EQ(s.panels.size(), 6u);
+  for (const FlatPanel& panel : s.panels) {
+    EXPECT_TRUE(overlappingPieces(panel).empty()) << "face " << panel.face;
+    for (const Point2& p : panel.outline) EXPECT_TRUE(p.allFinite());
   }
 }
 

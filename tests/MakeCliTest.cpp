@@ -66,8 +66,10 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
     EXPECT_LE(std::stoi(box[4]), 18 * 72 + 1);
   }
   // structure.obj: the 3D panels, a vertex band and the bands' triangles each.
-  const std::string obj = readFile(out / "structure.obj");
-  EXPECT_GT(std::count(obj.begin(), obj.end(), 'f'), 32 * 6);
+  std::istringstream obj(readFile(out / "structure.obj"));
+  int faces = 0;
+  for (std::string line; std::getline(obj, line);) faces += line.starts_with("f ");
+  EXPECT_EQ(faces, 32 + 90 * 2 * 16);  // 32 vertex bands; 90 bands on two panels, 8 segments of 2 triangles
 }
 
 TEST(MakeCli, ManifestIsSpecsVersionOne) {
@@ -155,6 +157,46 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
   const CommandResult missing = run(kCli + " manifest '" + dir.path().string() + "'");
   EXPECT_EQ(missing.status, 1);
   EXPECT_NE(missing.err.find("manifest.json: cannot read it"), std::string::npos) << missing.err;
+}
+
+// A second make into the same folder replaces the first's files, stale sheets included;
+// an open mesh is built open (boundary edges get no band) or with its holes filled.
+TEST(MakeCli, ReusedFolderAndOpenMeshes) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  dir.write("out/sheet-009.eps", "stale");
+  dir.write("out/notes.txt", "mine");
+  // An open hemisphere-like cap: the soccer ball without one face.
+  std::string obj = readFile(kSource / "examples/soccer-ball.obj");
+  const auto lastFace = obj.rfind("\nf ");
+  ASSERT_NE(lastFace, std::string::npos);
+  obj.erase(lastFace + 1);
+  const auto open = dir.write("open.obj", obj);
+  const CommandResult kept = run(kCli + " make " + quoted(open) + " --structure band --time 0 --out " + quoted(out));
+  ASSERT_EQ(kept.status, 0) << kept.err;
+  EXPECT_FALSE(std::filesystem::exists(out / "sheet-009.eps"));
+  EXPECT_EQ(readFile(out / "notes.txt"), "mine");
+  auto manifest = nlohmann::json::parse(readFile(out / "manifest.json"));
+  EXPECT_EQ(manifest.at("panels").size(), 31u);
+  EXPECT_EQ(manifest.at("mesh").at("faces"), 31);
+  EXPECT_LT(manifest.at("fasteners").get<int>(), 180);
+  const CommandResult filled =
+      run(kCli + " make " + quoted(open) + " --structure band --holes fill --time 0 --out " + quoted(out));
+  ASSERT_EQ(filled.status, 0) << filled.err;
+  manifest = nlohmann::json::parse(readFile(out / "manifest.json"));
+  EXPECT_EQ(manifest.at("panels").size(), 32u);
+  EXPECT_EQ(manifest.at("fasteners"), 180);
+  int caps = 0;
+  for (const auto& panel : manifest.at("panels")) caps += panel.at("source").contains("cap");
+  EXPECT_EQ(caps, 1);
+  const CommandResult refused =
+      run(kCli + " make " + quoted(open) + " --structure band --holes error --out " + quoted(dir.path() / "x"));
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("open (1 boundary loop)"), std::string::npos) << refused.err;
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << "left " << entry.path();
+  }
 }
 
 TEST(MakeCli, JsonSummaryAndErrors) {
