@@ -17,6 +17,7 @@
 #include <map>
 #include <string>
 
+#include "geometry/BandStructure.h"
 #include "geometry/FaceTracing.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
@@ -102,6 +103,33 @@ void BM_RotationSystemAndTrace(benchmark::State& state) {
   state.SetComplexityN(state.range(0));
 }
 BENCHMARK(BM_RotationSystemAndTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// Issue 4, item 8: `make --structure band` up to the planner, import to
+// labelled panels: import, analysis, scale (mean edge 2 in), vertex bands,
+// developable bands, unfolding, holes, labels, flood fill. Target: linear,
+// under 5 s for 50k faces. (Nesting is measured by rotafab_nest_bench.)
+void BM_BandStructure(benchmark::State& state) {
+  const auto& path = meshFile(state.range(0));
+  long faces = 0;
+  for (auto _ : state) {
+    geo::ImportedMesh imported = geo::importMesh(path);
+    geo::requireUsable(geo::analyzeMesh(imported.mesh));
+    const double scale = geo::constructionScale(imported.mesh, std::nullopt, std::nullopt);
+    for (geo::Point3& p : imported.mesh.positions) p *= scale;
+    const geo::BandStructure structure = geo::buildBandStructure(imported.mesh, geo::BandOptions{});
+    benchmark::DoNotOptimize(structure.panels.data());
+    faces = imported.mesh.faceCount();
+  }
+  state.SetComplexityN(faces);
+}
+BENCHMARK(BM_BandStructure)
+    ->Arg(4000)
+    ->Arg(8000)
+    ->Arg(16000)
+    ->Arg(32000)
+    ->Arg(50000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
 
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "geometry/BandDecomposition.h"
 #include "geometry/DevelopableBands.h"
@@ -140,8 +141,11 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
 
   say(options, fmt::format("labels on {} panels", mesh.faceCount()));
   const HersheyFont& font = HersheyFont::simplex();
-  std::vector<std::string> unfitted;  // labels that do not fit at the smallest height
-  for (int number = 0; number < mesh.faceCount(); ++number) {
+  // Each panel on its own, so the panels are shared out among the cores.
+  result.panels.resize(mesh.faceCount());
+  std::vector<std::vector<std::string>> unfittedOf(mesh.faceCount());  // labels too large even at the smallest height
+  const auto makePanel = [&](int number) {
+    std::vector<std::string>& unfitted = unfittedOf[number];
     const int f = order.faceOfPanel[number];
     const FlatPanel& fp = flat[f];
     Panel panel;
@@ -222,8 +226,26 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
         panel.scores.push_back({fp.vertexBand[side], fp.vertexBand[(side + 1) % fp.vertexBand.size()]});
       }
     }
-    result.panels.push_back(std::move(panel));
+    result.panels[number] = std::move(panel);
+  };
+  const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
+  std::vector<std::thread> threads;
+  std::vector<std::exception_ptr> errors(workers);
+  for (int w = 0; w < workers; ++w) {
+    threads.emplace_back([&, w] {
+      try {
+        for (int number = w; number < mesh.faceCount(); number += workers) makePanel(number);
+      } catch (...) {
+        errors[w] = std::current_exception();
+      }
+    });
   }
+  for (std::thread& thread : threads) thread.join();
+  for (const auto& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+  std::vector<std::string> unfitted;
+  for (auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
   if (!unfitted.empty()) {
     std::string some;
     for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];

@@ -7,6 +7,7 @@
 #include <limits>
 #include <optional>
 #include <stdexcept>
+#include <thread>
 
 namespace rotafab::geometry {
 
@@ -85,10 +86,10 @@ std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, doub
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
                                           double diameter, const std::function<std::string(int)>& edgeName) {
   std::vector<BandHoles> result(bands.size());
-  std::vector<std::vector<Point2>> holesOn(panels.size());  // centres placed so far, per panel
   const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
-  for (const EdgeBand& band : bands) {
-    if (band.edge < 0) continue;
+  // One band's holes, kept clear of `holesOn` (centres already placed, per panel).
+  const auto placeBand = [&](const EdgeBand& band, const std::vector<std::vector<Point2>>& holesOn) {
+    BandHoles placed;
     const FlatBand* copies[2] = {bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)};
     const int faces[2] = {band.faceA, band.faceB};
     const FlatBand& flat = copies[0]->fromA ? *copies[0] : *copies[1];
@@ -124,9 +125,15 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     };
     const HoleLayout preferred = length >= width ? HoleLayout::Along : HoleLayout::Across;
     const HoleLayout other = preferred == HoleLayout::Along ? HoleLayout::Across : HoleLayout::Along;
-    BandHoles& placed = result[band.edge];
     placed.edge = band.edge;
+    // A hole with the full clearance needs the band at least twice that
+    // wide where it is, and the band is nowhere wider than its widest
+    // ruling (a ruling between two others is no longer than the longer).
+    double widest = 0;
+    for (int i = 0; i <= k; ++i) widest = std::max(widest, (flat.points[k + 1 + i] - flat.points[i]).norm());
+    const bool roomForFull = widest >= 2 * fromOutline;
     for (HoleLayout kind : {preferred, other}) {
+      if (!roomForFull) break;
       for (double spread : {0.3, 0.25, 0.2, 0.15, 0.1}) {
         auto holes = layout(kind, spread);
         if (holes.size() == 2 && clearance(holes) >= 1) {
@@ -137,15 +144,23 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       if (!placed.holes.empty()) break;
     }
     if (placed.holes.empty()) {
-      // One hole: the middle, or the point of most clearance on a grid over the band.
-      double most = -1;
-      for (double s = 0.2; s <= 0.801; s += 0.05) {
-        for (double t = 0.2; t <= 0.801; t += 0.05) {
-          std::vector<BandPoint> holes;
-          if (auto p = locate(band, flat, s, t)) holes = {*p};
-          if (holes.empty()) continue;
-          const double c = clearance(holes) - 1e-3 * (std::abs(s - 0.5) + std::abs(t - 0.5));  // the middle on a tie
-          if (c > most) most = c, placed.holes = holes;
+      // One hole: the point of most clearance, found on a coarse grid over
+      // the band and then by a pattern search around the best (the middle on a tie).
+      double most = -1, bestS = 0.5, bestT = 0.5;
+      const auto consider = [&](double s, double t) {
+        if (s < 0.05 || s > 0.95 || t < 0.05 || t > 0.95) return;
+        const auto p = locate(band, flat, s, t);
+        if (!p) return;
+        const double c = clearance({*p}) - 1e-3 * (std::abs(s - 0.5) + std::abs(t - 0.5));
+        if (c > most) most = c, bestS = s, bestT = t, placed.holes = {*p};
+      };
+      for (double s = 0.2; s <= 0.801; s += 0.1) {
+        for (double t : {0.3, 0.5, 0.7}) consider(s, t);
+      }
+      for (double step = 0.05; step > 0.01; step /= 2) {
+        const double s0 = bestS, t0 = bestT;
+        for (const auto& [ds, dt] : {std::pair{step, 0.0}, {-step, 0.0}, {0.0, step}, {0.0, -step}}) {
+          consider(s0 + ds, t0 + dt);
         }
       }
       placed.layout = HoleLayout::Single;
@@ -164,8 +179,50 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
                         edgeName(band.edge), length, width, diameter, kLeastClearance));
       }
     }
+    return placed;
+  };
+  // Each band alone first, the bands shared out among the cores; then, in
+  // edge order, a band whose holes come too near those of a band before it
+  // on the same panel (rare: the outline runs between two bands) is placed
+  // again beside them. The result does not depend on the number of cores.
+  const std::vector<std::vector<Point2>> none(panels.size());
+  std::vector<std::exception_ptr> errors(bands.size());
+  const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
+  std::vector<std::thread> threads;
+  for (int w = 0; w < workers; ++w) {
+    threads.emplace_back([&, w] {
+      for (size_t e = w; e < bands.size(); e += workers) {
+        if (bands[e].edge < 0) continue;
+        try {
+          result[e] = placeBand(bands[e], none);
+        } catch (...) {
+          errors[e] = std::current_exception();
+        }
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  for (const auto& error : errors) {
+    if (error) std::rethrow_exception(error);
+  }
+  std::vector<std::vector<Point2>> holesOn(panels.size());
+  for (const EdgeBand& band : bands) {
+    if (band.edge < 0) continue;
+    const FlatBand* copies[2] = {bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)};
+    const int faces[2] = {band.faceA, band.faceB};
+    const auto tooNear = [&] {
+      for (int c = 0; c < 2; ++c) {
+        for (const BandPoint& h : result[band.edge].holes) {
+          for (const Point2& other : holesOn[faces[c]]) {
+            if ((other - h.onPanel(*copies[c])).norm() < fromHole) return true;
+          }
+        }
+      }
+      return false;
+    };
+    if (tooNear()) result[band.edge] = placeBand(band, holesOn);
     for (int c = 0; c < 2; ++c) {
-      for (const BandPoint& h : placed.holes) holesOn[faces[c]].push_back(h.onPanel(*copies[c]));
+      for (const BandPoint& h : result[band.edge].holes) holesOn[faces[c]].push_back(h.onPanel(*copies[c]));
     }
   }
   return result;

@@ -35,14 +35,20 @@ std::vector<Point2> perimeter(const TextBox& box, double step) {
   return points;
 }
 
+// Whether two boxes keep `gap` apart: separated along one of their four
+// axes once one is grown by the gap (a little stricter than the true
+// distance near the corners, which only costs a smaller label there).
 bool boxesApart(const TextBox& a, const TextBox& b, double gap) {
-  for (const Point2& p : perimeter(a, gap)) {
-    if (b.distanceTo(p) < gap) return false;
+  const auto ca = a.corners(), cb = b.corners();
+  for (const TextBox* box : {&a, &b}) {
+    for (const Point2& axis : {box->along, Point2(-box->along.y(), box->along.x())}) {
+      double aLow = std::numeric_limits<double>::max(), aHigh = -aLow, bLow = aLow, bHigh = -aLow;
+      for (const Point2& p : ca) aLow = std::min(aLow, p.dot(axis)), aHigh = std::max(aHigh, p.dot(axis));
+      for (const Point2& p : cb) bLow = std::min(bLow, p.dot(axis)), bHigh = std::max(bHigh, p.dot(axis));
+      if (aHigh + gap <= bLow || bHigh + gap <= aLow) return true;
+    }
   }
-  for (const Point2& p : perimeter(b, gap)) {
-    if (a.distanceTo(p) < gap) return false;
-  }
-  return true;
+  return false;
 }
 
 }  // namespace
@@ -87,9 +93,17 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     most = std::max(most, room.back());
   }
   const auto clear = [&](const Point2& p, double gap) { return insidePolygon(region, p) && distanceToSides(p) >= gap; };
+  // The region's extent along the text and across it: a box longer or
+  // taller than that, with its gaps, cannot fit anywhere.
+  double alongLow = std::numeric_limits<double>::max(), alongHigh = -alongLow, upLow = alongLow, upHigh = -alongLow;
+  for (const Point2& p : region) {
+    alongLow = std::min(alongLow, p.dot(along)), alongHigh = std::max(alongHigh, p.dot(along));
+    upLow = std::min(upLow, p.dot(up)), upHigh = std::max(upHigh, p.dot(up));
+  }
   for (double height = std::min(kLargestLabel, most / 0.75); height >= kSmallestLabel - 1e-12; height *= 0.85) {
     const double width = font.advance(text, height);
     const double gap = std::max(kLabelGap, height / 4);
+    if (width + 2 * gap > alongHigh - alongLow || height + 2 * gap > upHigh - upLow) continue;
     for (size_t c = 0; c < candidates.size(); ++c) {
       if (room[c] < height / 2 + gap) continue;
       const Point2& centre = candidates[c];
