@@ -96,18 +96,46 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     return fmt::format("the edge between vertices {} and {}", mesh.sourceVertexIndex(rs.origin(2 * e)),
                        mesh.sourceVertexIndex(rs.target(2 * e)));
   };
+  // A panel that would overlap itself (V.4) is split: one band at a time,
+  // the later of two that overlap, is cut off with a tab, until none do.
+  // A piece crossing itself cannot be mended so.
+  int split = 0;
   for (int f = 0; f < mesh.faceCount(); ++f) {
-    const auto overlaps = overlappingPieces(flat[f]);
-    if (!overlaps.empty()) {
+    for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
       const auto [i, j] = overlaps.front();
-      const int piece = j >= 0 ? j : i;
-      throw std::invalid_argument(fmt::format(
-          "panel {} (face {}) would overlap itself when unfolded ({}); splitting such panels is not supported "
-          "yet: try another --tension",
-          order.panelOfFace[f] + 1, mesh.sourceFaceIndex(f),
-          piece < 0 ? std::string("its vertex band crosses itself")
-                    : "the band of " + edgeName(flat[f].bands[piece].edge)));
+      const auto where = [&] {
+        return fmt::format("panel {} (face {})", order.panelOfFace[f] + 1, mesh.sourceFaceIndex(f));
+      };
+      if (j < 0) {
+        throw std::invalid_argument(fmt::format(
+            "{}: its vertex band crosses itself when laid flat (the face is far from planar); split the face in "
+            "the mesh",
+            where()));
+      }
+      if (i == j) {
+        throw std::invalid_argument(
+            fmt::format("{}: the band of {} overlaps itself when laid flat", where(), edgeName(flat[f].bands[j].edge)));
+      }
+      // The later band of the two, or else the earlier one.
+      try {
+        detachBand(flat[f], j, 2 * kClearance * options.fastener);
+      } catch (const std::invalid_argument& error) {
+        try {
+          if (i < 0) throw;
+          detachBand(flat[f], i, 2 * kClearance * options.fastener);
+        } catch (const std::invalid_argument&) {
+          throw std::invalid_argument(fmt::format(
+              "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger --size "
+              "or a smaller --fastener makes room",
+              where(), edgeName(flat[f].bands[j].edge), error.what()));
+        }
+      }
+      ++split;
     }
+  }
+  if (split > 0) {
+    say(options, fmt::format("{} band{} cut off {} panel{} that would overlap themselves, each fastened back by a tab",
+                             split, split == 1 ? "" : "s", split == 1 ? "a" : "the", split == 1 ? "" : "s"));
   }
 
   // Edge numbers in the order the flood fill meets the edges, so that the
@@ -125,6 +153,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   say(options, fmt::format("fastener holes on {} bands", result.interiorEdges));
   const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener, edgeName);
   int narrow = 0, narrowest = -1;
+  result.fasteners = split;  // the tabs'
   for (const BandHoles& h : holes) {
     result.fasteners += static_cast<int>(h.holes.size());
     if (h.edge < 0 || h.clearance >= kClearance) continue;
@@ -155,25 +184,58 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     const VertexBand& vb = decomposition.vertexBands[f];
     panel.area = polygonArea3(vb.corners);
     panel.surface.push_back(vb.corners);
+    // The panel's holes (a detached band's go on its piece; its tab's
+    // fastener on both), and the pieces themselves.
     std::vector<Circle> circles;
+    std::vector<std::vector<Circle>> pieceCircles;
     for (const FlatBand& copy : fp.bands) {
       const EdgeBand& band = bands[copy.edge];
-      for (const BandPoint& hole : holes[copy.edge].holes) {
-        panel.holes.push_back({edgeNumber[copy.edge], hole.onPanel(copy), options.fastener});
-        circles.push_back({panel.holes.back().xy, options.fastener / 2});
+      PanelPiece* piece = nullptr;
+      if (copy.detached) {
+        panel.pieces.push_back({fmt::format("{}{}", panel.id, static_cast<char>('a' + panel.pieces.size() % 26)),
+                                edgeNumber[copy.edge],
+                                copy.pieceOutline,
+                                {},
+                                {},
+                                0.0});
+        piece = &panel.pieces.back();
+        pieceCircles.emplace_back();
       }
+      auto& holesHere = piece ? piece->holes : panel.holes;
+      auto& circlesHere = piece ? pieceCircles.back() : circles;
+      for (const BandPoint& hole : holes[copy.edge].holes) {
+        holesHere.push_back({edgeNumber[copy.edge], hole.onPanel(copy), options.fastener});
+        circlesHere.push_back({holesHere.back().xy, options.fastener / 2});
+      }
+      if (piece) {
+        piece->holes.push_back({0, copy.tab, options.fastener});
+        pieceCircles.back().push_back({copy.tab, options.fastener / 2});
+        panel.holes.push_back({0, copy.tab, options.fastener});
+        circles.push_back({copy.tab, options.fastener / 2});
+      }
+      double bandArea = 0;
       for (const auto& t : band.triangles()) {
         panel.surface.push_back({band.point(t[0]), band.point(t[1]), band.point(t[2])});
-        panel.area += polygonArea3(panel.surface.back());
+        bandArea += polygonArea3(panel.surface.back());
       }
+      (piece ? piece->area : panel.area) += bandArea;
       panel.neighbors.push_back(order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1);
       panel.edges.push_back(edgeNumber[copy.edge]);
     }
     // Labels: each band's edge number near its holes, reading out from the
-    // vertex band; then the panel number on the vertex band.
+    // vertex band (on a piece: and the piece's name on its tab); then the
+    // panel number on the vertex band.
     std::vector<TextBox> taken;
+    size_t pieceIndex = 0;
     for (const FlatBand& copy : fp.bands) {
       const EdgeBand& band = bands[copy.edge];
+      PanelPiece* piece = copy.detached ? &panel.pieces[pieceIndex] : nullptr;
+      const std::vector<Circle>& circlesHere = piece ? pieceCircles[pieceIndex] : circles;
+      std::vector<TextBox> pieceTaken;
+      std::vector<TextBox>& takenHere = piece ? pieceTaken : taken;
+      auto& labelsHere = piece ? piece->labels : panel.labels;
+      const auto& outlineHere = piece ? copy.pieceOutline : fp.outline;
+      if (piece) ++pieceIndex;
       const int k = band.segments();
       const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
       const Point2 out = flatPoint(copy, k, far, 0.5) - flatPoint(copy, k, near, 0.5);
@@ -188,15 +250,32 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
         return (a - holesAt).squaredNorm() < (b - holesAt).squaredNorm();
       });
       const std::string label = std::to_string(edgeNumber[copy.edge]);
-      const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, fp.outline, circles,
-                               taken, candidates);
-      if (!box) {
-        unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
-        continue;
-      }
-      taken.push_back(*box);
-      panel.labels.push_back({labelText(label), edgeNumber[copy.edge], "edge", *box,
+      if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, outlineHere,
+                                   circlesHere, takenHere, candidates)) {
+        takenHere.push_back(*box);
+        labelsHere.push_back({labelText(label), edgeNumber[copy.edge], "edge", *box,
                               labelStrokes(font, label, box->origin, box->height, box->angle)});
+      } else {
+        unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
+      }
+      if (piece) {
+        // The piece's name on its tab, along the side it is fastened to.
+        std::vector<Point2> onTab;
+        for (double u = 0.2; u <= 0.801; u += 0.15) {
+          for (double v = 0.2; v <= 0.801; v += 0.3) {
+            const auto& t = copy.tabOutline;
+            onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * ((1 - u) * t[3] + u * t[2]));
+          }
+        }
+        const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
+        if (const auto box = fitText(font, piece->name, std::atan2(side.y(), side.x()), copy.tabOutline,
+                                     copy.pieceOutline, circlesHere, takenHere, onTab)) {
+          piece->labels.push_back(
+              {piece->name, 0, "piece", *box, font.strokes(piece->name, box->origin, box->height, box->angle)});
+        } else {
+          unfitted.push_back(fmt::format("piece {}", piece->name));
+        }
+      }
     }
     {
       Point2 centre = Point2::Zero();

@@ -31,12 +31,25 @@ struct PanelLabel {
   std::vector<Polyline2> strokes;
 };
 
+// A band cut off its panel because the panel would overlap itself when
+// unfolded (V.4): the band and a tab that lies over the panel's vertex band,
+// fastened to it through one extra hole. Cut as a part of its own.
+struct PanelPiece {
+  std::string name;                // "17a": its panel's number and a letter
+  int edge = 0;                    // the edge number of its band
+  Polyline2 outline;               // in the panel's frame, where it lies on the panel; counter-clockwise
+  std::vector<PanelHole> holes;    // the band's, then the tab's (edge 0)
+  std::vector<PanelLabel> labels;  // the edge number on the band, the name on the tab
+  double area = 0;                 // of the band in 3D (the tab doubles the vertex band)
+};
+
 struct Panel {
-  int id = 0;         // flood-fill number, 1-based: the assembly order
-  int face = 0;       // the input face (its index in the file)
-  Polyline2 outline;  // the cut contour, counter-clockwise, not closed
-  std::vector<PanelHole> holes;
+  int id = 0;                    // flood-fill number, 1-based: the assembly order
+  int face = 0;                  // the input face (its index in the file)
+  Polyline2 outline;             // the cut contour, counter-clockwise, not closed
+  std::vector<PanelHole> holes;  // a tab's fastener has edge 0
   std::vector<PanelLabel> labels;
+  std::vector<PanelPiece> pieces;            // bands cut off, each fastened back by a tab
   std::vector<Polyline2> scores;             // fold lines between the vertex band and its bands (--score-folds)
   std::vector<int> neighbors;                // panel ids across its bands, in the order of its sides
   std::vector<int> edges;                    // the edge numbers of its bands, in the same order
@@ -57,7 +70,7 @@ struct BandOptions {
 struct BandStructure {
   std::vector<Panel> panels;  // in flood-fill order: panels[i].id == i + 1
   int interiorEdges = 0;
-  int fasteners = 0;                  // one per hole pair
+  int fasteners = 0;                  // one per hole pair, and one per piece's tab
   std::vector<std::string> warnings;  // one line each (labels that did not fit, ...)
 };
 

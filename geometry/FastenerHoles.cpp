@@ -83,6 +83,10 @@ std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, doub
 
 }  // namespace
 
+const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy) {
+  return copy.detached ? copy.pieceOutline : panel.outline;
+}
+
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
                                           double diameter, const std::function<std::string(int)>& edgeName) {
   std::vector<BandHoles> result(bands.size());
@@ -102,11 +106,11 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     const auto clearance = [&](const std::vector<BandPoint>& holes) {
       double least = std::numeric_limits<double>::max();
       for (int c = 0; c < 2; ++c) {
-        const FlatPanel& panel = panels[faces[c]];
+        const std::vector<Point2>& outline = cutOutline(panels[faces[c]], *copies[c]);
         for (size_t h = 0; h < holes.size(); ++h) {
           const Point2 at = holes[h].onPanel(*copies[c]);
-          if (!insidePolygon(panel.outline, at)) return -1.0;
-          least = std::min(least, distanceToOutline(panel.outline, at) / fromOutline);
+          if (!insidePolygon(outline, at)) return -1.0;
+          least = std::min(least, distanceToOutline(outline, at) / fromOutline);
           for (const Point2& other : holesOn[faces[c]]) least = std::min(least, (other - at).norm() / fromHole);
           for (size_t g = 0; g < h; ++g) least = std::min(least, (holes[g].onPanel(*copies[c]) - at).norm() / fromHole);
         }
@@ -167,9 +171,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       // What it keeps from the outlines alone, in diameters (the ratio above also weighs the other holes).
       double fromOutlines = std::numeric_limits<double>::max();
       for (int c = 0; c < 2 && !placed.holes.empty(); ++c) {
-        fromOutlines =
-            std::min(fromOutlines,
-                     distanceToOutline(panels[faces[c]].outline, placed.holes.front().onPanel(*copies[c])) / diameter);
+        fromOutlines = std::min(fromOutlines, distanceToOutline(cutOutline(panels[faces[c]], *copies[c]),
+                                                                placed.holes.front().onPanel(*copies[c])) /
+                                                  diameter);
       }
       placed.clearance = std::min(kClearance, fromOutlines);
       if (most < kLeastClearance / kClearance) {
@@ -206,6 +210,11 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     if (error) std::rethrow_exception(error);
   }
   std::vector<std::vector<Point2>> holesOn(panels.size());
+  for (size_t f = 0; f < panels.size(); ++f) {
+    for (const FlatBand& copy : panels[f].bands) {
+      if (copy.detached) holesOn[f].push_back(copy.tab);  // the tab's fastener
+    }
+  }
   for (const EdgeBand& band : bands) {
     if (band.edge < 0) continue;
     const FlatBand* copies[2] = {bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)};

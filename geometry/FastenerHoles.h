@@ -55,6 +55,9 @@ std::vector<BandHoles> placeFastenerHoles(
     const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels, double diameter,
     const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); });
 
+// The outline a copy of a band is cut with: its panel's, or its own piece's when detached.
+const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy);
+
 // The copy of edge `edge`'s band on `panel`, or nullptr.
 const FlatBand* bandCopy(const FlatPanel& panel, int edge);
 

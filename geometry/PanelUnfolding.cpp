@@ -1,5 +1,7 @@
 #include "geometry/PanelUnfolding.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -98,7 +100,47 @@ bool outlinesCross(const std::vector<Point2>& a, const std::vector<Point2>& b) {
   return false;
 }
 
+// The cut contour: the vertex band's corners, each side but those of
+// detached bands going out around its band.
+void rebuildOutline(FlatPanel& panel) {
+  panel.outline.clear();
+  for (size_t side = 0; side < panel.vertexBand.size(); ++side) {
+    panel.outline.push_back(panel.vertexBand[side]);
+    const int b = panel.bandOfSide[side];
+    if (b < 0 || panel.bands[b].detached) continue;
+    // Closed by the side from its end back to its start: counter-clockwise, as the panel's outline runs.
+    const auto& band = panel.bands[b].outline;
+    panel.outline.insert(panel.outline.end(), band.begin() + 1, band.end() - 1);
+  }
+}
+
 }  // namespace
+
+void detachBand(FlatPanel& panel, int index, double depth) {
+  const int sides = static_cast<int>(panel.vertexBand.size());
+  const int side =
+      static_cast<int>(std::find(panel.bandOfSide.begin(), panel.bandOfSide.end(), index) - panel.bandOfSide.begin());
+  const Point2& from = panel.vertexBand[side];
+  const Point2& to = panel.vertexBand[(side + 1) % sides];
+  const Point2& before = panel.vertexBand[(side + sides - 1) % sides];
+  const Point2& after = panel.vertexBand[(side + 2) % sides];
+  const Point2 along = (to - from).normalized(), inward(-along.y(), along.x());
+  // Down the two neighbouring sides until `depth` from this one.
+  const double dropBefore = (before - from).dot(inward), dropAfter = (after - to).dot(inward);
+  if (!(dropBefore > depth && dropAfter > depth)) {
+    throw std::invalid_argument(fmt::format("its vertex band is too shallow for a tab {:.3f} in deep", depth));
+  }
+  const Point2 tabFrom = from + (before - from) * (depth / dropBefore);
+  const Point2 tabTo = to + (after - to) * (depth / dropAfter);
+  FlatBand& band = panel.bands[index];
+  band.detached = true;
+  band.tabOutline = {from, to, tabTo, tabFrom};
+  band.tab = (from + to + tabTo + tabFrom) / 4;
+  band.pieceOutline = band.outline;  // from `from` around the band to `to`
+  band.pieceOutline.push_back(tabTo);
+  band.pieceOutline.push_back(tabFrom);
+  rebuildOutline(panel);
+}
 
 FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decomposition,
                       const std::vector<EdgeBand>& bands, int face) {
@@ -124,7 +166,6 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
     const Point2& from = panel.vertexBand[side];
     const Point2& to = panel.vertexBand[(side + 1) % sides];
     const int e = RotationSystem::edgeOf(d);
-    panel.outline.push_back(from);
     if (rs.isBoundaryEdge(e)) {
       panel.bandOfSide.push_back(-1);
       continue;
@@ -152,10 +193,10 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
     for (int i = 1; i <= k; ++i) flat.outline.push_back(railPoint(outRailU, out[i]));
     for (int i = k; i >= 0; --i) flat.outline.push_back(railPoint(!outRailU, out[i]));
     // Closed by the side from `to` back to `from`: counter-clockwise, as the panel's outline runs.
-    panel.outline.insert(panel.outline.end(), flat.outline.begin() + 1, flat.outline.end() - 1);
     panel.bandOfSide.push_back(static_cast<int>(panel.bands.size()));
     panel.bands.push_back(std::move(flat));
   }
+  rebuildOutline(panel);
   return panel;
 }
 
@@ -175,7 +216,7 @@ std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
   };
   if (crossesItself(panel.vertexBand)) result.emplace_back(-1, -1);
   for (int i = 0; i < n; ++i) {
-    if (crossesItself(panel.bands[i].outline)) result.emplace_back(i, i);
+    if (!panel.bands[i].detached && crossesItself(panel.bands[i].outline)) result.emplace_back(i, i);
   }
   const auto piece = [&](int i) -> const std::vector<Point2>& {
     return i < 0 ? panel.vertexBand : panel.bands[i].outline;
@@ -184,8 +225,10 @@ std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
     const auto& o = piece(i);
     return i < 0 ? Point2((o[0] + o[1] + o[2]) / 3) : Point2((o[o.size() / 2] + o[o.size() / 2 - 1]) / 2);
   };
+  const auto attached = [&](int i) { return i < 0 || !panel.bands[i].detached; };
   for (int i = -1; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
+      if (!attached(i) || !attached(j)) continue;
       if (outlinesCross(piece(i), piece(j)) || inside(piece(i), middle(j)) || inside(piece(j), middle(i))) {
         result.emplace_back(i, j);
       }

@@ -24,6 +24,12 @@ struct FlatBand {
   bool fromA = true;            // hangs on face A's side (the panel is face A), else on face B's
   std::vector<Point2> points;   // of EdgeBand::point(i), i = 0 .. 2k+1, in the panel's frame
   std::vector<Point2> outline;  // the band alone, counter-clockwise, its side on the vertex band included
+  // Cut off its panel (detachBand()): then cut as a piece of its own, the
+  // band and a tab over the vertex band, fastened to it through `tab`.
+  bool detached = false;
+  std::vector<Point2> pieceOutline;  // counter-clockwise, in the panel's frame
+  std::vector<Point2> tabOutline;    // the tab alone
+  Point2 tab = Point2::Zero();       // the extra fastener's hole, on the piece and on the vertex band
 };
 
 struct FlatPanel {
@@ -39,6 +45,14 @@ struct FlatPanel {
 // Throws std::invalid_argument if a band has a side of zero length (a degenerate face).
 FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decomposition,
                       const std::vector<EdgeBand>& bands, int face);
+
+// V.4's remedy for a panel that would overlap itself: band `index` is cut
+// off and becomes a piece of its own, the band plus a tab `depth` deep over
+// the vertex band along their common side (the vertex band clipped to that
+// depth), fastened back through one extra hole in the middle of the tab.
+// The panel's outline loses the band. Throws std::invalid_argument when the
+// vertex band is too shallow there for the tab.
+void detachBand(FlatPanel& panel, int index, double depth);
 
 // Signed area (positive counter-clockwise).
 double signedArea(const std::vector<Point2>& polygon);

@@ -10,14 +10,16 @@
 
 namespace rotafab::jobs {
 
-std::vector<Part> bandParts(const geometry::BandStructure& structure) {
+std::vector<Part> bandParts(const geometry::BandStructure& structure, std::vector<std::pair<int, int>>* owners) {
   std::vector<Part> parts;
-  for (const geometry::Panel& panel : structure.panels) {
+  const auto add = [&](const std::string& name, int order, const Polygon2& outline,
+                       const std::vector<geometry::PanelHole>& holes, const std::vector<geometry::PanelLabel>& labels,
+                       const std::vector<Polyline2>& scores) {
     Part part;
-    part.name = fmt::format("panel {}", panel.id);
-    part.order = panel.id - 1;
-    part.outline = panel.outline;
-    for (const geometry::PanelHole& hole : panel.holes) {
+    part.name = name;
+    part.order = order;
+    part.outline = outline;
+    for (const geometry::PanelHole& hole : holes) {
       // The polygon around the circle (its sides touch it), so the fastener passes.
       const double radius = hole.diameter / 2 / std::cos(std::numbers::pi / kHoleSides);
       Polygon2 circle;
@@ -27,11 +29,21 @@ std::vector<Part> bandParts(const geometry::BandStructure& structure) {
       }
       part.holes.push_back(std::move(circle));
     }
-    for (const geometry::PanelLabel& label : panel.labels) {
+    for (const geometry::PanelLabel& label : labels) {
       part.etch.insert(part.etch.end(), label.strokes.begin(), label.strokes.end());
     }
-    part.score = panel.scores;
+    part.score = scores;
     parts.push_back(std::move(part));
+  };
+  for (size_t i = 0; i < structure.panels.size(); ++i) {
+    const geometry::Panel& panel = structure.panels[i];
+    add(fmt::format("panel {}", panel.id), panel.id - 1, panel.outline, panel.holes, panel.labels, panel.scores);
+    if (owners) owners->emplace_back(static_cast<int>(i), -1);
+    for (size_t k = 0; k < panel.pieces.size(); ++k) {
+      const geometry::PanelPiece& piece = panel.pieces[k];
+      add("piece " + piece.name, panel.id - 1, piece.outline, piece.holes, piece.labels, {});
+      if (owners) owners->emplace_back(static_cast<int>(i), static_cast<int>(k));
+    }
   }
   return parts;
 }
@@ -55,16 +67,35 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
                       {"genus", mesh.genus ? nlohmann::ordered_json(*mesh.genus) : nlohmann::ordered_json(nullptr)}};
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
+  // Which panel (and piece) each planned part is, in bandParts()'s order.
+  std::vector<std::pair<int, int>> owners;
+  bandParts(structure, &owners);
+  std::vector<const PlannedPart*> placement(structure.panels.size());
+  std::map<std::pair<int, int>, const PlannedPart*> piecePlacement;
+  for (const PlannedPart& placed : plan.parts) {
+    const auto [panel, piece] = owners.at(placed.part);
+    if (piece < 0) {
+      placement[panel] = &placed;
+    } else {
+      piecePlacement[{panel, piece}] = &placed;
+    }
+  }
   manifest["sheets"] = nlohmann::ordered_json::array();
   for (size_t s = 0; s < plan.sheets.size(); ++s) {
-    nlohmann::ordered_json panels = nlohmann::ordered_json::array();
+    nlohmann::ordered_json panels = nlohmann::ordered_json::array(), pieces = nlohmann::ordered_json::array();
     for (const PlannedPart& placed : plan.parts) {
-      if (placed.sheet == static_cast<int>(s) + 1) panels.push_back(structure.panels[placed.part].id);
+      if (placed.sheet != static_cast<int>(s) + 1) continue;
+      const auto [panel, piece] = owners.at(placed.part);
+      if (piece < 0) {
+        panels.push_back(structure.panels[panel].id);
+      } else {
+        pieces.push_back(structure.panels[panel].pieces[piece].name);
+      }
     }
-    manifest["sheets"].push_back({{"index", s + 1}, {"files", files.at(s)}, {"panels", panels}});
+    nlohmann::ordered_json sheet = {{"index", s + 1}, {"files", files.at(s)}, {"panels", panels}};
+    if (!pieces.empty()) sheet["pieces"] = pieces;  // extension: the pieces of split panels it holds
+    manifest["sheets"].push_back(sheet);
   }
-  std::vector<const PlannedPart*> placement(structure.panels.size());
-  for (const PlannedPart& placed : plan.parts) placement[placed.part] = &placed;
   manifest["panels"] = nlohmann::ordered_json::array();
   for (size_t i = 0; i < structure.panels.size(); ++i) {
     const geometry::Panel& panel = structure.panels[i];
@@ -97,6 +128,29 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
     // how far the layout moved the panel from its assembly order.
     entry["edges"] = panel.edges;
     entry["moved"] = placed.moved;
+    // Extension: the bands cut off a panel that would overlap itself (V.4),
+    // each a part of its own with a tab fastened to the vertex band.
+    if (!panel.pieces.empty()) {
+      entry["pieces"] = nlohmann::ordered_json::array();
+      for (size_t k = 0; k < panel.pieces.size(); ++k) {
+        const geometry::PanelPiece& piece = panel.pieces[k];
+        const PlannedPart& at = *piecePlacement.at({static_cast<int>(i), static_cast<int>(k)});
+        nlohmann::ordered_json p;
+        p["name"] = piece.name;
+        p["edge"] = piece.edge;
+        p["sheet"] = at.sheet;
+        p["order"] = at.cuttingIndex + 1;
+        p["outline"] = nlohmann::ordered_json::array();
+        for (const Point2& q : piece.outline) p["outline"].push_back(point(q));
+        p["placement"] = {{"x", at.x}, {"y", at.y}, {"rotation", at.rotation}};
+        p["holes"] = nlohmann::ordered_json::array();
+        for (const auto& hole : piece.holes) {
+          p["holes"].push_back({{"edge", hole.edge}, {"xy", point(hole.xy)}, {"diameter", hole.diameter}});
+        }
+        p["area"] = piece.area;
+        entry["pieces"].push_back(p);
+      }
+    }
     manifest["panels"].push_back(entry);
   }
   return manifest;
@@ -112,6 +166,7 @@ struct Join {
 struct Step {
   int panel = 0, sheet = 0;
   std::vector<Join> joins;
+  std::vector<std::pair<std::string, int>> pieces;  // (name, sheet) of its bands cut off
 };
 
 std::vector<Step> stepsOf(const nlohmann::json& manifest) {
@@ -120,9 +175,16 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
   std::vector<Step> steps;
   for (const auto& [id, panel] : byId) {
     const auto& neighbors = panel->at("neighbors");
+    // A band's holes are on the panel, or on the piece it was cut off as.
     std::map<int, int> holesOfEdge;
     for (const auto& hole : panel->at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
-    Step step{id, panel->at("sheet").get<int>(), {}};
+    Step step{id, panel->at("sheet").get<int>(), {}, {}};
+    if (panel->contains("pieces")) {
+      for (const auto& piece : panel->at("pieces")) {
+        for (const auto& hole : piece.at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
+        step.pieces.emplace_back(piece.at("name").get<std::string>(), piece.at("sheet").get<int>());
+      }
+    }
     for (size_t j = 0; j < neighbors.size(); ++j) {
       const int other = neighbors[j].get<int>();
       if (other >= id) continue;
@@ -143,8 +205,12 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
 }
 
 std::string describeJoins(const Step& step) {
-  if (step.joins.empty()) return "start here, the base";
-  std::string text = "join to ";
+  std::string text;
+  for (const auto& [name, sheet] : step.pieces) {
+    text += fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", name, sheet);
+  }
+  if (step.joins.empty()) return text + "start here, the base";
+  text += "join to ";
   for (size_t j = 0; j < step.joins.size(); ++j) {
     const Join& join = step.joins[j];
     text += fmt::format("{}panel {} at edge {} ({} fastener{})", j ? ", " : "", join.panel, join.edge, join.fasteners,
@@ -193,6 +259,7 @@ std::string manifestText(const nlohmann::json& manifest) {
         headline(manifest));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
+      total += static_cast<int>(step.pieces.size());  // the tabs'
       for (const Join& join : step.joins) total += join.fasteners;
       text +=
           fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.panel, step.panel, step.sheet, describeJoins(step));
@@ -232,7 +299,7 @@ the same number on the panel named; fasten them through their holes.</p>
                                    escaped(headline(manifest)));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
-      int fasteners = 0;
+      int fasteners = static_cast<int>(step.pieces.size());  // the tabs'
       for (const Join& join : step.joins) fasteners += join.fasteners;
       total += fasteners;
       html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.panel, step.panel,

@@ -24,8 +24,12 @@ struct MeshCounts {
 // The band panels as parts for the planner: outline, holes (polygons of
 // kHoleSides sides around the circle, so the fastener still passes), labels
 // to etch, folds to score; assembly order = panel id - 1.
+// Each panel's pieces (bands cut off, see geometry::PanelPiece) follow it
+// as parts of their own; `owners`, when given, gets for each part its panel
+// (index) and its piece (index, -1 for the panel itself).
 constexpr int kHoleSides = 32;
-std::vector<Part> bandParts(const geometry::BandStructure& structure);
+std::vector<Part> bandParts(const geometry::BandStructure& structure,
+                            std::vector<std::pair<int, int>>* owners = nullptr);
 
 // `files[s]`: the files written for sheet s + 1.
 nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, const MeshCounts& mesh,

@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "CrumpledMesh.h"
 #include "geometry/BandDecomposition.h"
 #include "geometry/DevelopableBands.h"
 #include "geometry/FastenerHoles.h"
@@ -208,6 +209,46 @@ TEST(BandStructure, UnfoldingKeepsTheArea) {
       EXPECT_NEAR(flat, panel.area, 1e-6 * panel.area) << name << ": panel " << panel.id;
     }
   }
+}
+
+// V.4: a panel that would overlap itself is split at a band: the band is cut
+// off with a tab over the vertex band, fastened back through one extra hole.
+TEST(BandStructure, APanelThatWouldOverlapItselfIsSplitAtABand) {
+  const PolygonMesh mesh = test::crumpledTorus();
+  BandOptions options;
+  const BandStructure s = buildBandStructure(mesh, options);
+  int pieces = 0, holes = 0;
+  for (const Panel& panel : s.panels) {
+    holes += static_cast<int>(panel.holes.size());
+    for (const PanelPiece& piece : panel.pieces) {
+      ++pieces;
+      holes += static_cast<int>(piece.holes.size());
+      EXPECT_EQ(piece.name, std::to_string(panel.id) + "a");
+      double twice = 0;
+      for (size_t i = 0; i < piece.outline.size(); ++i) {
+        const Point2& a = piece.outline[i];
+        const Point2& b = piece.outline[(i + 1) % piece.outline.size()];
+        twice += a.x() * b.y() - b.x() * a.y();
+      }
+      EXPECT_GT(twice, 0) << "piece " << piece.name << " runs clockwise";
+      // The tab's hole is on both the piece and the panel, clear of both outlines.
+      const PanelHole& tab = piece.holes.back();
+      EXPECT_EQ(tab.edge, 0);
+      EXPECT_TRUE(std::any_of(panel.holes.begin(), panel.holes.end(),
+                              [&](const PanelHole& h) { return h.edge == 0 && (h.xy - tab.xy).norm() < 1e-12; }));
+      EXPECT_GE(distanceToOutline(piece.outline, tab.xy), kClearance * options.fastener - 1e-9);
+      EXPECT_GE(distanceToOutline(panel.outline, tab.xy), kClearance * options.fastener - 1e-9);
+      EXPECT_TRUE(insidePolygon(panel.outline, tab.xy));
+      // The band's own holes went with it; its edge is not on the panel any more.
+      EXPECT_GE(piece.holes.size(), 2u);
+      for (const PanelHole& hole : panel.holes) EXPECT_NE(hole.edge, piece.edge);
+      std::set<std::string> roles;
+      for (const PanelLabel& label : piece.labels) roles.insert(label.role);
+      EXPECT_EQ(roles, (std::set<std::string>{"edge", "piece"}));
+    }
+  }
+  EXPECT_GE(pieces, 1) << "the crumpled torus no longer needs a split: the test proves nothing";
+  EXPECT_EQ(holes, 2 * s.fasteners);  // a hole on each copy of a band, and on both sides of a tab
 }
 
 }  // namespace

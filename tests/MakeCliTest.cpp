@@ -4,13 +4,16 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <sstream>
 
+#include "CrumpledMesh.h"
 #include "TestSupport.h"
+#include "geometry/ObjWriter.h"
 
 namespace rotafab::test {
 namespace {
@@ -197,6 +200,42 @@ TEST(MakeCli, ReusedFolderAndOpenMeshes) {
   for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
     EXPECT_EQ(entry.path().filename().string().find(".partial"), std::string::npos) << "left " << entry.path();
   }
+}
+
+// A panel split at a band (V.4): its piece is planned and cut as a part of
+// its own, listed with the panel and on its sheet, and the steps say to
+// fasten it first.
+TEST(MakeCli, SplitPanelsComeWithTheirPieces) {
+  TempDir dir;
+  {
+    std::ofstream obj(dir.path() / "crumpled.obj");
+    geometry::writeObj(obj, crumpledTorus());
+  }
+  // --scale 1: the mesh is already at its size.
+  const CommandResult made = run(kCli + " make " + quoted(dir.path() / "crumpled.obj") +
+                                 " --structure band --scale 1 --time 0 --out " + quoted(dir.path() / "out"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto manifest = nlohmann::json::parse(readFile(dir.path() / "out/manifest.json"));
+  std::set<std::string> pieces, onSheets;
+  for (const auto& panel : manifest.at("panels")) {
+    if (!panel.contains("pieces")) continue;
+    for (const auto& piece : panel.at("pieces")) {
+      pieces.insert(piece.at("name").get<std::string>());
+      EXPECT_GE(piece.at("sheet").get<int>(), 1);
+      EXPECT_GE(piece.at("outline").size(), 3u);
+    }
+  }
+  for (const auto& sheet : manifest.at("sheets")) {
+    if (sheet.contains("pieces")) {
+      for (const auto& name : sheet.at("pieces")) onSheets.insert(name.get<std::string>());
+    }
+  }
+  ASSERT_FALSE(pieces.empty());
+  EXPECT_EQ(pieces, onSheets);
+  const std::string steps = readFile(dir.path() / "out/manifest.txt");
+  EXPECT_NE(steps.find("first fasten piece " + *pieces.begin()), std::string::npos) << steps;
+  const std::string fasteners = std::to_string(manifest.at("fasteners").get<int>()) + " fasteners in all";
+  EXPECT_NE(steps.find(fasteners), std::string::npos) << steps;
 }
 
 TEST(MakeCli, JsonSummaryAndErrors) {
