@@ -241,10 +241,10 @@ int runMake(const MakeOptions& options) {
     } else {
       fmt::print("{}: {} panels on {} sheet{} ({:.1f}% of the usable bed area), {} fasteners; written to {}/\n",
                  options.mesh, structure.panels.size(), sheets.sheets.size(), sheets.sheets.size() == 1 ? "" : "s",
-                 100 * sheets.utilization, structure.fasteners, out.string());
+                 100 * sheets.utilization, structure.fasteners, target.string());
       fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, writing {:.2f} s\n", importSeconds,
                  geometrySeconds, nestingSeconds, writingSeconds);
-      fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", out.string(), out.string());
+      fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", target.string(), target.string());
     }
     return kSuccess;
   } catch (const UserError& error) {
