@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <regex>
+#include <set>
 
 #include "daemon/ExitCode.h"
 #include "geometry/BandStructure.h"
@@ -177,14 +178,16 @@ int runMake(const MakeOptions& options) {
         options.out.empty() ? std::filesystem::path(std::filesystem::path(options.mesh).stem().string() + "-band")
                             : std::filesystem::path(options.out);
     progress(fmt::format("writing {} sheets to {}", sheets.sheets.size(), out.string()));
-    // Everything goes to a folder beside `out` first, and moves in only when
-    // all is written: a failure leaves no partial set, and a set made before
-    // into the same folder loses its files (so no stale sheet-009.eps stays
-    // beside a new 8-sheet job).
+    // Everything is written into a hidden folder inside `out` first (the
+    // same file system, whatever links lead there), and moves in only when
+    // all is written: a failure leaves the folder as it was. Each new file
+    // then replaces its old namesake in one rename, and only after that are
+    // the old job's files that the new one does not have (a stale
+    // sheet-009.eps beside a new 8-sheet job) removed.
     std::filesystem::path target = out;
     if (target.filename().empty()) target = target.parent_path();  // "dir/"
-    const std::filesystem::path staging =
-        target.parent_path() / fmt::format(".{}.partial-{}", target.filename().string(), ::getpid());
+    std::filesystem::create_directories(target);
+    const std::filesystem::path staging = target / fmt::format(".rotafab-partial-{}", ::getpid());
     std::filesystem::remove_all(staging);
     std::filesystem::create_directories(staging);
     struct Cleanup {
@@ -215,15 +218,21 @@ int runMake(const MakeOptions& options) {
         structure, {topology.vertices, topology.edges, topology.faces, topology.genus}, machine.bed, sheets, files);
     jobs::writeFileAtomically(staging / "manifest.json", manifest.dump(1) + "\n");
     jobs::writeFileAtomically(staging / "manifest.txt", jobs::manifestText(manifest));
-    std::filesystem::create_directories(target);
+    std::set<std::string> written;
+    for (const auto& entry : std::filesystem::directory_iterator(staging)) {
+      written.insert(entry.path().filename().string());
+    }
+    // manifest.json last: until it moves in, the folder's manifest is the old job's.
+    for (const std::string& name : written) {
+      if (name != "manifest.json") std::filesystem::rename(staging / name, target / name);
+    }
+    std::filesystem::rename(staging / "manifest.json", target / "manifest.json");
     static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
     for (const auto& entry : std::filesystem::directory_iterator(target)) {
-      if (entry.is_regular_file() && std::regex_match(entry.path().filename().string(), ours)) {
+      const std::string name = entry.path().filename().string();
+      if (entry.is_regular_file() && std::regex_match(name, ours) && !written.count(name)) {
         std::filesystem::remove(entry.path());
       }
-    }
-    for (const auto& entry : std::filesystem::directory_iterator(staging)) {
-      std::filesystem::rename(entry.path(), target / entry.path().filename());
     }
     const double writingSeconds = seconds();
 

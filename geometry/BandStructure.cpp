@@ -65,6 +65,11 @@ void say(const BandOptions& options, const std::string& line) {
 BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options) {
   if (!(options.fastener > 0)) throw std::invalid_argument("--fastener: the hole diameter must be positive");
   const RotationSystem rs = RotationSystem::fromMesh(mesh);
+  // Faces as a user finds them in the file; a face capping a hole (--holes fill) has no number there.
+  const auto faceName = [&](int f) {
+    return mesh.sourceFaceIndex(f) >= 0 ? fmt::format("face {}", mesh.sourceFaceIndex(f))
+                                        : std::string("the face filling a hole");
+  };
   say(options, fmt::format("band decomposition of {} faces", mesh.faceCount()));
   const BandDecomposition decomposition = bandDecomposition(mesh, rs, options.tension);
   const std::vector<EdgeBand> bands = developableBands(rs, decomposition, options.samples);
@@ -73,7 +78,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     try {
       flat.push_back(unfoldPanel(rs, decomposition, bands, f));
     } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument(fmt::format("face {}: {}", mesh.sourceFaceIndex(f), error.what()));
+      throw std::invalid_argument(fmt::format("{}: {}", faceName(f), error.what()));
     }
   }
 
@@ -103,9 +108,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   for (int f = 0; f < mesh.faceCount(); ++f) {
     for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
       const auto [i, j] = overlaps.front();
-      const auto where = [&] {
-        return fmt::format("panel {} (face {})", order.panelOfFace[f] + 1, mesh.sourceFaceIndex(f));
-      };
+      const auto where = [&] { return fmt::format("panel {} ({})", order.panelOfFace[f] + 1, faceName(f)); };
       if (j < 0) {
         throw std::invalid_argument(fmt::format(
             "{}: its vertex band crosses itself when laid flat (the face is far from planar); split the face in "
@@ -116,19 +119,39 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
         throw std::invalid_argument(
             fmt::format("{}: the band of {} overlaps itself when laid flat", where(), edgeName(flat[f].bands[j].edge)));
       }
-      // The later band of the two, or else the earlier one.
-      try {
-        detachBand(flat[f], j, 2 * kClearance * options.fastener);
-      } catch (const std::invalid_argument& error) {
+      // The later band of the two, or else the earlier one: the first whose
+      // tab fits, its hole clear of the piece's and the panel's outlines and
+      // of the panel's other tabs.
+      std::string why;
+      const auto cutOff = [&](int index) {
+        FlatPanel trial = flat[f];
         try {
-          if (i < 0) throw;
-          detachBand(flat[f], i, 2 * kClearance * options.fastener);
-        } catch (const std::invalid_argument&) {
-          throw std::invalid_argument(fmt::format(
-              "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger --size "
-              "or a smaller --fastener makes room",
-              where(), edgeName(flat[f].bands[j].edge), error.what()));
+          detachBand(trial, index, 2 * kClearance * options.fastener);
+        } catch (const std::invalid_argument& error) {
+          why = error.what();
+          return false;
         }
+        const FlatBand& cut = trial.bands[index];
+        const double clearance = kClearance * options.fastener;
+        bool clear = distanceToOutline(cut.pieceOutline, cut.tab) >= clearance &&
+                     insidePolygon(trial.outline, cut.tab) && distanceToOutline(trial.outline, cut.tab) >= clearance;
+        for (const FlatBand& other : trial.bands) {
+          if (&other != &cut && other.detached && (other.tab - cut.tab).norm() < clearance + options.fastener) {
+            clear = false;
+          }
+        }
+        if (!clear) {
+          why = "the tab's hole would not keep its clearance";
+          return false;
+        }
+        flat[f] = std::move(trial);
+        return true;
+      };
+      if (!cutOff(j) && (i < 0 || !cutOff(i))) {
+        throw std::invalid_argument(fmt::format(
+            "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger --size "
+            "or a smaller --fastener makes room",
+            where(), edgeName(flat[f].bands[j].edge), why));
       }
       ++split;
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <optional>
 #include <stdexcept>
 #include <thread>
@@ -91,8 +92,18 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
                                           double diameter, const std::function<std::string(int)>& edgeName) {
   std::vector<BandHoles> result(bands.size());
   const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
-  // One band's holes, kept clear of `holesOn` (centres already placed, per panel).
-  const auto placeBand = [&](const EdgeBand& band, const std::vector<std::vector<Point2>>& holesOn) {
+  // Holes already placed, per part cut: a panel (key (face, -1)) and each
+  // band cut off it (key (face, edge)) are parts of their own, only sharing
+  // the panel's frame; a tab's hole is on both.
+  using Placed = std::map<std::pair<int, int>, std::vector<Point2>>;
+  const auto partOf = [](int face, const FlatBand& copy) { return std::pair{face, copy.detached ? copy.edge : -1}; };
+  const auto near = [](const Placed& placed, const std::pair<int, int>& part) -> const std::vector<Point2>& {
+    static const std::vector<Point2> none;
+    const auto it = placed.find(part);
+    return it == placed.end() ? none : it->second;
+  };
+  // One band's holes, kept clear of `holesOn`.
+  const auto placeBand = [&](const EdgeBand& band, const Placed& holesOn) {
     BandHoles placed;
     const FlatBand* copies[2] = {bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)};
     const int faces[2] = {band.faceA, band.faceB};
@@ -111,7 +122,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
           const Point2 at = holes[h].onPanel(*copies[c]);
           if (!insidePolygon(outline, at)) return -1.0;
           least = std::min(least, distanceToOutline(outline, at) / fromOutline);
-          for (const Point2& other : holesOn[faces[c]]) least = std::min(least, (other - at).norm() / fromHole);
+          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c]))) {
+            least = std::min(least, (other - at).norm() / fromHole);
+          }
           for (size_t g = 0; g < h; ++g) least = std::min(least, (holes[g].onPanel(*copies[c]) - at).norm() / fromHole);
         }
       }
@@ -189,7 +202,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   // edge order, a band whose holes come too near those of a band before it
   // on the same panel (rare: the outline runs between two bands) is placed
   // again beside them. The result does not depend on the number of cores.
-  const std::vector<std::vector<Point2>> none(panels.size());
+  const Placed none;
   std::vector<std::exception_ptr> errors(bands.size());
   const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
   std::vector<std::thread> threads;
@@ -209,10 +222,12 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   for (const auto& error : errors) {
     if (error) std::rethrow_exception(error);
   }
-  std::vector<std::vector<Point2>> holesOn(panels.size());
+  Placed holesOn;
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {
-      if (copy.detached) holesOn[f].push_back(copy.tab);  // the tab's fastener
+      if (!copy.detached) continue;
+      holesOn[{static_cast<int>(f), -1}].push_back(copy.tab);          // the tab's fastener, on the panel
+      holesOn[partOf(static_cast<int>(f), copy)].push_back(copy.tab);  // and on the piece
     }
   }
   for (const EdgeBand& band : bands) {
@@ -222,7 +237,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     const auto tooNear = [&] {
       for (int c = 0; c < 2; ++c) {
         for (const BandPoint& h : result[band.edge].holes) {
-          for (const Point2& other : holesOn[faces[c]]) {
+          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c]))) {
             if ((other - h.onPanel(*copies[c])).norm() < fromHole) return true;
           }
         }
@@ -231,7 +246,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     };
     if (tooNear()) result[band.edge] = placeBand(band, holesOn);
     for (int c = 0; c < 2; ++c) {
-      for (const BandPoint& h : result[band.edge].holes) holesOn[faces[c]].push_back(h.onPanel(*copies[c]));
+      for (const BandPoint& h : result[band.edge].holes) {
+        holesOn[partOf(faces[c], *copies[c])].push_back(h.onPanel(*copies[c]));
+      }
     }
   }
   return result;

@@ -17,7 +17,12 @@
 // mean edge of 2 in, a few of the bunny's 5511 bands and every band of a
 // cube are about 1/3 in wide, under 3 diameters of a 1/8 in fastener) gets
 // one hole where it keeps the most clearance, if that is at least
-// kLeastClearance diameters; the caller warns (BandHoles::clearance).
+// kLeastClearance diameters; the caller warns (BandHoles::clearance, which
+// counts the outlines only). That least clearance is measured on the same
+// scale against outlines and other holes: from another hole's centre, at
+// least kLeastClearance / kClearance of (kClearance + 1) diameters.
+// "Each part it is on": a band cut off its panel (detachBand()) is a part
+// of its own, with its piece's outline and its tab's hole.
 
 #include <array>
 #include <functional>

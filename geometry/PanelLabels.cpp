@@ -94,7 +94,8 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
   }
   const auto clear = [&](const Point2& p, double gap) { return insidePolygon(region, p) && distanceToSides(p) >= gap; };
   // The region's extent along the text and across it: a box longer or
-  // taller than that, with its gaps, cannot fit anywhere.
+  // taller than that cannot fit anywhere. (Not with the gaps: the gap is
+  // kept from the cut outline, and the region's side may be a fold.)
   double alongLow = std::numeric_limits<double>::max(), alongHigh = -alongLow, upLow = alongLow, upHigh = -alongLow;
   for (const Point2& p : region) {
     alongLow = std::min(alongLow, p.dot(along)), alongHigh = std::max(alongHigh, p.dot(along));
@@ -103,7 +104,7 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
   for (double height = std::min(kLargestLabel, most / 0.75); height >= kSmallestLabel - 1e-12; height *= 0.85) {
     const double width = font.advance(text, height);
     const double gap = std::max(kLabelGap, height / 4);
-    if (width + 2 * gap > alongHigh - alongLow || height + 2 * gap > upHigh - upLow) continue;
+    if (width > alongHigh - alongLow || height > upHigh - upLow) continue;
     for (size_t c = 0; c < candidates.size(); ++c) {
       if (room[c] < height / 2 + gap) continue;
       const Point2& centre = candidates[c];

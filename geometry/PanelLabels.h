@@ -23,7 +23,7 @@ struct TextBox {
   Point2 origin;
   double angle = 0;  // radians, counter-clockwise from +x
   double width = 0, height = 0;
-  Point2 along{1, 0};  // (cos angle, sin angle), kept to spare the trigonometry in the fitting
+  Point2 along{1, 0};  // must be (cos angle, sin angle): kept to spare the trigonometry in the fitting
 
   [[nodiscard]] std::vector<Point2> corners() const;
   // The distance from p to the box (0 inside).

@@ -116,6 +116,16 @@ void rebuildOutline(FlatPanel& panel) {
 
 }  // namespace
 
+bool crossesItself(const std::vector<Point2>& o) {
+  for (size_t a = 0; a < o.size(); ++a) {
+    for (size_t b = a + 2; b < o.size(); ++b) {
+      if (a == 0 && b + 1 == o.size()) continue;
+      if (properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()])) return true;
+    }
+  }
+  return false;
+}
+
 void detachBand(FlatPanel& panel, int index, double depth) {
   const int sides = static_cast<int>(panel.vertexBand.size());
   const int side =
@@ -139,6 +149,17 @@ void detachBand(FlatPanel& panel, int index, double depth) {
   band.pieceOutline = band.outline;  // from `from` around the band to `to`
   band.pieceOutline.push_back(tabTo);
   band.pieceOutline.push_back(tabFrom);
+  // The tab must lie on the vertex band (no other corner of it inside the
+  // tab, no side across it), and the piece must not cross itself (a band
+  // that reached over its own vertex band could cross its tab).
+  for (int c = 0; c < sides; ++c) {
+    if (c != side && c != (side + 1) % sides && inside(band.tabOutline, panel.vertexBand[c])) {
+      throw std::invalid_argument(fmt::format("its vertex band has a corner where the tab would go"));
+    }
+  }
+  if (outlinesCross(band.tabOutline, panel.vertexBand) || crossesItself(band.pieceOutline)) {
+    throw std::invalid_argument("the tab would not lie on the vertex band");
+  }
   rebuildOutline(panel);
 }
 
@@ -205,15 +226,6 @@ std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
   const int n = static_cast<int>(panel.bands.size());
   // A piece that crosses itself: a vertex band projected from a twisted face,
   // or a band whose development curls over itself (V.4).
-  const auto crossesItself = [](const std::vector<Point2>& o) {
-    for (size_t a = 0; a < o.size(); ++a) {
-      for (size_t b = a + 2; b < o.size(); ++b) {
-        if (a == 0 && b + 1 == o.size()) continue;
-        if (properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()])) return true;
-      }
-    }
-    return false;
-  };
   if (crossesItself(panel.vertexBand)) result.emplace_back(-1, -1);
   for (int i = 0; i < n; ++i) {
     if (!panel.bands[i].detached && crossesItself(panel.bands[i].outline)) result.emplace_back(i, i);

@@ -51,8 +51,13 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
 // the vertex band along their common side (the vertex band clipped to that
 // depth), fastened back through one extra hole in the middle of the tab.
 // The panel's outline loses the band. Throws std::invalid_argument when the
-// vertex band is too shallow there for the tab.
+// vertex band is too shallow there for the tab, when the tab would not lie
+// on the vertex band, or when the piece would cross itself; the panel is
+// then left half changed (detach a copy).
 void detachBand(FlatPanel& panel, int index, double depth);
+
+// Whether a closed outline crosses itself (two sides that are not neighbours properly cross).
+bool crossesItself(const std::vector<Point2>& outline);
 
 // Signed area (positive counter-clockwise).
 double signedArea(const std::vector<Point2>& polygon);
@@ -60,8 +65,9 @@ double signedArea(const std::vector<Point2>& polygon);
 // Pairs of the panel's pieces that overlap: -1 for the vertex band, else an
 // index into bands; (i, i) for a piece that crosses itself. Empty when no
 // two pieces' outlines cross, none holds another's middle, and none
-// crosses itself. (Developed triangles never turn over: each goes on the
-// far side of the edge it shares, so a fold shows only as crossing outlines.)
+// crosses itself. Bands cut off (detachBand()) are no longer pieces of the
+// panel and are skipped. (Developed triangles never turn over: each goes on
+// the far side of the edge it shares, so a fold shows only as crossing outlines.)
 std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel);
 
 }  // namespace rotafab::geometry

@@ -37,11 +37,14 @@ std::vector<Part> bandParts(const geometry::BandStructure& structure, std::vecto
   };
   for (size_t i = 0; i < structure.panels.size(); ++i) {
     const geometry::Panel& panel = structure.panels[i];
-    add(fmt::format("panel {}", panel.id), panel.id - 1, panel.outline, panel.holes, panel.labels, panel.scores);
+    // One running order: a panel, then its pieces, then the next panel (so
+    // that pieces do not push later panels out of the planner's window).
+    add(fmt::format("panel {}", panel.id), static_cast<int>(parts.size()), panel.outline, panel.holes, panel.labels,
+        panel.scores);
     if (owners) owners->emplace_back(static_cast<int>(i), -1);
     for (size_t k = 0; k < panel.pieces.size(); ++k) {
       const geometry::PanelPiece& piece = panel.pieces[k];
-      add("piece " + piece.name, panel.id - 1, piece.outline, piece.holes, piece.labels, {});
+      add("piece " + piece.name, static_cast<int>(parts.size()), piece.outline, piece.holes, piece.labels, {});
       if (owners) owners->emplace_back(static_cast<int>(i), static_cast<int>(k));
     }
   }
@@ -193,8 +196,15 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
       if (panel->contains("edges")) {
         edge = panel->at("edges").at(j).get<int>();
       } else if (byId.count(other)) {
-        for (const auto& hole : byId.at(other)->at("holes")) {
-          if (holesOfEdge.count(hole.at("edge").get<int>())) edge = hole.at("edge").get<int>();
+        const auto look = [&](const nlohmann::json& holes) {
+          for (const auto& hole : holes) {
+            const int e = hole.at("edge").get<int>();
+            if (e != 0 && holesOfEdge.count(e)) edge = e;  // 0: a tab's fastener, no edge
+          }
+        };
+        look(byId.at(other)->at("holes"));
+        if (byId.at(other)->contains("pieces")) {
+          for (const auto& piece : byId.at(other)->at("pieces")) look(piece.at("holes"));
         }
       }
       step.joins.push_back({other, edge, holesOfEdge[edge]});

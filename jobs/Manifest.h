@@ -23,7 +23,8 @@ struct MeshCounts {
 
 // The band panels as parts for the planner: outline, holes (polygons of
 // kHoleSides sides around the circle, so the fastener still passes), labels
-// to etch, folds to score; assembly order = panel id - 1.
+// to etch, folds to score. The parts' order runs over the panels in
+// flood-fill order, each panel's pieces right after it.
 // Each panel's pieces (bands cut off, see geometry::PanelPiece) follow it
 // as parts of their own; `owners`, when given, gets for each part its panel
 // (index) and its piece (index, -1 for the panel itself).

@@ -231,6 +231,8 @@ TEST(BandStructure, APanelThatWouldOverlapItselfIsSplitAtABand) {
         twice += a.x() * b.y() - b.x() * a.y();
       }
       EXPECT_GT(twice, 0) << "piece " << piece.name << " runs clockwise";
+      EXPECT_FALSE(crossesItself(piece.outline)) << "piece " << piece.name;
+      EXPECT_FALSE(crossesItself(panel.outline)) << "panel " << panel.id;
       // The tab's hole is on both the piece and the panel, clear of both outlines.
       const PanelHole& tab = piece.holes.back();
       EXPECT_EQ(tab.edge, 0);
