@@ -13,6 +13,7 @@
 #include <regex>
 #include <set>
 
+#include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
 #include "geometry/BandStructure.h"
 #include "geometry/MeshAnalysis.h"
@@ -46,19 +47,6 @@ struct MakeOptions {
   std::string order = "window";
   int window = 8;
 };
-
-class UserError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-double lengthOption(const std::string& text, const char* option) {
-  const auto value = profiles::parseLength(text);
-  if (!value || !(*value > 0)) {
-    throw UserError(fmt::format("{} {}: expected a positive length such as 0.125in, 3.2mm or 0.32cm", option, text));
-  }
-  return *value;
-}
 
 // --holes fill: each boundary loop capped by one polygon face, along the
 // loop's own walk (so that the cap is oriented like the faces around it).
@@ -129,7 +117,8 @@ int runMake(const MakeOptions& options) {
     // The mesh as built (after --holes fill): one panel per face.
     const geometry::MeshTopology topology = analysis.topology;
     const double scale = geometry::constructionScale(
-        mesh, options.size.empty() ? std::nullopt : std::optional(lengthOption(options.size, "--size")), options.scale);
+        mesh, options.size.empty() ? std::nullopt : std::optional(lengthOption(options.size, "--size", true)),
+        options.scale);
     if (!(scale > 0) || !std::isfinite(scale)) throw UserError("--scale: expected a positive number");
     for (geometry::Point3& p : mesh.positions) p *= scale;
     const double importSeconds = seconds();
@@ -138,7 +127,8 @@ int runMake(const MakeOptions& options) {
     geometry::BandOptions band;
     band.tension = options.tension;
     band.samples = options.samples;
-    band.fastener = options.fastener.empty() ? material.fastenerDiameter : lengthOption(options.fastener, "--fastener");
+    band.fastener =
+        options.fastener.empty() ? material.fastenerDiameter : lengthOption(options.fastener, "--fastener", true);
     band.start = options.start;
     band.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
     band.scoreFolds = options.scoreFolds;

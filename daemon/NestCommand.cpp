@@ -7,6 +7,7 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/LayoutSvg.h"
@@ -34,19 +35,6 @@ struct NestOptions {
   int evaluations = 0;
   int threads = 0;
 };
-
-class UserError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-double lengthOption(const std::string& text, const char* option) {
-  const auto value = profiles::parseLength(text);
-  if (!value || *value < 0) {
-    throw UserError(fmt::format("{} {}: expected a length such as 0.25in, 6.35mm or 0.635cm", option, text));
-  }
-  return *value;
-}
 
 int runNest(const NestOptions& options) {
   try {

@@ -29,30 +29,6 @@ const FlatBand* bandCopy(const FlatPanel& panel, int edge) {
   return nullptr;
 }
 
-double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p) {
-  double nearest = std::numeric_limits<double>::max();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[(i + 1) % polygon.size()];
-    const Point2 ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    nearest = std::min(nearest, (a + t * ab - p).norm());
-  }
-  return nearest;
-}
-
-bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p) {
-  bool in = false;
-  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
 namespace {
 
 // The band point at (s, t) of a flat copy: s from the first face's side

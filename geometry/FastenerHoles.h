@@ -66,10 +66,4 @@ const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& co
 // The copy of edge `edge`'s band on `panel`, or nullptr.
 const FlatBand* bandCopy(const FlatPanel& panel, int edge);
 
-// The distance from `p` to the nearest side of a closed polygon.
-double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p);
-
-// Whether `p` is inside a closed polygon (even-odd).
-bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p);
-
 }  // namespace rotafab::geometry

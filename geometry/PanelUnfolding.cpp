@@ -18,6 +18,30 @@ double signedArea(const std::vector<Point2>& polygon) {
   return twice / 2;
 }
 
+double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p) {
+  double nearest = std::numeric_limits<double>::max();
+  for (size_t i = 0; i < polygon.size(); ++i) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[(i + 1) % polygon.size()];
+    const Point2 ab = b - a;
+    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    nearest = std::min(nearest, (a + t * ab - p).norm());
+  }
+  return nearest;
+}
+
+bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p) {
+  bool in = false;
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const Point2& a = polygon[i];
+    const Point2& b = polygon[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
+      in = !in;
+    }
+  }
+  return in;
+}
+
 namespace {
 
 double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -77,18 +101,6 @@ bool properlyCross(const Point2& a, const Point2& b, const Point2& c, const Poin
   const double scale = 1e-12 * std::max((b - a).squaredNorm(), (d - c).squaredNorm());
   return ((d1 > scale && d2 < -scale) || (d1 < -scale && d2 > scale)) &&
          ((d3 > scale && d4 < -scale) || (d3 < -scale && d4 > scale));
-}
-
-bool inside(const std::vector<Point2>& polygon, const Point2& p) {
-  bool in = false;
-  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
-      in = !in;
-    }
-  }
-  return in;
 }
 
 bool outlinesCross(const std::vector<Point2>& a, const std::vector<Point2>& b) {
@@ -153,7 +165,7 @@ void detachBand(FlatPanel& panel, int index, double depth) {
   // tab, no side across it), and the piece must not cross itself (a band
   // that reached over its own vertex band could cross its tab).
   for (int c = 0; c < sides; ++c) {
-    if (c != side && c != (side + 1) % sides && inside(band.tabOutline, panel.vertexBand[c])) {
+    if (c != side && c != (side + 1) % sides && insidePolygon(band.tabOutline, panel.vertexBand[c])) {
       throw std::invalid_argument(fmt::format("its vertex band has a corner where the tab would go"));
     }
   }
@@ -241,7 +253,8 @@ std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
   for (int i = -1; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       if (!attached(i) || !attached(j)) continue;
-      if (outlinesCross(piece(i), piece(j)) || inside(piece(i), middle(j)) || inside(piece(j), middle(i))) {
+      if (outlinesCross(piece(i), piece(j)) || insidePolygon(piece(i), middle(j)) ||
+          insidePolygon(piece(j), middle(i))) {
         result.emplace_back(i, j);
       }
     }

@@ -59,6 +59,12 @@ void detachBand(FlatPanel& panel, int index, double depth);
 // Whether a closed outline crosses itself (two sides that are not neighbours properly cross).
 bool crossesItself(const std::vector<Point2>& outline);
 
+// The distance from `p` to the nearest side of a closed polygon.
+double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p);
+
+// Whether `p` is inside a closed polygon (even-odd).
+bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p);
+
 // Signed area (positive counter-clockwise).
 double signedArea(const std::vector<Point2>& polygon);
 

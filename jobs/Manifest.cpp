@@ -8,6 +8,8 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "jobs/SvgWriter.h"
+
 namespace rotafab::jobs {
 
 std::vector<Part> bandParts(const geometry::BandStructure& structure, std::vector<std::pair<int, int>>* owners) {
@@ -235,29 +237,6 @@ std::string headline(const nlohmann::json& manifest) {
                      manifest.at("panels").size(), sheets, sheets == 1 ? "" : "s", manifest.at("fasteners").get<int>());
 }
 
-std::string escaped(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
 }  // namespace
 
 std::string manifestText(const nlohmann::json& manifest) {
@@ -306,14 +285,14 @@ the same number on the panel named; fasten them through their holes.</p>
 <table>
 <tr><th>step</th><th>panel</th><th>sheet</th><th>joins</th><th>fasteners</th></tr>
 )",
-                                   escaped(headline(manifest)));
+                                   xmlText(headline(manifest)));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
       int fasteners = static_cast<int>(step.pieces.size());  // the tabs'
       for (const Join& join : step.joins) fasteners += join.fasteners;
       total += fasteners;
       html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.panel, step.panel,
-                          step.sheet, escaped(describeJoins(step)), fasteners);
+                          step.sheet, xmlText(describeJoins(step)), fasteners);
     }
     html += fmt::format("</table>\n<p>{} fasteners in all.</p>\n", total);
     for (const auto& sheet : manifest.at("sheets")) {

@@ -1,4 +1,5 @@
 #include "jobs/Nesting.h"
+#include "geometry/PanelUnfolding.h"
 
 #include "jobs/CellCover.h"
 #include "jobs/ConvexPieces.h"
@@ -1380,15 +1381,7 @@ Point2 rotatedPoint(const Point2& p, double degrees) {
   return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
 }
 
-double polygonArea(const Polygon2& polygon) {
-  double twice = 0;
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[(i + 1) % polygon.size()];
-    twice += a.x() * b.y() - b.x() * a.y();
-  }
-  return twice / 2;
-}
+double polygonArea(const Polygon2& polygon) { return geometry::signedArea(polygon); }
 
 Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement) {
   Polygon2 out = rotated(part.outline, placement.rotation);

@@ -14,8 +14,8 @@ namespace {
 constexpr int kDecimals = 9;
 constexpr double kHairlineInches = 0.001;
 
-// Character data for XML 1.0: markup characters escaped, control characters
-// (not allowed in XML 1.0) and bytes that are not valid UTF-8 replaced by '?'.
+}  // namespace
+
 std::string xmlText(std::string_view text) {
   std::string out;
   for (size_t i = 0; i < text.size();) {
@@ -54,8 +54,6 @@ std::string xmlText(std::string_view text) {
   }
   return out;
 }
-
-}  // namespace
 
 void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   checkDrawable(sheet);

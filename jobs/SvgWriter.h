@@ -18,11 +18,18 @@
 // The same inputs as the EPS writer are refused, with std::invalid_argument.
 
 #include <ostream>
+#include <string>
+#include <string_view>
 
 #include "jobs/SheetDrawing.h"
 
 namespace rotafab::jobs {
 
 void writeSvg(const SheetDrawing& sheet, std::ostream& out);
+
+// Character data for XML 1.0 (and HTML): markup characters escaped, control
+// characters (not allowed in XML 1.0) and bytes that are not valid UTF-8
+// replaced by '?'.
+std::string xmlText(std::string_view text);
 
 }  // namespace rotafab::jobs
