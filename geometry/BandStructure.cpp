@@ -132,7 +132,9 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
           return false;
         }
         const FlatBand& cut = trial.bands[index];
-        const double clearance = kClearance * options.fastener;
+        // The tab is exactly twice the clearance deep, so its hole is at the
+        // clearance from the fold: allow for rounding (1e-9 in).
+        const double clearance = kClearance * options.fastener - 1e-9;
         bool clear = distanceToOutline(cut.pieceOutline, cut.tab) >= clearance &&
                      insidePolygon(trial.outline, cut.tab) && distanceToOutline(trial.outline, cut.tab) >= clearance;
         for (const FlatBand& other : trial.bands) {
