@@ -12,7 +12,7 @@
 
 namespace rotafab::jobs {
 
-std::vector<Part> bandParts(const geometry::BandStructure& structure, std::vector<std::pair<int, int>>* owners) {
+std::vector<Part> bandParts(const geometry::BandStructure& structure) {
   std::vector<Part> parts;
   const auto add = [&](const std::string& name, int order, const Polygon2& outline,
                        const std::vector<geometry::PanelHole>& holes, const std::vector<geometry::PanelLabel>& labels,
@@ -37,20 +37,30 @@ std::vector<Part> bandParts(const geometry::BandStructure& structure, std::vecto
     part.score = scores;
     parts.push_back(std::move(part));
   };
-  for (size_t i = 0; i < structure.panels.size(); ++i) {
+  // One running order: a panel, then its pieces, then the next panel (so
+  // that pieces do not push later panels out of the planner's window).
+  for (const auto& [i, k] : partOwners(structure)) {
     const geometry::Panel& panel = structure.panels[i];
-    // One running order: a panel, then its pieces, then the next panel (so
-    // that pieces do not push later panels out of the planner's window).
-    add(fmt::format("panel {}", panel.id), static_cast<int>(parts.size()), panel.outline, panel.holes, panel.labels,
-        panel.scores);
-    if (owners) owners->emplace_back(static_cast<int>(i), -1);
-    for (size_t k = 0; k < panel.pieces.size(); ++k) {
+    if (k < 0) {
+      add(fmt::format("panel {}", panel.id), static_cast<int>(parts.size()), panel.outline, panel.holes, panel.labels,
+          panel.scores);
+    } else {
       const geometry::PanelPiece& piece = panel.pieces[k];
       add("piece " + piece.name, static_cast<int>(parts.size()), piece.outline, piece.holes, piece.labels, {});
-      if (owners) owners->emplace_back(static_cast<int>(i), static_cast<int>(k));
     }
   }
   return parts;
+}
+
+std::vector<std::pair<int, int>> partOwners(const geometry::BandStructure& structure) {
+  std::vector<std::pair<int, int>> owners;
+  for (size_t i = 0; i < structure.panels.size(); ++i) {
+    owners.emplace_back(static_cast<int>(i), -1);
+    for (size_t k = 0; k < structure.panels[i].pieces.size(); ++k) {
+      owners.emplace_back(static_cast<int>(i), static_cast<int>(k));
+    }
+  }
+  return owners;
 }
 
 namespace {
@@ -73,8 +83,7 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
   // Which panel (and piece) each planned part is, in bandParts()'s order.
-  std::vector<std::pair<int, int>> owners;
-  bandParts(structure, &owners);
+  const std::vector<std::pair<int, int>> owners = partOwners(structure);
   std::vector<const PlannedPart*> placement(structure.panels.size());
   std::map<std::pair<int, int>, const PlannedPart*> piecePlacement;
   for (const PlannedPart& placed : plan.parts) {

@@ -26,11 +26,13 @@ struct MeshCounts {
 // to etch, folds to score. The parts' order runs over the panels in
 // flood-fill order, each panel's pieces right after it.
 // Each panel's pieces (bands cut off, see geometry::PanelPiece) follow it
-// as parts of their own; `owners`, when given, gets for each part its panel
-// (index) and its piece (index, -1 for the panel itself).
+// as parts of their own.
 constexpr int kHoleSides = 32;
-std::vector<Part> bandParts(const geometry::BandStructure& structure,
-                            std::vector<std::pair<int, int>>* owners = nullptr);
+std::vector<Part> bandParts(const geometry::BandStructure& structure);
+
+// For each of bandParts()'s parts, in its order: its panel (index) and its
+// piece (index, -1 for the panel itself).
+std::vector<std::pair<int, int>> partOwners(const geometry::BandStructure& structure);
 
 // `files[s]`: the files written for sheet s + 1.
 nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, const MeshCounts& mesh,
