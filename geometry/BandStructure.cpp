@@ -45,17 +45,6 @@ double polygonArea3(const std::vector<Point3>& polygon) {
   return sum.norm() / 2;
 }
 
-// The point (s, t) of a flat band copy: s from its first face's side (0) to
-// the second's (1), t from rail U (0) to rail V (1).
-Point2 flatPoint(const FlatBand& copy, int segments, double s, double t) {
-  const double x = s * segments;
-  const int i = std::min(static_cast<int>(x), segments - 1);
-  const double along = x - i;
-  const Point2 u = (1 - along) * copy.points[i] + along * copy.points[i + 1];
-  const Point2 v = (1 - along) * copy.points[segments + 1 + i] + along * copy.points[segments + 2 + i];
-  return (1 - t) * u + t * v;
-}
-
 void say(const BandOptions& options, const std::string& line) {
   if (options.progress) options.progress(line);
 }
@@ -253,7 +242,6 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     std::vector<TextBox> taken;
     size_t pieceIndex = 0;
     for (const FlatBand& copy : fp.bands) {
-      const EdgeBand& band = bands[copy.edge];
       PanelPiece* piece = copy.detached ? &panel.pieces[pieceIndex] : nullptr;
       const std::vector<Circle>& circlesHere = piece ? pieceCircles[pieceIndex] : circles;
       std::vector<TextBox> pieceTaken;
@@ -261,15 +249,14 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
       auto& labelsHere = piece ? piece->labels : panel.labels;
       const auto& outlineHere = piece ? copy.pieceOutline : fp.outline;
       if (piece) ++pieceIndex;
-      const int k = band.segments();
       const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
-      const Point2 out = flatPoint(copy, k, far, 0.5) - flatPoint(copy, k, near, 0.5);
+      const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
       Point2 holesAt = Point2::Zero();
       for (const BandPoint& hole : holes[copy.edge].holes) holesAt += hole.onPanel(copy);
       holesAt /= std::max<double>(1, static_cast<double>(holes[copy.edge].holes.size()));
       std::vector<Point2> candidates;
       for (double s = 0.1; s <= 0.901; s += 0.1) {
-        for (double t = 0.2; t <= 0.801; t += 0.1) candidates.push_back(flatPoint(copy, k, s, t));
+        for (double t = 0.2; t <= 0.801; t += 0.1) candidates.push_back(copy.at(s, t));
       }
       std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
         return (a - holesAt).squaredNorm() < (b - holesAt).squaredNorm();

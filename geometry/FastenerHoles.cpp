@@ -34,13 +34,7 @@ namespace {
 // The band point at (s, t) of a flat copy: s from the first face's side
 // (0) to the second's (1) along the rails, t from rail U (0) to rail V (1).
 std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, double s, double t) {
-  const int k = band.segments();
-  const double x = s * k;
-  const int i = std::min(static_cast<int>(x), k - 1);
-  const double along = x - i;
-  const Point2 u = (1 - along) * copy.points[i] + along * copy.points[i + 1];
-  const Point2 v = (1 - along) * copy.points[k + 1 + i] + along * copy.points[k + 2 + i];
-  const Point2 p = (1 - t) * u + t * v;
+  const Point2 p = copy.at(s, t);
   std::optional<BandPoint> best;
   double bestLeast = -1e-9;
   for (const auto& tri : band.triangles()) {

@@ -8,6 +8,16 @@
 
 namespace rotafab::geometry {
 
+Point2 FlatBand::at(double s, double t) const {
+  const int segments = static_cast<int>(points.size()) / 2 - 1;
+  const double x = s * segments;
+  const int i = std::min(static_cast<int>(x), segments - 1);
+  const double along = x - i;
+  const Point2 u = (1 - along) * points[i] + along * points[i + 1];
+  const Point2 v = (1 - along) * points[segments + 1 + i] + along * points[segments + 2 + i];
+  return (1 - t) * u + t * v;
+}
+
 double signedArea(const std::vector<Point2>& polygon) {
   double twice = 0;
   for (size_t i = 0; i < polygon.size(); ++i) {

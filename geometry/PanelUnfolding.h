@@ -30,6 +30,10 @@ struct FlatBand {
   std::vector<Point2> pieceOutline;  // counter-clockwise, in the panel's frame
   std::vector<Point2> tabOutline;    // the tab alone
   Point2 tab = Point2::Zero();       // the extra fastener's hole, on the piece and on the vertex band
+
+  // The point (s, t) of this copy: s from face A's side (0) to face B's (1)
+  // along the rails, t from rail U (0) to rail V (1), bilinear in each segment.
+  [[nodiscard]] Point2 at(double s, double t) const;
 };
 
 struct FlatPanel {
