@@ -60,8 +60,10 @@ Structure build(PolygonMesh mesh) {
 }
 
 // The test meshes: genus 0, 1 and 2, open surfaces (one with saddles
-// everywhere), mixed pentagons and hexagons, and the bunny (triangles, many
-// saddles).
+// everywhere), mixed pentagons and hexagons, the bunny (triangles, many
+// saddles), and meshes other programs wrote (tests/data/external/README.md):
+// Geomview's open tube of quads and its abstract polyhedron, CGAL's double
+// torus with three holes and its cube of mixed polygons, an STL of OpenSCAD's.
 std::map<std::string, PolygonMesh> testMeshes() {
   std::map<std::string, PolygonMesh> meshes{
       {"cube", cube()},
@@ -76,6 +78,13 @@ std::map<std::string, PolygonMesh> testMeshes() {
   meshes["bunny"] = importMesh(std::string(ROTAFAB_SOURCE_DIR) + "/examples/bunny.obj").mesh;
   // The bunny is about 0.15 units across: scale it to its construction size (mean edge 2 in).
   for (Point3& p : meshes["bunny"].positions) p *= 400;
+  for (const std::string& where :
+       std::vector<std::string>{"/usr/share/geomview/geom/tref.off", "/usr/share/geomview/geom/abstr.off",
+                                test::cgalMesh("double-torus-3-holes.off"), test::cgalMesh("cube_poly.off"),
+                                "/usr/share/openscad/testdata/scad/3D/features/import.stl"}) {
+    const auto path = test::publicMesh(where);
+    meshes[path.filename().string()] = test::atConstructionSize(importMesh(path.string()).mesh);
+  }
   return meshes;
 }
 
@@ -102,7 +111,9 @@ TEST(BandDecomposition, VertexBandsArePlanarAndFaceOutwards) {
       const VertexBand& vb = s.decomposition.vertexBands[f];
       std::vector<Point3> face;
       for (int v : s.mesh.faces[f]) face.push_back(s.mesh.positions[v]);
-      EXPECT_GT(vb.normal.dot(newellNormal(face)), 0.5) << name << ": face " << f;
+      // On the face's outer side. Not much tighter: CGAL's double torus has a
+      // warped pentagon (face 82) whose mean plane is 64 degrees from its band's.
+      EXPECT_GT(vb.normal.dot(newellNormal(face)), 0.25) << name << ": face " << f;
       EXPECT_GT(vb.normal.dot(newellNormal(vb.corners)), 0.999) << name << ": face " << f << " turns the wrong way";
       for (const Point3& p : vb.corners) EXPECT_LT(std::abs((p - vb.centroid).dot(vb.normal)), 1e-9) << name;
     }

@@ -75,22 +75,19 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
   EXPECT_EQ(faces, 32 + 90 * 2 * 16);  // 32 vertex bands; 90 bands on two panels, 8 segments of 2 triangles
 }
 
-TEST(MakeCli, ManifestIsSpecsVersionOne) {
-  const nlohmann::json m = nlohmann::json::parse(readFile(soccerBall() / "manifest.json"));
-  EXPECT_EQ(m.at("version"), 1);
-  EXPECT_EQ(m.at("structure"), "band");
-  EXPECT_EQ(m.at("units"), "in");
-  EXPECT_EQ(m.at("mesh"), nlohmann::json::parse(R"({"vertices":60,"edges":90,"faces":32,"genus":0})"));
-  EXPECT_EQ(m.at("bed"), nlohmann::json::parse(R"({"width":32.0,"height":18.0,"margin":0.25})"));
-  EXPECT_EQ(m.at("fasteners"), 180);  // two per band: 2 x 90 interior edges
+// SPEC's manifest.json panels of a band structure of `faceCount` faces:
+// numbered 1..n, one per face, each on a sheet inside the bed's margins,
+// outlines counter-clockwise with their areas, and every interior edge's
+// holes on exactly two panels, as many on each.
+void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges) {
   const auto& panels = m.at("panels");
-  ASSERT_EQ(panels.size(), 32u);
+  ASSERT_EQ(panels.size(), static_cast<size_t>(faceCount));
   std::map<int, std::vector<int>> holesOfEdge;  // edge -> hole count per panel
   std::set<int> faces, onSheets;
   for (const auto& sheet : m.at("sheets")) {
     for (const auto& id : sheet.at("panels")) onSheets.insert(id.get<int>());
   }
-  EXPECT_EQ(onSheets.size(), 32u);
+  EXPECT_EQ(onSheets.size(), static_cast<size_t>(faceCount));
   for (size_t i = 0; i < panels.size(); ++i) {
     const auto& p = panels[i];
     EXPECT_EQ(p.at("id"), static_cast<int>(i) + 1);
@@ -126,11 +123,57 @@ TEST(MakeCli, ManifestIsSpecsVersionOne) {
     for (const auto& label : p.at("labels")) edgeLabels += label.at("role") == "edge";
     EXPECT_EQ(edgeLabels, static_cast<int>(p.at("edges").size()));
   }
-  EXPECT_EQ(faces.size(), 32u);
-  EXPECT_EQ(holesOfEdge.size(), 90u);
+  EXPECT_EQ(faces.size(), static_cast<size_t>(faceCount));
+  EXPECT_EQ(holesOfEdge.size(), static_cast<size_t>(interiorEdges));
   for (const auto& [edge, counts] : holesOfEdge) {
     ASSERT_EQ(counts.size(), 2u) << "edge " << edge;
     EXPECT_EQ(counts[0], counts[1]) << "edge " << edge;
+  }
+}
+
+TEST(MakeCli, ManifestIsSpecsVersionOne) {
+  const nlohmann::json m = nlohmann::json::parse(readFile(soccerBall() / "manifest.json"));
+  EXPECT_EQ(m.at("version"), 1);
+  EXPECT_EQ(m.at("structure"), "band");
+  EXPECT_EQ(m.at("units"), "in");
+  EXPECT_EQ(m.at("mesh"), nlohmann::json::parse(R"({"vertices":60,"edges":90,"faces":32,"genus":0})"));
+  EXPECT_EQ(m.at("bed"), nlohmann::json::parse(R"({"width":32.0,"height":18.0,"margin":0.25})"));
+  EXPECT_EQ(m.at("fasteners"), 180);  // two per band: 2 x 90 interior edges
+  expectSpecPanels(m, 32, 90);
+}
+
+// Meshes other programs wrote (tests/data/external/README.md): Geomview's
+// abstract polyhedron (faces of 4 to 7 sides, stored inside out) and CGAL's
+// cube of triangles and quads (comment lines; narrow bands with one hole
+// each). The mesh's numbers are those of the independent checker.
+TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
+  std::map<std::string, nlohmann::json> expected;
+  for (const char* list : {"meshes.json", "meshes-cgal.json"}) {
+    for (const auto& entry : nlohmann::json::parse(readFile(kSource / "tests/data/external" / list))) {
+      const std::string where = entry.contains("path")
+                                    ? entry["path"].get<std::string>()
+                                    : entry["archive"].get<std::string>() + ":" + entry["member"].get<std::string>();
+      expected[where] = entry["expected"];
+    }
+  }
+  for (const std::string& where : {std::string("/usr/share/geomview/geom/abstr.off"), cgalMesh("cube_poly.off")}) {
+    SCOPED_TRACE(where);
+    ASSERT_TRUE(expected.count(where));
+    const nlohmann::json& mesh = expected[where];
+    TempDir dir;
+    const CommandResult made = run(kCli + " make " + quoted(publicMesh(where)) + " --structure band --time 0 --out " +
+                                   quoted(dir.path() / "out"));
+    ASSERT_EQ(made.status, 0) << made.err;
+    const auto m = nlohmann::json::parse(readFile(dir.path() / "out/manifest.json"));
+    for (const char* key : {"vertices", "edges", "faces", "genus"})
+      EXPECT_EQ(m.at("mesh").at(key), mesh.at(key)) << key;
+    const int edges = mesh.at("edges");
+    expectSpecPanels(m, mesh.at("faces"), edges);
+    EXPECT_GE(m.at("fasteners").get<int>(), edges);
+    EXPECT_LE(m.at("fasteners").get<int>(), 2 * edges);
+    const CommandResult gs =
+        run("gs -q -dNOPAUSE -dBATCH -sDEVICE=nullpage " + quoted(dir.path() / "out/sheet-001.eps"));
+    EXPECT_EQ(gs.status, 0) << gs.err;
   }
 }
 

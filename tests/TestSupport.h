@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 
+#include "geometry/BandStructure.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/PolygonMesh.h"
 
@@ -64,6 +65,40 @@ inline CommandResult run(const std::string& commandLine) {
   result.out = readFile(outFile);
   result.err = readFile(errFile);
   return result;
+}
+
+// A mesh that someone else made, as a Debian package of scripts/setup.sh
+// installs it (tests/data/external/README.md): a plain path, or
+// "ARCHIVE.tar.gz:MEMBER" for a file inside a tarball (CGAL's data sets),
+// extracted once per test program into a folder that lives as long as it.
+inline std::filesystem::path publicMesh(const std::string& where) {
+  const auto colon = where.find(".tar.gz:");
+  if (colon == std::string::npos) {
+    EXPECT_TRUE(std::filesystem::exists(where)) << where << ": install it with scripts/setup.sh";
+    return where;
+  }
+  static TempDir extracted;
+  const std::string archive = where.substr(0, colon + 7), member = where.substr(colon + 8);
+  const auto path = extracted.path() / member;
+  if (!std::filesystem::exists(path)) {
+    const CommandResult untar =
+        run("tar -xzf '" + archive + "' -C '" + extracted.path().string() + "' '" + member + "'");
+    EXPECT_EQ(untar.status, 0) << where << ": " << untar.err << " (install it with scripts/setup.sh)";
+  }
+  return path;
+}
+
+// CGAL's data sets (Debian package libcgal-demo).
+inline std::string cgalMesh(const std::string& name) {
+  return "/usr/share/doc/libcgal-dev/data.tar.gz:data/meshes/" + name;
+}
+
+// A mesh scaled as `make` scales it by default (mean edge 2 in).
+inline geometry::PolygonMesh atConstructionSize(geometry::PolygonMesh mesh) {
+  geometry::analyzeMesh(mesh);
+  const double scale = geometry::constructionScale(mesh, std::nullopt, std::nullopt);
+  for (geometry::Point3& p : mesh.positions) p *= scale;
+  return mesh;
 }
 
 inline geometry::MeshTopology topologyOf(geometry::PolygonMesh mesh) { return geometry::analyzeMesh(mesh).topology; }
