@@ -16,6 +16,7 @@
 #include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
 #include "geometry/BandStructure.h"
+#include "geometry/FastenerHoles.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
 #include "geometry/ObjWriter.h"
@@ -136,6 +137,17 @@ int runMake(const MakeOptions& options) {
     geometry::BandStructure structure;
     try {
       structure = geometry::buildBandStructure(mesh, band);
+    } catch (const geometry::NoRoomForHoleError& error) {
+      // The same advice as the options that give it: the largest side --size needs.
+      Eigen::AlignedBox3d box;
+      for (const geometry::Point3& p : mesh.positions) box.extend(p);
+      std::string advice = "use a smaller --fastener or a larger --size";
+      if (std::isfinite(error.scaleNeeded)) {
+        advice = fmt::format("--fastener {:.3f}in or smaller, or --size {:.0f}in or larger, gives every band room",
+                             std::floor(band.fastener / error.scaleNeeded * 1000) / 1000,
+                             std::ceil(box.sizes().maxCoeff() * error.scaleNeeded));
+      }
+      throw UserError(fmt::format("{}: {}; {}", options.mesh, error.bandsWithoutRoom, advice));
     } catch (const std::invalid_argument& error) {
       throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
     }

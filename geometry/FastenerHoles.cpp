@@ -58,6 +58,28 @@ const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& co
   return copy.detached ? copy.pieceOutline : panel.outline;
 }
 
+namespace {
+
+// One band without room for a hole, and how many times larger the mesh would have to be to give it room.
+struct BandTooSmall {
+  std::string what;
+  double scaleNeeded;
+};
+
+}  // namespace
+
+NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded_, double diameter)
+    : std::invalid_argument(""),
+      bandsWithoutRoom(firstBand + (bands > 1 ? fmt::format(" (nor have {} other bands)", bands - 1) : "")),
+      scaleNeeded(scaleNeeded_) {
+  static_cast<std::invalid_argument&>(*this) = std::invalid_argument(
+      bandsWithoutRoom +
+      (std::isfinite(scaleNeeded)
+           ? fmt::format("; a fastener of {:.3f} in or less, or the mesh {:.2f} times larger, gives every band room",
+                         std::floor(diameter / scaleNeeded * 1000) / 1000, scaleNeeded)
+           : "; use a smaller --fastener or a larger --size"));
+}
+
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
                                           double diameter, const std::function<std::string(int)>& edgeName) {
   std::vector<BandHoles> result(bands.size());
@@ -160,10 +182,12 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       }
       placed.clearance = std::min(kClearance, fromOutlines);
       if (most < kLeastClearance / kClearance) {
-        throw std::invalid_argument(
+        throw BandTooSmall{
             fmt::format("{}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole even {} diameters "
-                        "from every outline; use a smaller --fastener or a larger --size",
-                        edgeName(band.edge), length, width, diameter, kLeastClearance));
+                        "from every outline",
+                        edgeName(band.edge), length, width, diameter, kLeastClearance),
+            // (with 2% to spare: the search for the hole's place is on a grid)
+            most > 0 ? 1.02 * kLeastClearance / kClearance / most : std::numeric_limits<double>::infinity()};
       }
     }
     return placed;
@@ -174,6 +198,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   // again beside them. The result does not depend on the number of cores.
   const Placed none;
   std::vector<std::exception_ptr> errors(bands.size());
+  std::vector<std::optional<BandTooSmall>> tooSmall(bands.size());
   const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
   std::vector<std::thread> threads;
   for (int w = 0; w < workers; ++w) {
@@ -182,6 +207,8 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
         if (bands[e].edge < 0) continue;
         try {
           result[e] = placeBand(bands[e], none);
+        } catch (const BandTooSmall& small) {
+          tooSmall[e] = small;
         } catch (...) {
           errors[e] = std::current_exception();
         }
@@ -192,6 +219,18 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   for (const auto& error : errors) {
     if (error) std::rethrow_exception(error);
   }
+  // Every band without room, in one error: the first by edge, how many, and
+  // the scale that gives the smallest of them room.
+  const BandTooSmall* first = nullptr;
+  int small = 0;
+  double scaleNeeded = 1;
+  for (const auto& some : tooSmall) {
+    if (!some) continue;
+    if (!first) first = &*some;
+    ++small;
+    scaleNeeded = std::max(scaleNeeded, some->scaleNeeded);
+  }
+  if (first) throw NoRoomForHoleError(first->what, small, scaleNeeded, diameter);
   Placed holesOn;
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {
@@ -214,7 +253,13 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       }
       return false;
     };
-    if (tooNear()) result[band.edge] = placeBand(band, holesOn);
+    if (tooNear()) {
+      try {
+        result[band.edge] = placeBand(band, holesOn);
+      } catch (const BandTooSmall& small) {
+        throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter);
+      }
+    }
     for (int c = 0; c < 2; ++c) {
       for (const BandPoint& h : result[band.edge].holes) {
         holesOn[partOf(faces[c], *copies[c])].push_back(h.onPanel(*copies[c]));

@@ -26,6 +26,7 @@
 
 #include <array>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -53,9 +54,20 @@ struct BandHoles {
   double clearance = kClearance;  // diameters kept from the outlines, when less than kClearance
 };
 
+// Bands too small for even one hole kLeastClearance from their outlines.
+// Every length of the structure scales with the mesh, so the mesh
+// `scaleNeeded` times larger, or the fastener that many times smaller,
+// gives every one of them room.
+class NoRoomForHoleError : public std::invalid_argument {
+ public:
+  NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded, double diameter);
+  std::string bandsWithoutRoom;  // "EDGE: its band (L x W in) has no room for ... (nor have N other bands)"
+  double scaleNeeded;            // > 1; infinite when a band's middle is off its panel
+};
+
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed
-// by face. Throws std::invalid_argument naming the edge (by `edgeName`)
-// when not even one hole keeps kLeastClearance.
+// by face. Throws NoRoomForHoleError naming the first edge (by `edgeName`)
+// when some band has no room for even one hole kLeastClearance from its outlines.
 std::vector<BandHoles> placeFastenerHoles(
     const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels, double diameter,
     const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); });

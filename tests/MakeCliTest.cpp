@@ -314,6 +314,19 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   fails(mesh + " --structure band --tension 1.5", 1, "tension");
   fails(mesh + " --structure band --start 32", 1, "--start 32");
   fails(mesh + " --structure band --fastener 2in", 1, "no room for a 2.000 in fastener hole");
+  // The error says which --fastener or --size would do, and either one does.
+  const CommandResult large =
+      run(kCli + " make " + mesh + " --structure band --fastener 1in --out " + quoted(dir.path() / "large"));
+  std::smatch advice;
+  ASSERT_TRUE(std::regex_search(large.err, advice,
+                                std::regex(R"(\(nor have 89 other bands\); (--fastener \S+) or smaller, or )"
+                                           R"((--size \S+) or larger, gives every band room)")))
+      << large.err;
+  for (const auto& option : {advice[1].str(), "--fastener 1in " + advice[2].str()}) {
+    const CommandResult followed = run(kCli + " make " + mesh + " --structure band --time 0 " + option + " --out " +
+                                       quoted(dir.path() / "followed"));
+    EXPECT_EQ(followed.status, 0) << option << ": " << followed.err;
+  }
   fails(mesh + " --structure band --fastener big", 1, "--fastener big");
   fails(quoted(dir.path() / "none.obj") + " --structure band", 1, "none.obj");
   fails(mesh + " --structure pleat", 2, "--structure");
