@@ -11,10 +11,12 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "geometry/BandStructure.h"
@@ -128,6 +130,53 @@ BENCHMARK(BM_BandStructure)
     ->Arg(16000)
     ->Arg(32000)
     ->Arg(50000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
+
+// Issue 4, item 8, the whole pipeline: `rotafab make MESH --structure band
+// --layout rows --json`, the program itself, import to written sheets
+// (EPS, SVG, DXF), manifest.json, manifest.txt and structure.obj. The time
+// is import + geometry + writing as make reports them; the layout is left
+// out and reported beside it (`nesting_s`; `--layout rows` keeps it to
+// seconds, where true-shape nesting would take minutes).
+void BM_MakeBand(benchmark::State& state) {
+  const auto& path = meshFile(state.range(0));
+  const auto out = std::filesystem::temp_directory_path() / ("rotafab-bench-make-" + std::to_string(state.range(0)));
+  const auto summary = out.string() + ".json";
+  nlohmann::json seconds;
+  for (auto _ : state) {
+    const std::string command = std::string(ROTAFAB_CLI) + " make '" + path.string() +
+                                "' --structure band --layout rows --json --out '" + out.string() + "' > '" + summary +
+                                "' 2>/dev/null";
+    if (std::system(command.c_str()) != 0) {
+      state.SkipWithError(("failed: " + command).c_str());
+      return;
+    }
+    std::ifstream in(summary);
+    const auto result = nlohmann::json::parse(in);
+    seconds = result.at("seconds");
+    state.SetIterationTime(seconds.at("import").get<double>() + seconds.at("geometry").get<double>() +
+                           seconds.at("writing").get<double>());
+    state.counters["sheets"] = result.at("sheets").get<double>();
+  }
+  for (const char* phase : {"import", "geometry", "nesting", "writing"}) {
+    state.counters[std::string(phase) + "_s"] = seconds.at(phase).get<double>();
+  }
+  std::uintmax_t bytes = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(out)) bytes += entry.file_size();
+  state.counters["MB"] = static_cast<double>(bytes) / 1e6;
+  std::filesystem::remove_all(out);
+  std::filesystem::remove(summary);
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_MakeBand)
+    ->Arg(4000)
+    ->Arg(8000)
+    ->Arg(16000)
+    ->Arg(32000)
+    ->Arg(50000)
+    ->UseManualTime()
+    ->Iterations(1)
     ->Unit(benchmark::kMillisecond)
     ->Complexity(benchmark::oN);
 

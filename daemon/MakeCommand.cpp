@@ -47,6 +47,7 @@ struct MakeOptions {
   double seconds = 5.0;
   std::string order = "window";
   int window = 8;
+  std::string layout = "nest";
 };
 
 // --holes fill: each boundary loop capped by one polygon face, along the
@@ -162,10 +163,11 @@ int runMake(const MakeOptions& options) {
                  : options.order == "free" ? jobs::OrderMode::Free
                                            : jobs::OrderMode::Window;
     plan.window = options.window;
+    plan.rows = options.layout == "rows";
     plan.title = fmt::format("{} (band)", std::filesystem::path(options.mesh).stem().string());
     plan.progress = [&](const std::string& line) { progress("nesting: " + line); };
-    progress(fmt::format("nesting {} panels on {} x {} in beds", structure.panels.size(), machine.bed.width,
-                         machine.bed.height));
+    progress(fmt::format("{} {} panels on {} x {} in beds", plan.rows ? "laying out in rows" : "nesting",
+                         structure.panels.size(), machine.bed.width, machine.bed.height));
     const std::vector<jobs::Part> parts = jobs::bandParts(structure);
     jobs::SheetPlan sheets;
     try {
@@ -346,6 +348,11 @@ void addMakeCommand(CLI::App& app, int& status) {
       ->check(CLI::IsMember({"strict", "window", "free"}));
   make->add_option("--window", options->window, "With --order window: at most this many places from the assembly order")
       ->capture_default_str();
+  make->add_option("--layout", options->layout,
+                   "nest (true shapes, interlocking) or rows (boxes in rows, in assembly order: a preview of any "
+                   "size in seconds, on more sheets)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"nest", "rows"}));
   make->footer(
       "Writes into the output folder: sheet-001.eps/.svg/.dxf, ... (one set per sheet), manifest.json (SPEC),\n"
       "manifest.txt (the assembly steps), structure.obj (the panels in 3D). Lengths take in, mm or cm.\n"

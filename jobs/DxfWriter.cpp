@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <iterator>
 #include <stdexcept>
@@ -16,18 +17,41 @@ constexpr int kDecimals = 9;
 
 class GroupWriter {
  public:
-  explicit GroupWriter(fmt::memory_buffer& buffer) : to_(std::back_inserter(buffer)) {}
+  explicit GroupWriter(fmt::memory_buffer& buffer) : out_(buffer) {}
   // Group codes right-aligned in 3 columns, as AutoCAD writes them.
-  void operator()(int code, std::string_view value) { fmt::format_to(to_, "{:>3}\n{}\n", code, value); }
-  void operator()(int code, int value) { fmt::format_to(to_, "{:>3}\n{}\n", code, value); }
+  void operator()(int code, std::string_view value) {
+    groupCode(code);
+    out_.append(value.data(), value.data() + value.size());
+    out_.push_back('\n');
+  }
+  void operator()(int code, int value) {
+    groupCode(code);
+    appendInteger(value);
+    out_.push_back('\n');
+  }
   void point(int code, double x, double y, double z = 0) {
-    (*this)(code, formatDecimal(x, kDecimals));
-    (*this)(code + 10, formatDecimal(y, kDecimals));
-    (*this)(code + 20, formatDecimal(z, kDecimals));
+    const double values[3] = {x, y, z};
+    for (int i = 0; i < 3; ++i) {
+      groupCode(code + 10 * i);
+      appendDecimal(out_, values[i], kDecimals);
+      out_.push_back('\n');
+    }
   }
 
  private:
-  std::back_insert_iterator<fmt::memory_buffer> to_;
+  void groupCode(int code) {
+    if (code >= 0 && code < 10) out_.append(std::string_view("  "));
+    if (code >= 10 && code < 100) out_.push_back(' ');
+    appendInteger(code);
+    out_.push_back('\n');
+  }
+  void appendInteger(int value) {
+    char digits[16];
+    const auto [end, error] = std::to_chars(digits, digits + sizeof digits, value);
+    out_.append(digits, end);
+  }
+
+  fmt::memory_buffer& out_;
 };
 
 }  // namespace

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <charconv>
+
 #include <cmath>
 #include <stdexcept>
 
@@ -38,13 +41,30 @@ std::string printableAscii(std::string_view text) {
   return out;
 }
 
-std::string formatDecimal(double value, int decimals) {
-  std::string text = fmt::format("{:.{}f}", value, decimals);
-  if (text.find('.') != std::string::npos) {
-    text.erase(text.find_last_not_of('0') + 1);
-    if (text.back() == '.') text.pop_back();
+void appendDecimal(fmt::memory_buffer& out, double value, int decimals) {
+  // std::to_chars rounds exactly as printf does, several times faster than
+  // a format string (the writers print every coordinate of every sheet).
+  char digits[400];
+  auto [end, error] = std::to_chars(digits, digits + sizeof digits, value, std::chars_format::fixed, decimals);
+  if (error != std::errc()) {  // beyond 400 digits: not a coordinate of any bed
+    fmt::format_to(std::back_inserter(out), "{:.{}f}", value, decimals);
+    return;
   }
-  return text == "-0" ? std::string(1, '0') : text;
+  if (std::find(digits, end, '.') != end) {
+    while (end[-1] == '0') --end;
+    if (end[-1] == '.') --end;
+  }
+  if (end - digits == 2 && digits[0] == '-' && digits[1] == '0') {
+    out.push_back('0');
+    return;
+  }
+  out.append(digits, end);
+}
+
+std::string formatDecimal(double value, int decimals) {
+  fmt::memory_buffer out;
+  appendDecimal(out, value, decimals);
+  return fmt::to_string(out);
 }
 
 }  // namespace rotafab::jobs

@@ -6,8 +6,10 @@
 // same geometry. The planner (nesting, kerf, ordering) produces it; labels
 // arrive already turned into single-stroke polylines (geometry/HersheyFont.h).
 
+#include <fmt/format.h>
 #include <Eigen/Core>
 #include <map>
+
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +48,8 @@ void checkDrawable(const SheetDrawing& sheet);
 // Fixed-point with `decimals` digits, trailing zeros dropped, never "-0": the
 // numbers of every sheet format, the same in any locale.
 std::string formatDecimal(double value, int decimals);
+// The same, appended to `out` without a string of its own (the writers' inner loops).
+void appendDecimal(fmt::memory_buffer& out, double value, int decimals);
 
 // Text for a one-line header field: printable ASCII only ('?' for anything
 // else), at most 200 characters.

@@ -22,6 +22,7 @@ struct PlanOptions {
   OrderMode order = OrderMode::Window;
   int window = 8;
   unsigned seed = 1;
+  bool rows = false;  // rowLayout() instead of nest(): seconds for any size, more sheets
   std::string title;  // "bunny (band)"; the sheet number is appended
   std::function<void(const std::string&)> progress;
 };

@@ -156,13 +156,15 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
       expected[where] = entry["expected"];
     }
   }
+  // (the second in rows, `--layout rows`: cut in assembly order, nothing moved)
   for (const std::string& where : {std::string("/usr/share/geomview/geom/abstr.off"), cgalMesh("cube_poly.off")}) {
     SCOPED_TRACE(where);
     ASSERT_TRUE(expected.count(where));
     const nlohmann::json& mesh = expected[where];
     TempDir dir;
+    const bool rows = where.ends_with("cube_poly.off");
     const CommandResult made = run(kCli + " make " + quoted(publicMesh(where)) + " --structure band --time 0 --out " +
-                                   quoted(dir.path() / "out"));
+                                   quoted(dir.path() / "out") + (rows ? " --layout rows" : ""));
     ASSERT_EQ(made.status, 0) << made.err;
     const auto m = nlohmann::json::parse(readFile(dir.path() / "out/manifest.json"));
     for (const char* key : {"vertices", "edges", "faces", "genus"})
@@ -171,6 +173,9 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
     expectSpecPanels(m, mesh.at("faces"), edges);
     EXPECT_GE(m.at("fasteners").get<int>(), edges);
     EXPECT_LE(m.at("fasteners").get<int>(), 2 * edges);
+    if (rows) {
+      for (const auto& panel : m.at("panels")) EXPECT_EQ(panel.at("moved"), 0) << panel.at("id");
+    }
     const CommandResult gs =
         run("gs -q -dNOPAUSE -dBATCH -sDEVICE=nullpage " + quoted(dir.path() / "out/sheet-001.eps"));
     EXPECT_EQ(gs.status, 0) << gs.err;

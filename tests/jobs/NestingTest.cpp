@@ -3,6 +3,7 @@
 // random concave parts, and the order modes keep their promises.
 
 #include "jobs/Nesting.h"
+#include "jobs/RowLayout.h"
 
 #include <gtest/gtest.h>
 
@@ -11,6 +12,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <set>
@@ -341,6 +343,44 @@ TEST(Nesting, AwkwardOutlinesAreNestedExactly) {
                                      [&](const NestingPart& part) { return message.rfind(part.name, 0) == 0; });
       EXPECT_TRUE(named) << message;
     }
+  }
+}
+
+}  // namespace
+}  // namespace rotafab::jobs
+
+namespace rotafab::jobs {
+namespace {
+
+// The quick layout (`make --layout rows`): exact checks as for nest(), the
+// cutting order is the assembly order, and an oversized part is named.
+TEST(RowLayout, PartsInAssemblyOrderNeverOverlapAndStayInside) {
+  auto parts = randomParts(11, 60);
+  std::mt19937 random(3);
+  std::vector<int> orders(parts.size());
+  std::iota(orders.begin(), orders.end(), 0);
+  std::shuffle(orders.begin(), orders.end(), random);
+  for (size_t i = 0; i < parts.size(); ++i) parts[i].order = orders[i];
+  NestingOptions options;
+  options.width = 15;
+  options.height = 10;
+  const NestingResult result = rowLayout(parts, options);
+  expectValid(parts, result, options);
+  EXPECT_GT(result.sheets, 1);
+  for (size_t i = 0; i < result.placements.size(); ++i) {
+    EXPECT_EQ(parts[result.placements[i].part].order, static_cast<int>(i));
+    if (i > 0) {
+      EXPECT_GE(result.placements[i].sheet, result.placements[i - 1].sheet);
+    }
+  }
+  parts[7].outline = {{0, 0}, {16, 0}, {16, 11}, {0, 11}};
+  parts[7].name = "panel 8";
+  try {
+    rowLayout(parts, options);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("panel 8 does not fit the usable area of 15 x 10", 0), 0u)
+        << error.what();
   }
 }
 
