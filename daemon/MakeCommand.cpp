@@ -144,9 +144,15 @@ int runMake(const MakeOptions& options) {
       for (const geometry::Point3& p : mesh.positions) box.extend(p);
       std::string advice = "use a smaller --fastener or a larger --size";
       if (std::isfinite(error.scaleNeeded)) {
-        advice = fmt::format("--fastener {:.3f}in or smaller, or --size {:.0f}in or larger, gives every band room",
-                             std::floor(band.fastener / error.scaleNeeded * 1000) / 1000,
-                             std::ceil(box.sizes().maxCoeff() * error.scaleNeeded));
+        // --scale excludes --size: advise the option the user gave.
+        const std::string larger =
+            options.scale ? fmt::format("--scale {:.4g}", *options.scale * error.scaleNeeded)
+                          : fmt::format("--size {:.0f}in", std::ceil(box.sizes().maxCoeff() * error.scaleNeeded));
+        const double smaller = std::floor(band.fastener / error.scaleNeeded * 1000) / 1000;
+        advice = smaller > 0
+                     ? fmt::format("--fastener {:.3f}in or smaller, or {} or larger, would give every band room",
+                                   smaller, larger)
+                     : fmt::format("{} or larger would give every band room", larger);
       }
       throw UserError(fmt::format("{}: {}; {}", options.mesh, error.bandsWithoutRoom, advice));
     } catch (const std::invalid_argument& error) {
@@ -349,8 +355,8 @@ void addMakeCommand(CLI::App& app, int& status) {
   make->add_option("--window", options->window, "With --order window: at most this many places from the assembly order")
       ->capture_default_str();
   make->add_option("--layout", options->layout,
-                   "nest (true shapes, interlocking) or rows (boxes in rows, in assembly order: a preview of any "
-                   "size in seconds, on more sheets)")
+                   "nest (true shapes, interlocking) or rows (boxes in rows, in assembly order, on more sheets: a "
+                   "quick preview; --order, --window and --time do not apply)")
       ->capture_default_str()
       ->check(CLI::IsMember({"nest", "rows"}));
   make->footer(

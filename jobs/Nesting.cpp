@@ -1576,13 +1576,17 @@ NestingResult searchLayout(const std::vector<NestingPart>& parts, const NestingO
 
 }  // namespace
 
-NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options) {
+void checkNestingParts(const std::vector<NestingPart>& parts) {
   for (const auto& part : parts) {
     if (part.outline.size() < 3 || std::abs(polygonArea(part.outline)) <= 0) {
       throw std::invalid_argument(fmt::format("{}: the outline is not a polygon with area", part.name));
     }
     if (part.rotations.empty()) throw std::invalid_argument(fmt::format("{}: no allowed rotation", part.name));
   }
+}
+
+NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options) {
+  checkNestingParts(parts);
   // Searches side by side, one per core, each on its own course; the best
   // layout wins (on a tie, the lowest seed's). Strict order has nothing to search.
   const unsigned searches = options.order == OrderMode::Strict || parts.size() < 2 ? 1u

@@ -77,6 +77,10 @@ struct NestingResult {
 // area (or the strip's height) in any allowed rotation.
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options);
 
+// Throws std::invalid_argument naming the first part whose outline is not a
+// polygon with area, or that has no allowed rotation.
+void checkNestingParts(const std::vector<NestingPart>& parts);
+
 // The placed outline of a part, in usable-area coordinates.
 Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement);
 

@@ -11,6 +11,7 @@ namespace rotafab::jobs {
 
 NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOptions& options) {
   if (options.strip) throw std::invalid_argument("the row layout is for beds, not a strip");
+  checkNestingParts(parts);
   std::vector<int> sequence(parts.size());
   std::iota(sequence.begin(), sequence.end(), 0);
   std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) { return parts[a].order < parts[b].order; });
@@ -23,7 +24,7 @@ NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOpti
     const NestingPart& part = parts[index];
     // The allowed rotation whose box is lowest, then narrowest.
     double bestRotation = 0;
-    Point2 low, high;
+    Point2 low = Point2::Zero(), high = Point2::Zero();
     bool fits = false;
     for (double rotation : part.rotations) {
       Point2 min = Point2::Constant(std::numeric_limits<double>::max()), max = -min;

@@ -111,9 +111,11 @@ TEST(BandDecomposition, VertexBandsArePlanarAndFaceOutwards) {
       const VertexBand& vb = s.decomposition.vertexBands[f];
       std::vector<Point3> face;
       for (int v : s.mesh.faces[f]) face.push_back(s.mesh.positions[v]);
-      // On the face's outer side. Not much tighter: CGAL's double torus has a
-      // warped pentagon (face 82) whose mean plane is 64 degrees from its band's.
-      EXPECT_GT(vb.normal.dot(newellNormal(face)), 0.25) << name << ": face " << f;
+      // On the face's outer side, within 60 degrees of its mean plane's
+      // normal; CGAL's double torus has a warped pentagon (face 82) whose
+      // mean plane is 64 degrees from its band's.
+      const double least = name == "double-torus-3-holes.off" ? 0.25 : 0.5;
+      EXPECT_GT(vb.normal.dot(newellNormal(face)), least) << name << ": face " << f;
       EXPECT_GT(vb.normal.dot(newellNormal(vb.corners)), 0.999) << name << ": face " << f << " turns the wrong way";
       for (const Point3& p : vb.corners) EXPECT_LT(std::abs((p - vb.centroid).dot(vb.normal)), 1e-9) << name;
     }

@@ -325,7 +325,7 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   std::smatch advice;
   ASSERT_TRUE(std::regex_search(large.err, advice,
                                 std::regex(R"(\(nor have 89 other bands\); (--fastener \S+) or smaller, or )"
-                                           R"((--size \S+) or larger, gives every band room)")))
+                                           R"((--size \S+) or larger, would give every band room)")))
       << large.err;
   for (const auto& option : {advice[1].str(), "--fastener 1in " + advice[2].str()}) {
     const CommandResult followed = run(kCli + " make " + mesh + " --structure band --time 0 " + option + " --out " +
