@@ -1,0 +1,25 @@
+#include "devices/Device.h"
+
+namespace rotafab::devices {
+
+std::string_view faultName(FaultKind kind) {
+  switch (kind) {
+    case FaultKind::Timeout:
+      return "timeout";
+    case FaultKind::Disconnected:
+      return "disconnected";
+    case FaultKind::Alarm:
+      return "alarm";
+    case FaultKind::Error:
+      return "error";
+    case FaultKind::Refused:
+      return "refused";
+    case FaultKind::Protocol:
+      return "protocol";
+    case FaultKind::Cancelled:
+      return "cancelled";
+  }
+  return "fault";
+}
+
+}  // namespace rotafab::devices

@@ -1,0 +1,78 @@
+#pragma once
+// The device abstraction (issue 5): one interface for every cutter, whatever
+// its wire protocol, as libsigrok has one for every logic analyser. A device
+// knows toolpaths (jobs/Toolpath.h), never meshes. Every call that waits on
+// the device has a timeout; a timeout, a disconnect, an error or alarm the
+// controller reports, or a cancel ends in a DeviceFault, and the driver has
+// turned the laser off (as far as the controller still answers) before it
+// throws.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+
+#include "jobs/Toolpath.h"
+
+namespace rotafab::devices {
+
+enum class FaultKind {
+  Timeout,       // the device stopped answering
+  Disconnected,  // the port or the USB device went away
+  Alarm,         // the controller stopped itself (GRBL ALARM:N, ...)
+  Error,         // the controller refused a command (GRBL error:N, ...)
+  Refused,       // the device is not set up to run this job (laser mode off, bed too small, ...)
+  Protocol,      // the device said something no controller of its kind says
+  Cancelled,     // the user stopped the job
+};
+std::string_view faultName(FaultKind kind);
+
+class DeviceFault : public std::runtime_error {
+ public:
+  DeviceFault(FaultKind kind, const std::string& what) : std::runtime_error(what), kind(kind) {}
+  FaultKind kind;
+};
+
+struct Progress {
+  int sheet = 1;
+  size_t stroke = 0, strokes = 0;  // strokes finished (acknowledged), of how many
+  size_t bytesAcknowledged = 0, bytesTotal = 0;
+  double secondsLeft = 0;  // estimated
+};
+
+struct DeviceStatus {
+  std::string state;    // the controller's own word: "Idle", "Run", "Hold:0", "Alarm", ...
+  double x = 0, y = 0;  // inches, machine position
+};
+
+// Set from another thread (a signal handler's watcher, the daemon) to stop a job.
+class CancelFlag {
+ public:
+  void cancel() { cancelled_ = true; }
+  [[nodiscard]] bool cancelled() const { return cancelled_; }
+
+ private:
+  std::atomic<bool> cancelled_{false};
+};
+
+class Device {
+ public:
+  virtual ~Device() = default;
+  // Connects and checks that the controller is one this driver drives; returns what it says it is.
+  virtual std::string connect() = 0;
+  virtual void home() = 0;
+  // Traces the box of the toolpath's strokes with the laser off.
+  virtual void frame(const jobs::Toolpath& toolpath) = 0;
+  // Runs the job to its end; `progress` is called as the device acknowledges it.
+  virtual void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+                   const CancelFlag& cancel) = 0;
+  // From another thread while run() streams: hold and resume motion.
+  virtual void pause() = 0;
+  virtual void resume() = 0;
+  virtual DeviceStatus status() = 0;
+  virtual void disconnect() = 0;
+};
+
+}  // namespace rotafab::devices

@@ -1,0 +1,327 @@
+#include "devices/grbl/GrblDriver.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <deque>
+#include <regex>
+#include <thread>
+
+#include "devices/grbl/GrblCodes.h"
+
+namespace rotafab::devices::grbl {
+namespace {
+
+constexpr char kStatus = '?', kHold = '!', kResume = '~', kReset = 0x18;
+constexpr double kMillimetresPerInch = 25.4;
+
+bool isBanner(const std::string& line) { return line.starts_with("Grbl ") || line.starts_with("GrblHAL "); }
+
+int codeAfter(const std::string& line, size_t prefix) {
+  try {
+    return std::stoi(line.substr(prefix));
+  } catch (const std::exception&) {
+    return -1;
+  }
+}
+
+}  // namespace
+
+std::optional<DeviceStatus> parseStatusReport(const std::string& line) {
+  static const std::regex report(R"(^<([A-Za-z]+(?::\d)?)\|[MW]Pos:(-?[0-9.]+),(-?[0-9.]+)(?:,(-?[0-9.]+))?.*>$)");
+  std::smatch m;
+  if (!std::regex_match(line, m, report)) return std::nullopt;
+  return DeviceStatus{m[1], std::stod(m[2]) / kMillimetresPerInch, std::stod(m[3]) / kMillimetresPerInch};
+}
+
+GrblDriver::GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts)
+    : open_(std::move(open)), timeouts_(timeouts) {}
+
+std::string GrblDriver::expectLine(Millis timeout, const char* waitingFor) {
+  auto line = link_->readLine(timeout);
+  if (!line) {
+    throw DeviceFault(FaultKind::Timeout, fmt::format("{}: no answer within {} ms while waiting for {}", link_->name(),
+                                                      timeout.count(), waitingFor));
+  }
+  return *line;
+}
+
+std::string GrblDriver::connect() {
+  link_ = open_();
+  // An Arduino resets when its port opens and prints the banner; a board
+  // reached over TCP does not, so it is reset once.
+  std::string banner;
+  for (int attempt = 0; attempt < 2 && banner.empty(); ++attempt) {
+    const auto until = std::chrono::steady_clock::now() + timeouts_.banner / 2;
+    while (banner.empty() && std::chrono::steady_clock::now() < until) {
+      const auto line = link_->readLine(Millis(100));
+      if (line && isBanner(*line)) banner = *line;
+    }
+    if (banner.empty() && attempt == 0) link_->write(std::string(1, kReset), timeouts_.answer);
+  }
+  if (banner.empty()) {
+    throw DeviceFault(FaultKind::Protocol,
+                      fmt::format("{}: no GRBL banner (\"Grbl 1.1h ['$' for help]\") within {} ms: is this a GRBL "
+                                  "controller, at the right baud rate?",
+                                  link_->name(), timeouts_.banner.count()));
+  }
+  // $$: "$32=1" lines, then ok.
+  settings_.clear();
+  link_->write("$$\n", timeouts_.answer);
+  for (;;) {
+    const std::string line = expectLine(timeouts_.answer, "the settings ($$)");
+    if (line == "ok") break;
+    if (line.starts_with("error:"))
+      throw DeviceFault(FaultKind::Error, link_->name() + ": $$: " + errorMessage(codeAfter(line, 6)));
+    static const std::regex setting(R"(^\$(\d+)=(-?[0-9.]+))");
+    std::smatch m;
+    if (std::regex_search(line, m, setting)) settings_[std::stoi(m[1])] = std::stod(m[2]);
+  }
+  // $I: [VER:...] and [OPT:flags,blocks,rx bytes], then ok.
+  receiveBuffer_ = 128;
+  link_->write("$I\n", timeouts_.answer);
+  for (;;) {
+    const std::string line = expectLine(timeouts_.answer, "the build info ($I)");
+    if (line == "ok") break;
+    static const std::regex options(R"(^\[OPT:[^,\]]*,(\d+),(\d+))");
+    std::smatch m;
+    if (std::regex_search(line, m, options)) receiveBuffer_ = std::stoul(m[2]);
+  }
+  if (settings_.count(32) && settings_[32] != 1) {
+    throw DeviceFault(FaultKind::Refused,
+                      fmt::format("{}: laser mode is off ($32={}): with it off GRBL stops at every S change and "
+                                  "keeps the laser on through rapid moves; send $32=1 to the controller (in a serial "
+                                  "terminal) and run again",
+                                  link_->name(), settings_[32]));
+  }
+  return fmt::format("{} (receive buffer {} bytes, laser mode on)", banner, receiveBuffer_);
+}
+
+jobs::GCodeOptions GrblDriver::gcodeOptions() const {
+  jobs::GCodeOptions options;
+  if (const auto it = settings_.find(30); it != settings_.end() && it->second > 0) options.maxSpindle = it->second;
+  return options;
+}
+
+jobs::MotionLimits GrblDriver::motionLimits() const {
+  jobs::MotionLimits limits;
+  const auto get = [&](int key) {
+    const auto it = settings_.find(key);
+    return it == settings_.end() ? 0.0 : it->second;
+  };
+  // The slower axis bounds a move in any direction.
+  const double rate = std::min(get(110), get(111)), accel = std::min(get(120), get(121));
+  if (rate > 0) limits.maxSpeed = rate / kMillimetresPerInch / 60;
+  if (accel > 0) limits.acceleration = accel / kMillimetresPerInch;
+  return limits;
+}
+
+void GrblDriver::send(const std::string& line) {
+  link_->write(line + "\n", timeouts_.answer);
+  for (;;) {
+    const std::string reply = expectLine(timeouts_.answer, line.c_str());
+    if (reply == "ok") return;
+    if (reply.starts_with("error:")) {
+      fail(DeviceFault(FaultKind::Error,
+                       fmt::format("{}: `{}`: {}", link_->name(), line, errorMessage(codeAfter(reply, 6)))));
+    }
+    if (reply.starts_with("ALARM:")) {
+      fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6)))));
+    }
+  }
+}
+
+void GrblDriver::home() {
+  if (!link_) connect();
+  link_->write("$H\n", timeouts_.answer);
+  for (;;) {
+    const std::string reply = expectLine(timeouts_.homing, "homing ($H)");
+    if (reply == "ok") return;
+    if (reply.starts_with("error:")) {
+      throw DeviceFault(codeAfter(reply, 6) == 5 ? FaultKind::Refused : FaultKind::Error,
+                        fmt::format("{}: $H: {}", link_->name(), errorMessage(codeAfter(reply, 6))));
+    }
+    if (reply.starts_with("ALARM:")) {
+      fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6)))));
+    }
+  }
+}
+
+DeviceStatus GrblDriver::status() {
+  if (!link_) connect();
+  link_->write(std::string(1, kStatus), timeouts_.answer);
+  for (;;) {
+    const std::string line = expectLine(timeouts_.answer, "a status report");
+    if (auto report = parseStatusReport(line)) return *report;
+  }
+}
+
+void GrblDriver::waitIdle(Millis silence) {
+  // As long as status reports come, the machine is working (or held).
+  for (;;) {
+    link_->write(std::string(1, kStatus), timeouts_.answer);
+    const auto until = std::chrono::steady_clock::now() + silence;
+    std::optional<DeviceStatus> report;
+    while (!report) {
+      const auto line = link_->readLine(timeouts_.poll);
+      if (!line) {
+        if (std::chrono::steady_clock::now() > until) {
+          fail(DeviceFault(FaultKind::Timeout,
+                           fmt::format("{}: no status report within {} ms", link_->name(), silence.count())));
+        }
+        link_->write(std::string(1, kStatus), timeouts_.answer);
+        continue;
+      }
+      if (line->starts_with("ALARM:")) {
+        fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6)))));
+      }
+      report = parseStatusReport(*line);
+    }
+    if (report->state == "Idle") return;
+    if (report->state == "Alarm") fail(DeviceFault(FaultKind::Alarm, link_->name() + ": the controller is in alarm"));
+    std::this_thread::sleep_for(timeouts_.poll);
+  }
+}
+
+void GrblDriver::frame(const jobs::Toolpath& toolpath) {
+  if (!link_) connect();
+  const auto box = toolpathBounds(toolpath);
+  const auto mm = [](double inches) { return jobs::formatDecimal(inches * kMillimetresPerInch, 3); };
+  try {
+    // Laser off (M5) for the whole trace; G0 is never lit in laser mode anyway.
+    send("M5 S0");
+    send("G21");
+    send("G90");
+    for (const auto& [x, y] :
+         {std::pair{box[0], box[1]}, {box[2], box[1]}, {box[2], box[3]}, {box[0], box[3]}, {box[0], box[1]}}) {
+      send(fmt::format("G0 X{} Y{}", mm(x), mm(y)));
+    }
+    waitIdle(timeouts_.answer);
+  } catch (const DeviceFault& fault) {
+    fail(fault);
+  }
+}
+
+void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+                     const CancelFlag& cancel) {
+  if (!link_) connect();
+  const std::vector<std::string> lines = jobs::gcodeLines(toolpath, gcodeOptions());
+  // Progress by strokes: each stroke's last line.
+  std::vector<size_t> strokesDoneAt(lines.size(), 0);
+  {
+    size_t line = 4, done = 0;  // after G21, G90, G94, M4 S0
+    for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
+      line += stroke.points.size();  // G0 and the G1s
+      ++done;
+      for (size_t k = line - stroke.points.size(); k < line && k < lines.size(); ++k) strokesDoneAt[k] = done - 1;
+      if (line - 1 < lines.size()) strokesDoneAt[line - 1] = done;
+    }
+    for (size_t k = line; k < lines.size(); ++k) strokesDoneAt[k] = done;
+  }
+  Progress state;
+  state.sheet = toolpath.sheet;
+  state.strokes = toolpath.strokes.size();
+  for (const std::string& line : lines) state.bytesTotal += line.size() + 1;
+  // Character counting: the bytes sent and not yet acknowledged never exceed
+  // what the receive buffer holds (one byte of the ring stays free).
+  const size_t capacity = receiveBuffer_ - 1;
+  std::deque<size_t> inFlight;
+  size_t inFlightBytes = 0, next = 0, acknowledged = 0;
+  auto lastHeard = std::chrono::steady_clock::now(), lastPoll = lastHeard;
+  try {
+    while (acknowledged < lines.size()) {
+      if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+      if (holdRequested_.exchange(false)) link_->write(std::string(1, kHold), timeouts_.answer);
+      if (resumeRequested_.exchange(false)) link_->write(std::string(1, kResume), timeouts_.answer);
+      while (next < lines.size() && inFlightBytes + lines[next].size() + 1 <= capacity) {
+        link_->write(lines[next] + "\n", timeouts_.answer);
+        inFlight.push_back(lines[next].size() + 1);
+        inFlightBytes += lines[next].size() + 1;
+        ++next;
+      }
+      const auto now = std::chrono::steady_clock::now();
+      if (now - lastPoll >= timeouts_.poll) {
+        link_->write(std::string(1, kStatus), timeouts_.answer);
+        lastPoll = now;
+      }
+      const auto line = link_->readLine(Millis(20));
+      if (!line) {
+        if (std::chrono::steady_clock::now() - lastHeard > timeouts_.answer) {
+          throw DeviceFault(FaultKind::Timeout, fmt::format("{}: no answer for {} ms (not even to status polls)",
+                                                            link_->name(), timeouts_.answer.count()));
+        }
+        continue;
+      }
+      lastHeard = std::chrono::steady_clock::now();
+      if (*line == "ok") {
+        if (inFlight.empty()) throw DeviceFault(FaultKind::Protocol, link_->name() + ": an `ok` for no line sent");
+        inFlightBytes -= inFlight.front();
+        state.bytesAcknowledged += inFlight.front();
+        inFlight.pop_front();
+        state.stroke = strokesDoneAt[acknowledged];
+        ++acknowledged;
+        state.secondsLeft = toolpath.seconds * (1.0 - static_cast<double>(state.bytesAcknowledged) /
+                                                          static_cast<double>(state.bytesTotal));
+        if (progress) progress(state);
+      } else if (line->starts_with("error:")) {
+        throw DeviceFault(FaultKind::Error, fmt::format("{}: line {} `{}`: {}", link_->name(), acknowledged + 1,
+                                                        lines[acknowledged], errorMessage(codeAfter(*line, 6))));
+      } else if (line->starts_with("ALARM:")) {
+        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6))));
+      } else if (line->starts_with("<")) {
+        const auto report = parseStatusReport(*line);
+        if (!report)
+          throw DeviceFault(FaultKind::Protocol,
+                            fmt::format("{}: a malformed status report: {}", link_->name(), *line));
+        if (report->state == "Alarm")
+          throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller went into alarm");
+      } else if (isBanner(*line)) {
+        throw DeviceFault(FaultKind::Protocol, link_->name() + ": the controller reset itself mid-job");
+      } else if (!line->empty() && !line->starts_with("[")) {
+        std::string shown;
+        for (char c : line->substr(0, 40)) shown += (c >= 32 && c < 127) ? c : '?';
+        throw DeviceFault(FaultKind::Protocol, fmt::format("{}: not a GRBL reply: \"{}\"", link_->name(), shown));
+      }
+    }
+    // Every line is in the planner: wait for the motion to end.
+    waitIdle(timeouts_.answer);
+  } catch (const DeviceFault& fault) {
+    fail(fault);
+  }
+}
+
+void GrblDriver::stopSafely() noexcept {
+  if (!link_) return;
+  try {
+    link_->write(std::string(1, kHold), Millis(500));
+    link_->write(std::string(1, kReset), Millis(500));
+    // The reset stops the spindle (the laser); once the banner is back, make sure.
+    const auto until = std::chrono::steady_clock::now() + Millis(3000);
+    bool answered = false;
+    while (!answered && std::chrono::steady_clock::now() < until) {
+      const auto line = link_->readLine(Millis(100));
+      answered = line && isBanner(*line);
+    }
+    if (!answered) return;
+    link_->write("M5 S0\n", Millis(500));
+    // ok, or error:9 in the alarm a reset during motion leaves: the laser is off either way.
+    for (int i = 0; i < 10; ++i) {
+      const auto line = link_->readLine(Millis(300));
+      if (!line || *line == "ok" || line->starts_with("error:")) break;
+    }
+  } catch (...) {
+    // The link is gone: nothing more can be said to the controller.
+  }
+}
+
+void GrblDriver::fail(const DeviceFault& fault) {
+  stopSafely();
+  throw fault;
+}
+
+void GrblDriver::disconnect() {
+  if (link_) link_->close();
+  link_.reset();
+}
+
+}  // namespace rotafab::devices::grbl

@@ -1,0 +1,68 @@
+#pragma once
+// GRBL 1.1 (and grblHAL) laser controllers, over serial or TCP (issue 5).
+// Connect: wait for the banner, read `$$` and `$I` (the receive buffer from
+// [OPT:...]), refuse to cut unless laser mode is on ($32=1). Run: the job's
+// G-code (jobs/GCode.h) streamed by character counting against the receive
+// buffer (gnea/grbl's stream.py method), with realtime `?` status polls; a
+// hold is `!`, a resume `~`. On any error, alarm, timeout, cancel or
+// disconnect: feed hold, soft reset (0x18), and `M5 S0` once the controller
+// answers again, then a DeviceFault.
+
+#include <atomic>
+#include <map>
+#include <memory>
+
+#include "devices/Device.h"
+#include "devices/transport/SerialLink.h"
+#include "jobs/GCode.h"
+
+namespace rotafab::devices::grbl {
+
+struct GrblTimeouts {
+  Millis banner{5000};    // after opening (an Arduino resets and waits in its bootloader first)
+  Millis answer{5000};    // for `ok` to a command, or any line while a job streams
+  Millis homing{120000};  // for `$H`
+  Millis poll{200};       // between status polls while streaming
+};
+
+class GrblDriver : public Device {
+ public:
+  // `open` makes the link (serial, TCP, or the simulator's pseudo-terminal).
+  GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts = {});
+  std::string connect() override;
+  void home() override;
+  void frame(const jobs::Toolpath& toolpath) override;
+  void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+           const CancelFlag& cancel) override;
+  void pause() override { holdRequested_ = true; }
+  void resume() override { resumeRequested_ = true; }
+  DeviceStatus status() override;
+  void disconnect() override;
+
+  // What the controller reported at connect().
+  [[nodiscard]] const std::map<int, double>& settings() const { return settings_; }
+  [[nodiscard]] size_t receiveBuffer() const { return receiveBuffer_; }
+  // The G-code options (S scale) and motion limits ($110, $120) of the controller.
+  [[nodiscard]] jobs::GCodeOptions gcodeOptions() const;
+  [[nodiscard]] jobs::MotionLimits motionLimits() const;
+
+ private:
+  void send(const std::string& line);  // a command and its `ok`
+  std::string expectLine(Millis timeout, const char* waitingFor);
+  void waitIdle(Millis timeout);
+  // Feed hold, soft reset, M5 S0: the laser off whatever state the controller was in. Never throws.
+  void stopSafely() noexcept;
+  [[noreturn]] void fail(const DeviceFault& fault);
+
+  std::function<std::unique_ptr<Link>()> open_;
+  GrblTimeouts timeouts_;
+  std::unique_ptr<Link> link_;
+  std::map<int, double> settings_;
+  size_t receiveBuffer_ = 128;
+  std::atomic<bool> holdRequested_{false}, resumeRequested_{false};
+};
+
+// A status report "<Run|MPos:1.000,2.000,0.000|FS:500,0>" as a DeviceStatus (MPos in mm -> inches).
+std::optional<DeviceStatus> parseStatusReport(const std::string& line);
+
+}  // namespace rotafab::devices::grbl

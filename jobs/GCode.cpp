@@ -1,0 +1,35 @@
+#include "jobs/GCode.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+
+namespace rotafab::jobs {
+namespace {
+
+constexpr double kMillimetresPerInch = 25.4;
+
+std::string millimetres(double inches) { return formatDecimal(inches * kMillimetresPerInch, 3); }
+
+}  // namespace
+
+std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options) {
+  std::vector<std::string> lines{"G21", "G90", "G94", "M4 S0"};
+  for (const ToolpathStroke& stroke : toolpath.strokes) {
+    lines.push_back(
+        fmt::format("G0 X{} Y{}", millimetres(stroke.points.front().x()), millimetres(stroke.points.front().y())));
+    const std::string feed = formatDecimal(stroke.speed * kMillimetresPerInch * 60, 1);
+    const std::string power = formatDecimal(std::round(stroke.power * options.maxSpindle), 0);
+    for (size_t i = 1; i < stroke.points.size(); ++i) {
+      std::string line =
+          fmt::format("G1 X{} Y{}", millimetres(stroke.points[i].x()), millimetres(stroke.points[i].y()));
+      if (i == 1) line += fmt::format(" F{} S{}", feed, power);
+      lines.push_back(std::move(line));
+    }
+  }
+  lines.push_back("M5 S0");
+  lines.push_back("G0 X0 Y0");
+  return lines;
+}
+
+}  // namespace rotafab::jobs

@@ -1,0 +1,23 @@
+#pragma once
+// G-code for a toolpath, in GRBL 1.1's laser mode ($32=1): millimetres,
+// absolute coordinates, M4 dynamic power (the power follows the speed, so
+// corners do not burn deeper), S scaled to the controller's $30. Every
+// stroke is a G0 to its start (the laser is off on G0 in laser mode) and
+// G1 moves with its F and S; M5 at the end. No comments: every byte counts
+// against the controller's receive buffer.
+
+#include <string>
+#include <vector>
+
+#include "jobs/Toolpath.h"
+
+namespace rotafab::jobs {
+
+struct GCodeOptions {
+  double maxSpindle = 1000;  // $30: S for full power
+};
+
+// One line each, without the newline.
+std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options);
+
+}  // namespace rotafab::jobs

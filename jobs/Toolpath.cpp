@@ -1,0 +1,233 @@
+#include "jobs/Toolpath.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "geometry/PanelUnfolding.h"
+
+namespace rotafab::jobs {
+namespace {
+
+// The stages, in cutting order.
+enum class Stage { Etch, Score, InnerCut, OuterCut };
+
+struct Candidate {
+  std::vector<Point2> points;  // a closed path with its first point repeated at the end
+  bool closed = false;
+};
+
+// Where a path is entered and left when it starts at its point `entry`
+// (closed: any corner; open: either end, `entry` 0 or the last).
+Point2 exitOf(const Candidate& c, size_t entry) {
+  if (c.closed) return c.points[entry];
+  return entry == 0 ? c.points.back() : c.points.front();
+}
+
+// The corner of `c` nearest `from` (open paths: the nearer end).
+size_t nearestEntry(const Candidate& c, const Point2& from) {
+  if (!c.closed)
+    return (c.points.front() - from).squaredNorm() <= (c.points.back() - from).squaredNorm() ? 0 : c.points.size() - 1;
+  size_t best = 0;
+  for (size_t i = 0; i + 1 < c.points.size(); ++i) {
+    if ((c.points[i] - from).squaredNorm() < (c.points[best] - from).squaredNorm()) best = i;
+  }
+  return best;
+}
+
+// The points of `c` burnt in order when entered at `entry`.
+std::vector<Point2> burnOrder(const Candidate& c, size_t entry) {
+  std::vector<Point2> out;
+  if (!c.closed) {
+    out = c.points;
+    if (entry != 0) std::reverse(out.begin(), out.end());
+    return out;
+  }
+  const size_t corners = c.points.size() - 1;
+  for (size_t k = 0; k <= corners; ++k) out.push_back(c.points[(entry + k) % corners]);
+  return out;
+}
+
+// Nearest neighbour from `from`, then 2-opt on the travel between the
+// strokes (a reversed run turns its open strokes round). Returns the
+// strokes' points in burning order; `from` ends where the last one ends.
+std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& candidates, Point2& from) {
+  const size_t n = candidates.size();
+  std::vector<size_t> order;
+  std::vector<size_t> entry(n, 0);
+  std::vector<char> done(n, 0);
+  Point2 at = from;
+  for (size_t step = 0; step < n; ++step) {
+    size_t best = n;
+    double bestDistance = std::numeric_limits<double>::max();
+    for (size_t i = 0; i < n; ++i) {
+      if (done[i]) continue;
+      const size_t e = nearestEntry(candidates[i], at);
+      const double d = (candidates[i].points[e] - at).squaredNorm();
+      if (d < bestDistance) bestDistance = d, best = i, entry[i] = e;
+    }
+    done[best] = 1;
+    order.push_back(best);
+    at = exitOf(candidates[best], entry[best]);
+  }
+  // 2-opt over the open strokes' ends and the closed strokes' entries:
+  // reversing order[i..j] also reverses each open stroke in it. A closed
+  // stroke is entered and left at the same corner, so only the travel to
+  // and from the run changes. Bounded in time for very large sheets.
+  const auto entryPoint = [&](size_t k) { return candidates[order[k]].points[entry[order[k]]]; };
+  const auto exitPoint = [&](size_t k) { return exitOf(candidates[order[k]], entry[order[k]]); };
+  const auto started = std::chrono::steady_clock::now();
+  for (bool improved = true; improved && n > 2;) {
+    improved = false;
+    for (size_t i = 0; i + 1 < n; ++i) {
+      if (std::chrono::steady_clock::now() - started > std::chrono::seconds(2)) break;
+      const Point2 before = i == 0 ? from : exitPoint(i - 1);
+      for (size_t j = i + 1; j < n; ++j) {
+        const bool last = j + 1 == n;
+        const double now = (entryPoint(i) - before).norm() + (last ? 0.0 : (entryPoint(j + 1) - exitPoint(j)).norm());
+        // Reversed, the run is entered where stroke j is left now, and left where stroke i is entered now.
+        const double then = (exitPoint(j) - before).norm() + (last ? 0.0 : (entryPoint(j + 1) - entryPoint(i)).norm());
+        if (then < now - 1e-9) {
+          std::reverse(order.begin() + static_cast<long>(i), order.begin() + static_cast<long>(j) + 1);
+          for (size_t k = i; k <= j; ++k) {
+            const Candidate& c = candidates[order[k]];
+            if (!c.closed) entry[order[k]] = entry[order[k]] == 0 ? c.points.size() - 1 : 0;
+          }
+          improved = true;
+        }
+      }
+    }
+  }
+  std::vector<std::vector<Point2>> out;
+  for (size_t k = 0; k < n; ++k) out.push_back(burnOrder(candidates[order[k]], entry[order[k]]));
+  if (n > 0) from = out.back().back();
+  return out;
+}
+
+double segmentSeconds(double length, double speed, double acceleration) {
+  if (length <= 0 || speed <= 0) return 0;
+  // From a stop to a stop: cruise at `speed` if there is room to reach it.
+  if (acceleration <= 0 || length >= speed * speed / acceleration) return length / speed + speed / acceleration;
+  return 2 * std::sqrt(length / acceleration);
+}
+
+}  // namespace
+
+Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
+                      const profiles::MaterialProfile& material, const MotionLimits& limits) {
+  Toolpath toolpath;
+  toolpath.sheet = sheet.index;
+  toolpath.width = sheet.width;
+  toolpath.height = sheet.height;
+  // A closed cut inside another closed cut is an inner cut (a hole, or a cut
+  // in a hole of a part): its part is not yet free when it is cut.
+  std::vector<const DrawnPath*> cuts;
+  for (const DrawnPath& path : sheet.paths) {
+    if (path.operation == Operation::Cut && path.closed) cuts.push_back(&path);
+  }
+  std::vector<std::array<double, 4>> boxes;
+  for (const DrawnPath* path : cuts) {
+    std::array<double, 4> box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                              std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+    for (const Point2& p : path->points) {
+      box[0] = std::min(box[0], p.x()), box[1] = std::min(box[1], p.y());
+      box[2] = std::max(box[2], p.x()), box[3] = std::max(box[3], p.y());
+    }
+    boxes.push_back(box);
+  }
+  const auto isInner = [&](const DrawnPath& path) {
+    if (path.operation != Operation::Cut) return false;
+    const Point2& p = path.points.front();
+    for (size_t k = 0; k < cuts.size(); ++k) {
+      if (cuts[k] == &path) continue;
+      const auto& b = boxes[k];
+      if (p.x() < b[0] || p.x() > b[2] || p.y() < b[1] || p.y() > b[3]) continue;
+      if (geometry::insidePolygon(cuts[k]->points, p)) return true;
+    }
+    return false;
+  };
+  std::map<Stage, std::vector<Candidate>> stages;
+  for (const DrawnPath& path : sheet.paths) {
+    if (path.operation == Operation::Outline) continue;  // the material's edge: drawn, never burnt
+    const Stage stage = path.operation == Operation::Etch    ? Stage::Etch
+                        : path.operation == Operation::Score ? Stage::Score
+                        : isInner(path)                      ? Stage::InnerCut
+                                                             : Stage::OuterCut;
+    Candidate c{path.points, path.closed};
+    if (c.closed) c.points.push_back(c.points.front());
+    stages[stage].push_back(std::move(c));
+  }
+  Point2 at(0, 0);
+  for (auto& [stage, candidates] : stages) {
+    const Operation operation = stage == Stage::Etch    ? Operation::Etch
+                                : stage == Stage::Score ? Operation::Score
+                                                        : Operation::Cut;
+    const profiles::ColourSetting& setting = machine.settingFor(operation);
+    double power = setting.power, speed = setting.speed;
+    int passes = setting.passes;
+    const auto overrides = material.machines.find(machine.name);
+    if (overrides != material.machines.end()) {
+      const auto it = overrides->second.find(operation);
+      if (it != overrides->second.end()) {
+        power = it->second.power.value_or(power);
+        speed = it->second.speed.value_or(speed);
+        passes = it->second.passes.value_or(passes);
+      }
+    }
+    if (!(speed > 0) || passes < 1) {
+      throw std::invalid_argument(fmt::format("{}: the {} setting ({}) has speed {}% and {} passes; nothing to run",
+                                              machine.name, profiles::operationName(operation), setting.name, speed,
+                                              passes));
+    }
+    const auto ordered = orderForTravel(candidates, at);
+    for (int pass = 1; pass <= passes; ++pass) {
+      for (const auto& points : ordered) {
+        toolpath.strokes.push_back({operation, stage == Stage::InnerCut, std::clamp(power / 100, 0.0, 1.0),
+                                    speed / 100 * limits.maxSpeed, pass, points});
+      }
+    }
+  }
+  Point2 head(0, 0);
+  for (const ToolpathStroke& stroke : toolpath.strokes) {
+    toolpath.travelLength += (stroke.points.front() - head).norm();
+    for (size_t i = 1; i < stroke.points.size(); ++i)
+      toolpath.burnLength += (stroke.points[i] - stroke.points[i - 1]).norm();
+    head = stroke.points.back();
+  }
+  toolpath.travelLength += head.norm();
+  toolpath.seconds = estimateSeconds(toolpath, limits);
+  return toolpath;
+}
+
+double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits) {
+  const double travel = limits.travelSpeed > 0 ? limits.travelSpeed : limits.maxSpeed;
+  double seconds = 0;
+  Point2 head(0, 0);
+  for (const ToolpathStroke& stroke : toolpath.strokes) {
+    seconds += segmentSeconds((stroke.points.front() - head).norm(), travel, limits.acceleration);
+    for (size_t i = 1; i < stroke.points.size(); ++i) {
+      seconds += segmentSeconds((stroke.points[i] - stroke.points[i - 1]).norm(), stroke.speed, limits.acceleration);
+    }
+    head = stroke.points.back();
+  }
+  return seconds + segmentSeconds(head.norm(), travel, limits.acceleration);
+}
+
+std::array<double, 4> toolpathBounds(const Toolpath& toolpath) {
+  std::array<double, 4> box{std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                            std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()};
+  for (const ToolpathStroke& stroke : toolpath.strokes) {
+    for (const Point2& p : stroke.points) {
+      box[0] = std::min(box[0], p.x()), box[1] = std::min(box[1], p.y());
+      box[2] = std::max(box[2], p.x()), box[3] = std::max(box[3], p.y());
+    }
+  }
+  if (toolpath.strokes.empty()) box = {0, 0, 0, 0};
+  return box;
+}
+
+}  // namespace rotafab::jobs

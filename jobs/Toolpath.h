@@ -1,0 +1,63 @@
+#pragma once
+// What a laser does with one sheet (issue 5): the strokes it burns, in order,
+// each with its power, speed and pass, and the travel between them. Built from
+// the planner's sheet and the machine and material profiles:
+// - power, speed and passes per operation from the machine's colour table
+//   (fig. 65), overridden by the material's settings for that machine;
+// - etch, then score, then inner cuts, then outer cuts, so that nothing is
+//   cut free before the work on it is done; the outline (the material's
+//   edge, power 0) is not burnt;
+// - within each stage, the strokes in the order that shortens the travel
+//   (nearest neighbour, then 2-opt), each entered at its nearer end (an open
+//   stroke may run backwards, a closed one start at any corner);
+// - every pass of a stage before the next stage.
+// Lengths in inches, speeds in inches per second, sheet coordinates (origin
+// at the bed's bottom-left corner, y up). Drivers turn it into their bytes.
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "jobs/SheetDrawing.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::jobs {
+
+// What the machine can do; the speeds of the colour table are percentages of `maxSpeed`.
+struct MotionLimits {
+  double maxSpeed = 500.0 / 25.4 / 60;  // in/s (GRBL's default $110, 500 mm/min)
+  double travelSpeed = 0;               // in/s for moves with the laser off; 0: maxSpeed
+  double acceleration = 10.0 / 25.4;    // in/s^2 (GRBL's default $120, 10 mm/s^2)
+};
+
+struct ToolpathStroke {
+  Operation operation = Operation::Cut;
+  bool inner = false;          // a cut inside another cut (a hole): before the outer cuts
+  double power = 0;            // 0..1 of the machine's full power
+  double speed = 0;            // in/s
+  int pass = 1;                // 1-based
+  std::vector<Point2> points;  // burnt from the first to the last; a closed path returns to its first point
+};
+
+struct Toolpath {
+  int sheet = 1;
+  double width = 0, height = 0;  // the bed
+  std::vector<ToolpathStroke> strokes;
+  double burnLength = 0;    // inches, all passes
+  double travelLength = 0;  // inches, from the origin through every stroke and back
+  double seconds = 0;       // estimated: see estimateSeconds()
+};
+
+// Throws std::invalid_argument when an operation drawn has no usable setting.
+Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
+                      const profiles::MaterialProfile& material, const MotionLimits& limits);
+
+// The time to run: each segment at its stroke's speed (travel at the travel
+// speed), accelerating from and braking to a stop at every corner (so an
+// upper bound for smooth curves, which a planner takes without stopping).
+double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits);
+
+// The box the laser head covers (strokes and nothing else), for framing: min x, min y, max x, max y.
+std::array<double, 4> toolpathBounds(const Toolpath& toolpath);
+
+}  // namespace rotafab::jobs

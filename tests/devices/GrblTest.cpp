@@ -1,0 +1,181 @@
+// The GRBL driver against the simulated GRBL on a pseudo-terminal (issue 5):
+// the real serial code, character counting against the 127-byte buffer, the
+// G-code a controller accepts, and every fault ending with the laser off, a
+// typed error and no hang.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <regex>
+#include <thread>
+
+#include "devices/grbl/GrblDriver.h"
+#include "devices/sim/GrblSimulator.h"
+#include "jobs/GCode.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::devices {
+namespace {
+
+using jobs::Point2;
+
+// A sheet: an etched label, a scored fold, and two parts with a hole each.
+jobs::SheetDrawing sheet() {
+  jobs::SheetDrawing s;
+  s.width = 15, s.height = 15, s.margin = 0.25;
+  for (auto op : profiles::kAllOperations) s.colours[op] = {0, 0, 0};
+  s.paths.push_back({jobs::Operation::Etch, {{1, 1}, {1.5, 1.2}, {2, 1}}, false});
+  s.paths.push_back({jobs::Operation::Score, {{1, 3}, {4, 3}}, false});
+  for (double x : {1.0, 6.0}) {
+    s.paths.push_back({jobs::Operation::Cut, {{x + 1, 5}, {x + 2, 5}, {x + 2, 6}, {x + 1, 6}}, true});  // hole
+    s.paths.push_back({jobs::Operation::Cut, {{x, 4}, {x + 4, 4}, {x + 4, 8}, {x, 8}}, true});          // outline
+  }
+  return s;
+}
+
+jobs::Toolpath toolpath(const jobs::MotionLimits& limits = {}) {
+  const auto machine =
+      profiles::loadMachineProfile(std::string(ROTAFAB_SOURCE_DIR) + "/profiles/machines/grbl-diode-400.yaml");
+  profiles::MaterialProfile material;
+  material.name = "test";
+  return jobs::planToolpath(sheet(), machine, material, limits);
+}
+
+grbl::GrblTimeouts quick() {
+  grbl::GrblTimeouts t;
+  t.banner = std::chrono::milliseconds(1000);
+  t.answer = std::chrono::milliseconds(1500);
+  t.poll = std::chrono::milliseconds(50);
+  return t;
+}
+
+std::unique_ptr<grbl::GrblDriver> driverFor(const sim::GrblSimulator& simulator) {
+  const std::string path = simulator.path();
+  return std::make_unique<grbl::GrblDriver>([path] { return openSerialLink(path, 115200); }, quick());
+}
+
+TEST(Grbl, ConnectReadsTheSettingsAndTheBuffer) {
+  sim::GrblSimulator simulator;
+  auto driver = driverFor(simulator);
+  EXPECT_EQ(driver->connect(), "Grbl 1.1h ['$' for help] (receive buffer 128 bytes, laser mode on)");
+  EXPECT_EQ(driver->receiveBuffer(), 128u);
+  EXPECT_EQ(driver->settings().at(32), 1);
+  EXPECT_EQ(driver->gcodeOptions().maxSpindle, 1000);
+  EXPECT_NEAR(driver->motionLimits().maxSpeed, 6000 / 25.4 / 60, 1e-9);
+}
+
+TEST(Grbl, RefusesToCutWithLaserModeOff) {
+  sim::GrblSimulatorOptions options;
+  options.laserMode = false;
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  try {
+    driver->connect();
+    FAIL() << "connected";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Refused);
+    EXPECT_NE(std::string(fault.what()).find("send $32=1"), std::string::npos) << fault.what();
+  }
+}
+
+// The whole job: every line taken in order, the buffer kept full and never
+// overflowed, the laser lit only while cutting and off at the end.
+TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 40;
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  driver->connect();
+  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  const auto lines = jobs::gcodeLines(path, driver->gcodeOptions());
+  std::vector<Progress> seen;
+  CancelFlag cancel;
+  driver->run(
+      path, [&](const Progress& p) { seen.push_back(p); }, cancel);
+  const auto record = simulator.record();
+  EXPECT_FALSE(record.overflowed);
+  EXPECT_GE(record.mostBuffered, 100u) << "character counting keeps the buffer nearly full";
+  EXPECT_LE(record.mostBuffered, 127u);
+  ASSERT_GE(record.lines.size(), lines.size());
+  const std::vector<std::string> job(record.lines.end() - static_cast<long>(lines.size()), record.lines.end());
+  std::vector<std::string> expected;
+  for (std::string line : lines) {
+    line.erase(std::remove(line.begin(), line.end(), ' '), line.end());
+    expected.push_back(line);
+  }
+  EXPECT_EQ(job, expected);
+  EXPECT_FALSE(record.laserOn);
+  EXPECT_FALSE(record.spindleEnabled) << "M5 at the end";
+  EXPECT_GT(record.litSeconds, 0);
+  EXPECT_EQ(record.state, "Idle");
+  ASSERT_FALSE(seen.empty());
+  EXPECT_EQ(seen.back().bytesAcknowledged, seen.back().bytesTotal);
+  EXPECT_EQ(seen.back().stroke, path.strokes.size());
+}
+
+// Each fault: the driver throws its kind, and the controller is left with the laser off.
+void expectFault(FaultKind kind, const std::function<void(sim::GrblSimulator&)>& inject, const std::string& says,
+                 bool cancelIt = false) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 2;  // slow: the fault comes mid-job
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  driver->connect();
+  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  CancelFlag cancel;
+  simulator.afterLines(12, [&](sim::GrblSimulator& s) {
+    if (cancelIt) cancel.cancel();
+    if (inject) inject(s);
+  });
+  const auto started = std::chrono::steady_clock::now();
+  try {
+    driver->run(path, nullptr, cancel);
+    FAIL() << "the job ran to its end";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, kind) << fault.what();
+    EXPECT_NE(std::string(fault.what()).find(says), std::string::npos) << fault.what();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(15)) << "no hang";
+  const auto record = simulator.record();
+  EXPECT_FALSE(record.laserOn);
+  if (kind != FaultKind::Disconnected && kind != FaultKind::Timeout) {
+    EXPECT_FALSE(record.spindleEnabled) << "reset or M5 after the fault";
+    EXPECT_NE(record.state, "Run");
+  }
+}
+
+TEST(Grbl, AnAlarmStopsTheJobWithTheLaserOff) {
+  expectFault(
+      FaultKind::Alarm, [](sim::GrblSimulator& s) { s.raiseAlarm(1); }, "ALARM:1 (hard limit");
+}
+
+TEST(Grbl, CancelHoldsResetsAndLeavesTheLaserOff) { expectFault(FaultKind::Cancelled, nullptr, "cancelled", true); }
+
+TEST(Grbl, GarbageIsAProtocolFault) {
+  expectFault(
+      FaultKind::Protocol, [](sim::GrblSimulator& s) { s.sendGarbage(); }, "not a GRBL reply");
+}
+
+TEST(Grbl, AControllerThatStopsAnsweringTimesOut) {
+  expectFault(
+      FaultKind::Timeout, [](sim::GrblSimulator& s) { s.mute(true); }, "no answer");
+}
+
+TEST(Grbl, UnpluggedMidJobIsADisconnect) {
+  expectFault(
+      FaultKind::Disconnected, [](sim::GrblSimulator& s) { s.unplug(); }, "");
+}
+
+TEST(Grbl, StatusReportsParse) {
+  const auto report = grbl::parseStatusReport("<Run|MPos:25.400,-50.800,0.000|FS:500,300>");
+  ASSERT_TRUE(report);
+  EXPECT_EQ(report->state, "Run");
+  EXPECT_DOUBLE_EQ(report->x, 1.0);
+  EXPECT_DOUBLE_EQ(report->y, -2.0);
+  EXPECT_EQ(grbl::parseStatusReport("<Hold:0|MPos:0.000,0.000,0.000|Bf:15,128|FS:0,0>")->state, "Hold:0");
+  EXPECT_FALSE(grbl::parseStatusReport("ok"));
+}
+
+}  // namespace
+}  // namespace rotafab::devices
