@@ -10,6 +10,7 @@
 #include "daemon/MakeCommand.h"
 #include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
+#include "daemon/RunCommand.h"
 
 int main(int argc, char** argv) {
   using namespace rotafab::cli;
@@ -24,6 +25,7 @@ int main(int argc, char** argv) {
   addMakeCommand(app, status);
   addNestCommand(app, status);
   addProfilesCommand(app, status);
+  addRunCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

@@ -21,14 +21,6 @@ namespace {
 const std::string kCli = ROTAFAB_CLI;
 const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
 
-// A path in single quotes, for the shell.
-std::string quoted(const std::filesystem::path& path) {
-  std::string text = "'";
-  text += path.string();
-  text += '\'';
-  return text;
-}
-
 // One make of the soccer ball for the tests that only read its output.
 const std::filesystem::path& soccerBall() {
   static TempDir dir;

@@ -43,6 +43,15 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// A path in single quotes, for the shell. (Built by appending: GCC 12 warns
+// falsely, -Wrestrict, on "'" + std::string.)
+inline std::string quoted(const std::filesystem::path& path) {
+  std::string text = "'";
+  text += path.string();
+  text += '\'';
+  return text;
+}
+
 inline std::string readFile(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

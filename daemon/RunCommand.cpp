@@ -1,0 +1,281 @@
+#include "daemon/RunCommand.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "daemon/CommandSupport.h"
+#include "daemon/ExitCode.h"
+#include "devices/DeviceUri.h"
+#include "devices/grbl/GrblDriver.h"
+#include "jobs/AtomicFile.h"
+#include "jobs/GCode.h"
+#include "jobs/SheetReader.h"
+#include "jobs/Toolpath.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::cli {
+namespace {
+
+struct RunOptions {
+  std::string target, device, out, machine, material = "posterboard";
+  std::optional<int> sheet;
+  bool frame = false, dryRun = false, json = false;
+};
+
+// Ctrl-C: the running job is cancelled (the driver holds, resets and turns the laser off).
+devices::CancelFlag* interruptFlag = nullptr;
+extern "C" void onInterrupt(int) {
+  if (interruptFlag) interruptFlag->cancel();
+}
+
+// The sheets to run: (number, SVG file).
+std::vector<std::pair<int, std::filesystem::path>> sheetsOf(const RunOptions& options) {
+  const std::filesystem::path target(options.target);
+  std::vector<std::pair<int, std::filesystem::path>> sheets;
+  if (std::filesystem::is_directory(target)) {
+    const auto manifestFile = target / "manifest.json";
+    std::ifstream in(manifestFile);
+    if (!in)
+      throw UserError(fmt::format("{}: no manifest.json (is it an output folder of `rotafab make`?)", target.string()));
+    nlohmann::json manifest;
+    try {
+      manifest = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& error) {
+      throw UserError(fmt::format("{}: not JSON: {}", manifestFile.string(), error.what()));
+    }
+    try {
+      for (const auto& sheet : manifest.at("sheets")) {
+        const int index = sheet.at("index");
+        for (const auto& file : sheet.at("files")) {
+          const std::string name = file;
+          if (name.ends_with(".svg")) sheets.emplace_back(index, target / name);
+        }
+      }
+    } catch (const nlohmann::json::exception& error) {
+      throw UserError(fmt::format("{}: sheets: {}", manifestFile.string(), error.what()));
+    }
+    if (sheets.empty()) throw UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
+  } else {
+    if (target.extension() != ".svg") {
+      throw UserError(
+          fmt::format("{}: give the sheet's .svg (or the output folder of `rotafab make`)", target.string()));
+    }
+    sheets.emplace_back(1, target);
+  }
+  if (options.sheet) {
+    const auto it =
+        std::find_if(sheets.begin(), sheets.end(), [&](const auto& s) { return s.first == *options.sheet; });
+    if (it == sheets.end()) {
+      throw UserError(fmt::format("--sheet {}: {} has sheets 1 to {}", *options.sheet, options.target, sheets.size()));
+    }
+    sheets = {*it};
+  }
+  return sheets;
+}
+
+std::string minutes(double seconds) {
+  const int s = static_cast<int>(std::lround(seconds));
+  return s >= 60 ? fmt::format("{}m {:02}s", s / 60, s % 60) : fmt::format("{}s", s);
+}
+
+int runRun(const RunOptions& options) {
+  try {
+    const devices::DeviceUri uri = [&] {
+      try {
+        return devices::parseDeviceUri(options.device);
+      } catch (const std::invalid_argument& error) {
+        throw UserError(error.what());
+      }
+    }();
+    if (uri.driver != "grbl") {
+      throw UserError(
+          fmt::format("--device {}: the {} driver is not built yet (issue 5: the M2 Nano over USB and "
+                      "the spool folder are still to come)",
+                      options.device, uri.driver));
+    }
+    if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
+    const auto sheets = sheetsOf(options);
+    const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+    profiles::MachineProfile machine;
+    if (!options.machine.empty()) {
+      machine = profiles::findMachine(catalogue, options.machine);
+    } else {
+      const auto it = std::find_if(catalogue.machines.begin(), catalogue.machines.end(),
+                                   [&](const auto& m) { return m.driver == uri.driver; });
+      if (it == catalogue.machines.end())
+        throw UserError(fmt::format("no machine profile for the {} driver; give --machine", uri.driver));
+      machine = *it;
+    }
+    const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
+    std::vector<jobs::SheetDrawing> drawings;
+    for (const auto& [index, file] : sheets) {
+      try {
+        drawings.push_back(jobs::readSheetSvg(file));
+      } catch (const std::invalid_argument& error) {
+        throw UserError(error.what());
+      }
+      const jobs::SheetDrawing& sheet = drawings.back();
+      if (sheet.width > machine.bed.width + 1e-6 || sheet.height > machine.bed.height + 1e-6) {
+        throw UserError(
+            fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
+                        "make it for this machine (`rotafab make ... --machine {}`)",
+                        file.string(), sheet.width, sheet.height, machine.name, machine.bed.width, machine.bed.height,
+                        machine.name));
+      }
+    }
+
+    // A dry run opens no real port: S and F follow GRBL's defaults ($30=1000,
+    // $110=500 mm/min) unless the device is the simulator, which it asks.
+    std::unique_ptr<devices::Device> device;
+    jobs::GCodeOptions gcode;
+    jobs::MotionLimits limits;
+    std::string identity;
+    if (!options.dryRun || uri.transport == "sim") {
+      device = devices::openDevice(uri);
+      identity = device->connect();
+      if (auto* grbl = dynamic_cast<devices::grbl::GrblDriver*>(device.get())) {
+        gcode = grbl->gcodeOptions();
+        limits = grbl->motionLimits();
+      }
+      fmt::print(stderr, "run: {}: {}\n", options.device, identity);
+    } else {
+      fmt::print(stderr, "run: dry run: S and F for GRBL's default settings ($30=1000, $110=500 mm/min)\n");
+    }
+
+    std::vector<jobs::Toolpath> toolpaths;
+    for (const jobs::SheetDrawing& sheet : drawings) {
+      try {
+        toolpaths.push_back(jobs::planToolpath(sheet, machine, material, limits));
+      } catch (const std::invalid_argument& error) {
+        throw UserError(error.what());
+      }
+    }
+    if (options.dryRun) {
+      jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
+        for (const jobs::Toolpath& toolpath : toolpaths) {
+          for (const std::string& line : jobs::gcodeLines(toolpath, gcode)) out << line << '\n';
+        }
+      });
+      fmt::print("{}: G-code for {} sheet{} ({} strokes), as the driver would send it\n", options.out, toolpaths.size(),
+                 toolpaths.size() == 1 ? "" : "s", [&] {
+                   size_t n = 0;
+                   for (const auto& t : toolpaths) n += t.strokes.size();
+                   return n;
+                 }());
+      return kSuccess;
+    }
+
+    devices::CancelFlag cancel;
+    interruptFlag = &cancel;
+    struct sigaction action {};
+    action.sa_handler = onInterrupt;
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+    const bool terminal = ::isatty(STDERR_FILENO) != 0;
+    double burnt = 0, seconds = 0;
+    size_t strokes = 0;
+    const auto started = std::chrono::steady_clock::now();
+    try {
+      for (size_t s = 0; s < toolpaths.size(); ++s) {
+        const jobs::Toolpath& toolpath = toolpaths[s];
+        if (s > 0) {
+          if (::isatty(STDIN_FILENO)) {
+            fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", toolpath.sheet);
+            std::string ignored;
+            std::getline(std::cin, ignored);
+          }
+        }
+        if (cancel.cancelled())
+          throw devices::DeviceFault(devices::FaultKind::Cancelled, options.device + ": cancelled");
+        fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}\n", toolpath.sheet, s + 1,
+                   toolpaths.size(), toolpath.strokes.size(), toolpath.burnLength, minutes(toolpath.seconds));
+        if (options.frame) {
+          fmt::print(stderr, "run: framing (laser off)\n");
+          device->frame(toolpath);
+        }
+        auto lastShown = std::chrono::steady_clock::time_point{};
+        int lastPercent = -1;
+        device->run(
+            toolpath,
+            [&](const devices::Progress& p) {
+              const int percent = static_cast<int>(100 * p.bytesAcknowledged / std::max<size_t>(p.bytesTotal, 1));
+              const auto now = std::chrono::steady_clock::now();
+              if (terminal ? now - lastShown < std::chrono::milliseconds(200) && percent != 100
+                           : percent / 10 == lastPercent / 10) {
+                return;
+              }
+              lastShown = now, lastPercent = percent;
+              const int filled = percent / 5;
+              fmt::print(stderr, "{}run: sheet {} [{}{}] {:3}%  stroke {} of {}, {} left{}", terminal ? "\r" : "",
+                         p.sheet, std::string(filled, '#'), std::string(20 - filled, '.'), percent, p.stroke, p.strokes,
+                         minutes(p.secondsLeft), terminal ? "" : "\n");
+            },
+            cancel);
+        if (terminal) fmt::print(stderr, "\n");
+        burnt += toolpath.burnLength, seconds += toolpath.seconds, strokes += toolpath.strokes.size();
+      }
+    } catch (const devices::DeviceFault& fault) {
+      interruptFlag = nullptr;
+      if (terminal) fmt::print(stderr, "\n");
+      fmt::print(stderr, "error: {} ({}; the laser is off)\n", fault.what(), devices::faultName(fault.kind));
+      return kDeviceFault;
+    }
+    interruptFlag = nullptr;
+    device->disconnect();
+    fmt::print("{}: {} sheet{} cut on {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target,
+               toolpaths.size(), toolpaths.size() == 1 ? "" : "s", options.device, strokes, burnt,
+               minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
+               minutes(seconds));
+    return kSuccess;
+  } catch (const UserError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+    return kUserError;
+  } catch (const profiles::ProfileError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+    return kUserError;
+  } catch (const devices::DeviceFault& fault) {
+    fmt::print(stderr, "error: {} ({})\n", fault.what(), devices::faultName(fault.kind));
+    return kDeviceFault;
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "error: {}: {}\n", options.target, error.what());
+    return kUserError;
+  }
+}
+
+}  // namespace
+
+void addRunCommand(CLI::App& app, int& status) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* run = app.add_subcommand("run", "Drive a cutter directly: cut the sheets of a `make` output");
+  run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
+  run->add_option("--device", options->device,
+                  "Device URI: grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
+                  "sim:grbl?speed=50 moves 50 times faster)")
+      ->required();
+  run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
+  run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
+  run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
+  run->add_option("--out", options->out, "With --dry-run: the file for the bytes (G-code for GRBL)");
+  run->add_option("--machine", options->machine, "Machine profile (default: the first whose driver the URI names)");
+  run->add_option("--material", options->material, "Material profile: power and speed overrides")
+      ->capture_default_str();
+  run->footer(
+      "Cuts etch, then score, then inner cuts, then outer cuts, each with the machine profile's power, speed and\n"
+      "passes. Ctrl-C stops the job: feed hold, reset, laser off. Exit status 3 on a device fault.\n\n"
+      "Examples:\n"
+      "  rotafab make examples/cube.obj --structure band --machine grbl-diode-400 --out cube/\n"
+      "  rotafab run cube/ --device sim:grbl\n"
+      "  rotafab run cube/ --sheet 1 --device grbl:///dev/ttyUSB0 --frame\n"
+      "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode");
+  run->callback([options, &status] { status = runRun(*options); });
+}
+
+}  // namespace rotafab::cli

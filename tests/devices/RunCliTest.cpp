@@ -1,0 +1,98 @@
+// `rotafab run` through the built program against the simulated GRBL: a
+// `make` output cut to the end with progress, the dry run's G-code, Ctrl-C
+// stopping safely, and one-line errors with SPEC's exit statuses.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+const std::string kCli = ROTAFAB_CLI;
+const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
+
+// One make of the cube for the GRBL machine's bed, shared by the tests.
+const std::filesystem::path& cubeJob() {
+  static TempDir dir;
+  static const auto out = dir.path() / "cube";
+  static const bool made = [] {
+    const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                " --structure band --machine grbl-diode-400 --time 0 --out " + quoted(out));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return true;
+  }();
+  EXPECT_TRUE(made);
+  return out;
+}
+
+TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
+  const CommandResult r = run(kCli + " run " + quoted(cubeJob()) + " --device 'sim:grbl?speed=200'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("Grbl 1.1h ['$' for help] (receive buffer 128 bytes, laser mode on)"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("] 100%  stroke 108 of 108"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("1 sheet cut on sim:grbl?speed=200: 108 strokes"), std::string::npos) << r.out;
+}
+
+TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
+  TempDir dir;
+  const auto file = dir.path() / "cube.gcode";
+  const CommandResult r =
+      run(kCli + " run " + quoted(cubeJob()) + " --device sim:grbl --dry-run --out " + quoted(file));
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::istringstream lines(readFile(file));
+  std::vector<std::string> all;
+  for (std::string line; std::getline(lines, line);) all.push_back(line);
+  ASSERT_GT(all.size(), 10u);
+  EXPECT_EQ(all[0], "G21");
+  EXPECT_EQ(all[3], "M4 S0");
+  EXPECT_EQ(all[all.size() - 2], "M5 S0");
+  int rapids = 0;
+  for (const auto& line : all) {
+    rapids += line.starts_with("G0 ");
+    EXPECT_LE(line.size(), 79u) << "GRBL takes at most 79 characters a line";
+  }
+  EXPECT_EQ(rapids, 108 + 1);  // one per stroke, and home
+}
+
+// Ctrl-C mid-job: the driver holds and resets the controller; exit 3, the laser off.
+TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
+  const CommandResult r =
+      run("timeout --preserve-status -s INT 2 " + kCli + " run " + quoted(cubeJob()) + " --device sim:grbl");
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("cancelled (cancelled; the laser is off)"), std::string::npos) << r.err;
+}
+
+TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
+  TempDir dir;
+  // A sheet for the 32 x 18 in workshop bed does not go on a 400 mm GRBL bed.
+  const CommandResult big = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                " --structure band --time 0 --out " + quoted(dir.path() / "big"));
+  ASSERT_EQ(big.status, 0) << big.err;
+  const auto fails = [&](const std::string& args, int status, const std::string& says) {
+    const CommandResult r = run(kCli + " run " + args);
+    EXPECT_EQ(r.status, status) << args << ": " << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << args << ": " << r.err;
+    int errors = 0;
+    std::istringstream lines(r.err);
+    for (std::string line; std::getline(lines, line);) errors += line.starts_with("error: ");
+    EXPECT_EQ(errors, 1) << args << ": " << r.err;
+  };
+  fails(quoted(dir.path() / "big") + " --device sim:grbl", 1, "larger than the bed of grbl-diode-400");
+  fails(quoted(cubeJob()) + " --device grbl://ttyUSB0", 1, "must be an absolute path");
+  fails(quoted(cubeJob()) + " --device sim:grbl?speed=fast", 1, "speed=N");
+  fails(quoted(cubeJob()) + " --device sim:grbl --sheet 4", 1, "--sheet 4");
+  fails(quoted(cubeJob()) + " --device sim:grbl --dry-run", 1, "--dry-run needs --out");
+  fails(quoted(dir.path()) + " --device sim:grbl", 1, "no manifest.json");
+  fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port", 3, "cannot open it");
+  fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512", 1, "not built yet");
+}
+
+}  // namespace
+}  // namespace rotafab::test
