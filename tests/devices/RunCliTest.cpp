@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <sstream>
 
@@ -92,6 +93,36 @@ TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
   fails(quoted(dir.path()) + " --device sim:grbl", 1, "no manifest.json");
   fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port", 3, "cannot open it");
   fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512", 1, "not built yet");
+}
+
+}  // namespace
+}  // namespace rotafab::test
+
+namespace rotafab::test {
+namespace {
+
+// `rotafab devices` in a faked sysfs (umockdev): a GRBL board behind a CH340
+// adapter (a serial port, found by libserialport) and a K40's M2 Nano (a CH341
+// in parallel mode, no serial port: found by libusb).
+TEST(DevicesCli, ListsTheCuttersOfAFakedSysfs) {
+  const auto testbed = std::filesystem::path(ROTAFAB_SOURCE_DIR) / "tests/data/devices/cutters.umockdev";
+  const CommandResult r =
+      run("umockdev-run --device " + quoted(testbed) + " -- " + std::string(ROTAFAB_CLI) + " devices --json");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto list = nlohmann::json::parse(r.out);
+  ASSERT_EQ(list.size(), 2u) << r.out;
+  EXPECT_EQ(list[0].at("port"), "/dev/ttyUSB0");
+  EXPECT_EQ(list[0].at("usb").at("vendor"), "1a86");
+  EXPECT_EQ(list[0].at("usb").at("product"), "7523");
+  EXPECT_EQ(list[0].at("usb").at("serial"), "GRBL-0042");
+  EXPECT_EQ(list[0].at("driver"), "grbl");
+  EXPECT_EQ(list[0].at("uri"), "grbl:///dev/ttyUSB0?baud=115200");
+  EXPECT_EQ(list[1].at("port"), "usb:001:004");
+  EXPECT_EQ(list[1].at("driver"), "m2nano");
+  EXPECT_EQ(list[1].at("uri"), "m2nano://usb/1a86:5512");
+  const CommandResult text =
+      run("umockdev-run --device " + quoted(testbed) + " -- " + std::string(ROTAFAB_CLI) + " devices");
+  EXPECT_NE(text.out.find("grbl driver: --device grbl:///dev/ttyUSB0?baud=115200"), std::string::npos) << text.out;
 }
 
 }  // namespace
