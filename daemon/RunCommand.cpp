@@ -16,7 +16,9 @@
 #include "devices/DeviceUri.h"
 #include "devices/Discovery.h"
 #include "devices/grbl/GrblDriver.h"
+#include "devices/spool/SpoolDevice.h"
 #include "jobs/AtomicFile.h"
+#include "jobs/EpsWriter.h"
 #include "jobs/GCode.h"
 #include "jobs/SheetReader.h"
 #include "jobs/Toolpath.h"
@@ -96,11 +98,11 @@ int runRun(const RunOptions& options) {
         throw UserError(error.what());
       }
     }();
-    if (uri.driver != "grbl") {
+    if (uri.driver == "m2nano") {
       throw UserError(
-          fmt::format("--device {}: the {} driver is not built yet (issue 5: the M2 Nano over USB and "
-                      "the spool folder are still to come)",
-                      options.device, uri.driver));
+          fmt::format("--device {}: the m2nano driver is not built yet (issue 5: the M2 Nano over USB "
+                      "is still to come)",
+                      options.device));
     }
     if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
     const auto sheets = sheetsOf(options);
@@ -139,8 +141,11 @@ int runRun(const RunOptions& options) {
     jobs::GCodeOptions gcode;
     jobs::MotionLimits limits;
     std::string identity;
+    std::map<jobs::Operation, jobs::Rgb> colours;
+    for (profiles::Operation operation : profiles::kAllOperations)
+      colours[operation] = machine.settingFor(operation).rgb;
     if (!options.dryRun || uri.transport == "sim") {
-      device = devices::openDevice(uri);
+      device = devices::openDevice(uri, colours);
       identity = device->connect();
       if (auto* grbl = dynamic_cast<devices::grbl::GrblDriver*>(device.get())) {
         gcode = grbl->gcodeOptions();
@@ -158,6 +163,16 @@ int runRun(const RunOptions& options) {
       } catch (const std::invalid_argument& error) {
         throw UserError(error.what());
       }
+    }
+    if (options.dryRun && uri.driver == "spool") {
+      // The bytes the spool writes: each sheet's EPS, one after another.
+      jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
+        for (const jobs::Toolpath& toolpath : toolpaths)
+          jobs::writeEps(devices::spool::drawingOf(toolpath, colours), out);
+      });
+      fmt::print("{}: EPS for {} sheet{}, as the spool would write it\n", options.out, toolpaths.size(),
+                 toolpaths.size() == 1 ? "" : "s");
+      return kSuccess;
     }
     if (options.dryRun) {
       jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
@@ -299,7 +314,8 @@ void addRunCommand(CLI::App& app, int& status) {
   run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
   run->add_option("--device", options->device,
                   "Device URI: grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
-                  "sim:grbl?speed=50 moves 50 times faster)")
+                  "sim:grbl?speed=50 moves 50 times faster), spool:DIR[?printer=NAME] (EPS for a print driver, "
+                  "sent to lp)")
       ->required();
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");

@@ -7,6 +7,7 @@
 
 #include "devices/grbl/GrblDriver.h"
 #include "devices/sim/GrblSimulator.h"
+#include "devices/spool/SpoolDevice.h"
 
 namespace rotafab::devices {
 namespace {
@@ -50,6 +51,15 @@ DeviceUri parseDeviceUri(const std::string& uri) {
   }
   if (uri.starts_with("spool:")) {
     parsed.driver = "spool", parsed.transport = "folder", parsed.path = uri.substr(6);
+    const auto query = parsed.path.find('?');
+    if (query != std::string::npos) {
+      const std::string option = parsed.path.substr(query + 1);
+      parsed.path.erase(query);
+      if (!option.starts_with("printer=") || option.size() == 8) {
+        throw bad(fmt::format("\"{}\": the spool takes printer=NAME", option));
+      }
+      parsed.printer = option.substr(8);
+    }
     if (parsed.path.empty()) throw bad("no folder after spool:");
     return parsed;
   }
@@ -87,7 +97,8 @@ DeviceUri parseDeviceUri(const std::string& uri) {
   throw bad("not a device URI this program knows");
 }
 
-std::unique_ptr<Device> openDevice(const DeviceUri& uri) {
+std::unique_ptr<Device> openDevice(const DeviceUri& uri, const std::map<jobs::Operation, jobs::Rgb>& colours) {
+  if (uri.driver == "spool") return std::make_unique<spool::SpoolDevice>(uri.path, uri.printer, colours);
   if (uri.driver == "grbl" && uri.transport == "sim") {
     sim::GrblSimulatorOptions options;
     options.timeScale = uri.simulatedSpeed;
@@ -99,9 +110,8 @@ std::unique_ptr<Device> openDevice(const DeviceUri& uri) {
   if (uri.driver == "grbl" && uri.transport == "tcp") {
     return std::make_unique<grbl::GrblDriver>([uri] { return openTcpLink(uri.path, uri.port, Millis(5000)); });
   }
-  throw std::invalid_argument(fmt::format(
-      "the {} driver is not built yet (issue 5: the M2 Nano over USB and the spool folder are still to come)",
-      uri.driver));
+  throw std::invalid_argument(
+      fmt::format("the {} driver is not built yet (issue 5: the M2 Nano over USB is still to come)", uri.driver));
 }
 
 }  // namespace rotafab::devices

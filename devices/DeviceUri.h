@@ -4,8 +4,10 @@
 //   grbl+tcp://host:23                GRBL over telnet (ESP32 boards, ser2net)
 //   sim:grbl[?speed=N]                a simulated GRBL on a pseudo-terminal, in this process
 //                                     (its machine moving N times faster than real, default 1)
-//   m2nano://usb/1a86:5512, sim:m2nano, spool:DIR   (issue 5: still to come)
+//   spool:DIR[?printer=NAME]          EPS files for a print-driver cutter, optionally sent to `lp`
+//   m2nano://usb/1a86:5512, sim:m2nano   (issue 5: still to come)
 
+#include <map>
 #include <memory>
 #include <string>
 
@@ -20,6 +22,7 @@ struct DeviceUri {
   std::string port;       // TCP port
   unsigned baud = 115200;
   double simulatedSpeed = 1;  // sim: simulated seconds per real second
+  std::string printer;        // spool: the printer for lp, or none
 };
 
 // Throws std::invalid_argument naming what is wrong with the URI.
@@ -27,6 +30,7 @@ DeviceUri parseDeviceUri(const std::string& uri);
 
 // The device, not yet connected (a simulator starts at once). Throws
 // std::invalid_argument for a driver that is not built yet.
-std::unique_ptr<Device> openDevice(const DeviceUri& uri);
+// `colours`: the machine profile's colour per operation (the spool draws in them).
+std::unique_ptr<Device> openDevice(const DeviceUri& uri, const std::map<jobs::Operation, jobs::Rgb>& colours = {});
 
 }  // namespace rotafab::devices

@@ -127,3 +127,45 @@ TEST(DevicesCli, ListsTheCuttersOfAFakedSysfs) {
 
 }  // namespace
 }  // namespace rotafab::test
+
+namespace rotafab::test {
+namespace {
+
+// The spool: each sheet as EPS in the folder, which Ghostscript reads, in
+// the machine's colours; with a printer, handed to `lp` (here a stand-in
+// that records its arguments), and lp's refusal is a device fault.
+TEST(RunCli, TheSpoolWritesEpsAndHandsItToLp) {
+  TempDir dir;
+  const auto job = dir.path() / "job";
+  const CommandResult made =
+      run(kCli + " make " + quoted(kSource / "examples/cube.obj") + " --structure band --time 0 --out " + quoted(job));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto spool = dir.path() / "spool";
+  const CommandResult r =
+      run(kCli + " run " + quoted(job) + " --device " + quoted(std::filesystem::path("spool:" + spool.string())));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const CommandResult gs = run("gs -q -dNOPAUSE -dBATCH -sDEVICE=bbox " + quoted(spool / "sheet-001.eps"));
+  ASSERT_EQ(gs.status, 0) << gs.err;
+  std::smatch box;
+  ASSERT_TRUE(std::regex_search(gs.err, box, std::regex(R"(%%BoundingBox: (\d+) (\d+) (\d+) (\d+))"))) << gs.err;
+  EXPECT_LE(std::stoi(box[3]), 32 * 72 + 1);
+  EXPECT_NE(readFile(spool / "sheet-001.eps").find("% cut\n0 0 1 c\n"), std::string::npos) << "cuts in blue";
+
+  const auto bin = dir.path() / "bin";
+  std::filesystem::create_directories(bin);
+  dir.write("bin/lp", "#!/bin/sh\necho \"$@\" > " + quoted(dir.path() / "lp-args") + "\n[ \"$2\" = laser1 ]\n");
+  std::filesystem::permissions(bin / "lp", std::filesystem::perms::owner_all);
+  const std::string withLp = "PATH=" + quoted(bin) + ":$PATH ";
+  const CommandResult printed = run(withLp + kCli + " run " + quoted(job) + " --device " +
+                                    quoted(std::filesystem::path("spool:" + spool.string() + "?printer=laser1")));
+  ASSERT_EQ(printed.status, 0) << printed.err;
+  EXPECT_EQ(readFile(dir.path() / "lp-args"),
+            "-d laser1 -t rotafab sheet 1 " + (spool / "sheet-001.eps").string() + "\n");
+  const CommandResult refused = run(withLp + kCli + " run " + quoted(job) + " --device " +
+                                    quoted(std::filesystem::path("spool:" + spool.string() + "?printer=nope")));
+  EXPECT_EQ(refused.status, 3) << refused.err;
+  EXPECT_NE(refused.err.find("lp -d nope refused"), std::string::npos) << refused.err;
+}
+
+}  // namespace
+}  // namespace rotafab::test

@@ -1,0 +1,86 @@
+#include "devices/spool/SpoolDevice.h"
+
+#include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <fstream>
+
+#include "jobs/AtomicFile.h"
+#include "jobs/EpsWriter.h"
+
+extern char** environ;
+
+namespace rotafab::devices::spool {
+
+jobs::SheetDrawing drawingOf(const jobs::Toolpath& toolpath, const std::map<jobs::Operation, jobs::Rgb>& colours) {
+  jobs::SheetDrawing sheet;
+  sheet.index = toolpath.sheet;
+  sheet.width = toolpath.width, sheet.height = toolpath.height, sheet.margin = 0;
+  sheet.colours = colours;
+  sheet.title = fmt::format("rotafab sheet {}", toolpath.sheet);
+  for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
+    if (stroke.pass != 1) continue;
+    jobs::DrawnPath path{stroke.operation, stroke.points, false};
+    if (path.points.size() > 2 && path.points.front() == path.points.back()) {
+      path.points.pop_back();
+      path.closed = true;
+    }
+    sheet.paths.push_back(std::move(path));
+  }
+  return sheet;
+}
+
+SpoolDevice::SpoolDevice(std::filesystem::path folder, std::string printer,
+                         std::map<jobs::Operation, jobs::Rgb> colours)
+    : folder_(std::move(folder)), printer_(std::move(printer)), colours_(std::move(colours)) {}
+
+std::string SpoolDevice::connect() {
+  std::error_code error;
+  std::filesystem::create_directories(folder_, error);
+  if (error || !std::filesystem::is_directory(folder_)) {
+    throw DeviceFault(FaultKind::Disconnected, fmt::format("spool:{}: cannot make the folder: {}", folder_.string(),
+                                                           error ? error.message() : "not a folder"));
+  }
+  return printer_.empty() ? fmt::format("EPS files in {}", folder_.string())
+                          : fmt::format("EPS files in {}, printed on {} with lp", folder_.string(), printer_);
+}
+
+void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+                      const CancelFlag& cancel) {
+  if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, "spool: cancelled");
+  const jobs::SheetDrawing sheet = drawingOf(toolpath, colours_);
+  lastFile_ = folder_ / fmt::format("sheet-{:03}.eps", toolpath.sheet);
+  try {
+    jobs::writeFileAtomically(lastFile_, [&](std::ostream& out) { jobs::writeEps(sheet, out); });
+  } catch (const std::exception& error) {
+    throw DeviceFault(FaultKind::Disconnected, fmt::format("spool:{}: {}", folder_.string(), error.what()));
+  }
+  if (!printer_.empty()) {
+    // lp -d PRINTER -t TITLE FILE, without a shell.
+    const std::string title = sheet.title, file = lastFile_.string();
+    std::vector<std::string> args{"lp", "-d", printer_, "-t", title, file};
+    std::vector<char*> argv;
+    for (std::string& arg : args) argv.push_back(arg.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    if (posix_spawnp(&pid, "lp", nullptr, nullptr, argv.data(), environ) != 0) {
+      throw DeviceFault(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      throw DeviceFault(FaultKind::Refused, fmt::format("spool: lp -d {} refused {} (exit status {})", printer_, file,
+                                                        WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+    }
+  }
+  if (progress) {
+    Progress done;
+    done.sheet = toolpath.sheet;
+    done.stroke = done.strokes = toolpath.strokes.size();
+    done.bytesAcknowledged = done.bytesTotal = std::filesystem::file_size(lastFile_);
+    progress(done);
+  }
+}
+
+}  // namespace rotafab::devices::spool

@@ -1,0 +1,45 @@
+#pragma once
+// The spool "driver" (`spool:DIR[?printer=NAME]`, issue 5): for cutters
+// driven through a print driver, as the dissertation's workshop cutter was.
+// Each sheet's toolpath becomes an EPS file in DIR, drawn in the machine's
+// colours (the print driver maps colours to power, speed and passes, fig. 65),
+// and with a printer name it is handed to `lp`. Nothing here lights a laser:
+// the print driver does, after this program is done.
+
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "devices/Device.h"
+
+namespace rotafab::devices::spool {
+
+// The sheet a toolpath draws: each stroke once (the print driver repeats the
+// passes), in cutting order, closed strokes closed, in the machine's colours.
+jobs::SheetDrawing drawingOf(const jobs::Toolpath& toolpath, const std::map<jobs::Operation, jobs::Rgb>& colours);
+
+class SpoolDevice : public Device {
+ public:
+  // `colours`: the machine profile's colour for each operation.
+  SpoolDevice(std::filesystem::path folder, std::string printer, std::map<jobs::Operation, jobs::Rgb> colours);
+  std::string connect() override;
+  void home() override {}
+  void frame(const jobs::Toolpath&) override {}
+  void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+           const CancelFlag& cancel) override;
+  void pause() override {}
+  void resume() override {}
+  DeviceStatus status() override { return {"Idle", 0, 0}; }
+  void disconnect() override {}
+
+  // The file the last run() wrote.
+  [[nodiscard]] const std::filesystem::path& lastFile() const { return lastFile_; }
+
+ private:
+  std::filesystem::path folder_;
+  std::string printer_;
+  std::map<jobs::Operation, jobs::Rgb> colours_;
+  std::filesystem::path lastFile_;
+};
+
+}  // namespace rotafab::devices::spool
