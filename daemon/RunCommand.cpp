@@ -189,12 +189,31 @@ int runRun(const RunOptions& options) {
       return kSuccess;
     }
 
+    if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
+      throw UserError(
+          fmt::format("{}: {} sheets, and no terminal to ask before each one that the next is loaded: "
+                      "run them one at a time with --sheet N",
+                      options.target, toolpaths.size()));
+    }
     devices::CancelFlag cancel;
-    interruptFlag = &cancel;
-    struct sigaction action {};
-    action.sa_handler = onInterrupt;
-    sigaction(SIGINT, &action, nullptr);
-    sigaction(SIGTERM, &action, nullptr);
+    // Ctrl-C and SIGTERM cancel the job while it runs; the old handlers come back after.
+    struct InterruptGuard {
+      struct sigaction oldInt {
+      }, oldTerm{};
+      explicit InterruptGuard(devices::CancelFlag& flag) {
+        interruptFlag = &flag;
+        struct sigaction action {};
+        action.sa_handler = onInterrupt;
+        action.sa_flags = SA_RESTART;
+        sigaction(SIGINT, &action, &oldInt);
+        sigaction(SIGTERM, &action, &oldTerm);
+      }
+      ~InterruptGuard() {
+        sigaction(SIGINT, &oldInt, nullptr);
+        sigaction(SIGTERM, &oldTerm, nullptr);
+        interruptFlag = nullptr;
+      }
+    } guard(cancel);
     const bool terminal = ::isatty(STDERR_FILENO) != 0;
     double burnt = 0, seconds = 0;
     size_t strokes = 0;
@@ -206,7 +225,7 @@ int runRun(const RunOptions& options) {
           if (::isatty(STDIN_FILENO)) {
             fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", toolpath.sheet);
             std::string ignored;
-            std::getline(std::cin, ignored);
+            if (!std::getline(std::cin, ignored)) cancel.cancel();  // end of input: stop, do not cut blind
           }
         }
         if (cancel.cancelled())
@@ -239,12 +258,13 @@ int runRun(const RunOptions& options) {
         burnt += toolpath.burnLength, seconds += toolpath.seconds, strokes += toolpath.strokes.size();
       }
     } catch (const devices::DeviceFault& fault) {
-      interruptFlag = nullptr;
       if (terminal) fmt::print(stderr, "\n");
-      fmt::print(stderr, "error: {} ({}; the laser is off)\n", fault.what(), devices::faultName(fault.kind));
+      fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
+                 fault.laserOffConfirmed
+                     ? "the laser is off"
+                     : "the controller did not confirm the laser off: switch it off at the machine");
       return kDeviceFault;
     }
-    interruptFlag = nullptr;
     device->disconnect();
     fmt::print("{}: {} sheet{} cut on {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target,
                toolpaths.size(), toolpaths.size() == 1 ? "" : "s", options.device, strokes, burnt,

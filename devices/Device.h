@@ -33,6 +33,9 @@ class DeviceFault : public std::runtime_error {
  public:
   DeviceFault(FaultKind kind, const std::string& what) : std::runtime_error(what), kind(kind) {}
   FaultKind kind;
+  // Whether the driver saw the controller take its laser-off command after
+  // the fault (it cannot when the device stopped answering or went away).
+  bool laserOffConfirmed = false;
 };
 
 struct Progress {

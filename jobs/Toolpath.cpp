@@ -13,8 +13,15 @@
 namespace rotafab::jobs {
 namespace {
 
-// The stages, in cutting order.
-enum class Stage { Etch, Score, InnerCut, OuterCut };
+// The stages, in cutting order: etch, score, then the cuts deepest first.
+// A cut's depth is how many closed cuts hold it: a part's holes (1) before
+// its outline (0); a part nested in another's hole (2) and its holes (3)
+// before that hole.
+struct Stage {
+  int rank;   // 0 etch, 1 score, 2 cuts
+  int depth;  // cuts: the negated depth, so that the deepest sorts first
+  auto operator<=>(const Stage&) const = default;
+};
 
 struct Candidate {
   std::vector<Point2> points;  // a closed path with its first point repeated at the end
@@ -139,33 +146,30 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
     }
     boxes.push_back(box);
   }
-  const auto isInner = [&](const DrawnPath& path) {
-    if (path.operation != Operation::Cut) return false;
+  const auto depthOf = [&](const DrawnPath& path) {
     const Point2& p = path.points.front();
+    int depth = 0;
     for (size_t k = 0; k < cuts.size(); ++k) {
       if (cuts[k] == &path) continue;
       const auto& b = boxes[k];
       if (p.x() < b[0] || p.x() > b[2] || p.y() < b[1] || p.y() > b[3]) continue;
-      if (geometry::insidePolygon(cuts[k]->points, p)) return true;
+      depth += geometry::insidePolygon(cuts[k]->points, p);
     }
-    return false;
+    return depth;
   };
   std::map<Stage, std::vector<Candidate>> stages;
   for (const DrawnPath& path : sheet.paths) {
     if (path.operation == Operation::Outline) continue;  // the material's edge: drawn, never burnt
-    const Stage stage = path.operation == Operation::Etch    ? Stage::Etch
-                        : path.operation == Operation::Score ? Stage::Score
-                        : isInner(path)                      ? Stage::InnerCut
-                                                             : Stage::OuterCut;
+    const Stage stage = path.operation == Operation::Etch    ? Stage{0, 0}
+                        : path.operation == Operation::Score ? Stage{1, 0}
+                                                             : Stage{2, -depthOf(path)};
     Candidate c{path.points, path.closed};
     if (c.closed) c.points.push_back(c.points.front());
     stages[stage].push_back(std::move(c));
   }
   Point2 at(0, 0);
   for (auto& [stage, candidates] : stages) {
-    const Operation operation = stage == Stage::Etch    ? Operation::Etch
-                                : stage == Stage::Score ? Operation::Score
-                                                        : Operation::Cut;
+    const Operation operation = stage.rank == 0 ? Operation::Etch : stage.rank == 1 ? Operation::Score : Operation::Cut;
     const profiles::ColourSetting& setting = machine.settingFor(operation);
     double power = setting.power, speed = setting.speed;
     int passes = setting.passes;
@@ -186,7 +190,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
     const auto ordered = orderForTravel(candidates, at);
     for (int pass = 1; pass <= passes; ++pass) {
       for (const auto& points : ordered) {
-        toolpath.strokes.push_back({operation, stage == Stage::InnerCut, std::clamp(power / 100, 0.0, 1.0),
+        toolpath.strokes.push_back({operation, stage.rank == 2 && stage.depth < 0, std::clamp(power / 100, 0.0, 1.0),
                                     speed / 100 * limits.maxSpeed, pass, points});
       }
     }

@@ -4,9 +4,10 @@
 // the planner's sheet and the machine and material profiles:
 // - power, speed and passes per operation from the machine's colour table
 //   (fig. 65), overridden by the material's settings for that machine;
-// - etch, then score, then inner cuts, then outer cuts, so that nothing is
-//   cut free before the work on it is done; the outline (the material's
-//   edge, power 0) is not burnt;
+// - etch, then score, then the cuts from the innermost out (a part's holes
+//   before its outline; a part nested in another's hole before that hole),
+//   so that nothing is cut free before the work on it is done; the outline
+//   (the material's edge, power 0) is not burnt;
 // - within each stage, the strokes in the order that shortens the travel
 //   (nearest neighbour, then 2-opt), each entered at its nearer end (an open
 //   stroke may run backwards, a closed one start at any corner);
@@ -32,7 +33,7 @@ struct MotionLimits {
 
 struct ToolpathStroke {
   Operation operation = Operation::Cut;
-  bool inner = false;          // a cut inside another cut (a hole): before the outer cuts
+  bool inner = false;          // a cut inside another closed cut (a hole, a nested part): before it
   double power = 0;            // 0..1 of the machine's full power
   double speed = 0;            // in/s
   int pass = 1;                // 1-based

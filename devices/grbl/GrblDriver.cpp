@@ -28,10 +28,14 @@ int codeAfter(const std::string& line, size_t prefix) {
 }  // namespace
 
 std::optional<DeviceStatus> parseStatusReport(const std::string& line) {
-  static const std::regex report(R"(^<([A-Za-z]+(?::\d)?)\|[MW]Pos:(-?[0-9.]+),(-?[0-9.]+)(?:,(-?[0-9.]+))?.*>$)");
+  static const std::regex report(R"(^<([A-Za-z]+(?::\d+)?)\|[MW]Pos:(-?[0-9.]+),(-?[0-9.]+)(?:,(-?[0-9.]+))?.*>$)");
   std::smatch m;
   if (!std::regex_match(line, m, report)) return std::nullopt;
-  return DeviceStatus{m[1], std::stod(m[2]) / kMillimetresPerInch, std::stod(m[3]) / kMillimetresPerInch};
+  try {
+    return DeviceStatus{m[1], std::stod(m[2]) / kMillimetresPerInch, std::stod(m[3]) / kMillimetresPerInch};
+  } catch (const std::exception&) {  // "." and the like
+    return std::nullopt;
+  }
 }
 
 GrblDriver::GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts)
@@ -87,12 +91,23 @@ std::string GrblDriver::connect() {
     std::smatch m;
     if (std::regex_search(line, m, options)) receiveBuffer_ = std::stoul(m[2]);
   }
-  if (settings_.count(32) && settings_[32] != 1) {
+  if (!settings_.count(32)) {
+    throw DeviceFault(FaultKind::Refused,
+                      fmt::format("{}: the controller has no laser mode ($32 missing from $$): GRBL 1.1 or later is "
+                                  "needed, as older firmware keeps the laser on through rapid moves",
+                                  link_->name()));
+  }
+  if (settings_[32] != 1) {
     throw DeviceFault(FaultKind::Refused,
                       fmt::format("{}: laser mode is off ($32={}): with it off GRBL stops at every S change and "
                                   "keeps the laser on through rapid moves; send $32=1 to the controller (in a serial "
                                   "terminal) and run again",
                                   link_->name(), settings_[32]));
+  }
+  if (receiveBuffer_ < 81) {
+    throw DeviceFault(FaultKind::Protocol, fmt::format("{}: [OPT:] reports a receive buffer of {} bytes; a line of "
+                                                       "80 would never fit",
+                                                       link_->name(), receiveBuffer_));
   }
   return fmt::format("{} (receive buffer {} bytes, laser mode on)", banner, receiveBuffer_);
 }
@@ -122,28 +137,44 @@ void GrblDriver::send(const std::string& line) {
     const std::string reply = expectLine(timeouts_.answer, line.c_str());
     if (reply == "ok") return;
     if (reply.starts_with("error:")) {
-      fail(DeviceFault(FaultKind::Error,
-                       fmt::format("{}: `{}`: {}", link_->name(), line, errorMessage(codeAfter(reply, 6)))));
+      throw DeviceFault(FaultKind::Error,
+                        fmt::format("{}: `{}`: {}", link_->name(), line, errorMessage(codeAfter(reply, 6))));
     }
     if (reply.starts_with("ALARM:")) {
-      fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6)))));
+      throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6))));
     }
+  }
+}
+
+void GrblDriver::stopAndRethrow() {
+  try {
+    throw;
+  } catch (DeviceFault& fault) {
+    fault.laserOffConfirmed = stopSafely();
+    throw;
+  } catch (...) {
+    stopSafely();
+    throw;
   }
 }
 
 void GrblDriver::home() {
   if (!link_) connect();
-  link_->write("$H\n", timeouts_.answer);
-  for (;;) {
-    const std::string reply = expectLine(timeouts_.homing, "homing ($H)");
-    if (reply == "ok") return;
-    if (reply.starts_with("error:")) {
-      throw DeviceFault(codeAfter(reply, 6) == 5 ? FaultKind::Refused : FaultKind::Error,
-                        fmt::format("{}: $H: {}", link_->name(), errorMessage(codeAfter(reply, 6))));
+  try {
+    link_->write("$H\n", timeouts_.answer);
+    for (;;) {
+      const std::string reply = expectLine(timeouts_.homing, "homing ($H)");
+      if (reply == "ok") return;
+      if (reply.starts_with("error:")) {
+        throw DeviceFault(codeAfter(reply, 6) == 5 ? FaultKind::Refused : FaultKind::Error,
+                          fmt::format("{}: $H: {}", link_->name(), errorMessage(codeAfter(reply, 6))));
+      }
+      if (reply.starts_with("ALARM:")) {
+        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6))));
+      }
     }
-    if (reply.starts_with("ALARM:")) {
-      fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6)))));
-    }
+  } catch (...) {
+    stopAndRethrow();
   }
 }
 
@@ -156,9 +187,12 @@ DeviceStatus GrblDriver::status() {
   }
 }
 
-void GrblDriver::waitIdle(Millis silence) {
+void GrblDriver::waitIdle(Millis silence, const CancelFlag* cancel) {
   // As long as status reports come, the machine is working (or held).
   for (;;) {
+    if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+    if (holdRequested_.exchange(false)) link_->write(std::string(1, kHold), timeouts_.answer);
+    if (resumeRequested_.exchange(false)) link_->write(std::string(1, kResume), timeouts_.answer);
     link_->write(std::string(1, kStatus), timeouts_.answer);
     const auto until = std::chrono::steady_clock::now() + silence;
     std::optional<DeviceStatus> report;
@@ -166,19 +200,21 @@ void GrblDriver::waitIdle(Millis silence) {
       const auto line = link_->readLine(timeouts_.poll);
       if (!line) {
         if (std::chrono::steady_clock::now() > until) {
-          fail(DeviceFault(FaultKind::Timeout,
-                           fmt::format("{}: no status report within {} ms", link_->name(), silence.count())));
+          throw DeviceFault(FaultKind::Timeout,
+                            fmt::format("{}: no status report within {} ms", link_->name(), silence.count()));
         }
         link_->write(std::string(1, kStatus), timeouts_.answer);
         continue;
       }
       if (line->starts_with("ALARM:")) {
-        fail(DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6)))));
+        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6))));
       }
       report = parseStatusReport(*line);
     }
     if (report->state == "Idle") return;
-    if (report->state == "Alarm") fail(DeviceFault(FaultKind::Alarm, link_->name() + ": the controller is in alarm"));
+    if (report->state.starts_with("Alarm")) {
+      throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller is in alarm");
+    }
     std::this_thread::sleep_for(timeouts_.poll);
   }
 }
@@ -196,9 +232,9 @@ void GrblDriver::frame(const jobs::Toolpath& toolpath) {
          {std::pair{box[0], box[1]}, {box[2], box[1]}, {box[2], box[3]}, {box[0], box[3]}, {box[0], box[1]}}) {
       send(fmt::format("G0 X{} Y{}", mm(x), mm(y)));
     }
-    waitIdle(timeouts_.answer);
-  } catch (const DeviceFault& fault) {
-    fail(fault);
+    waitIdle(timeouts_.answer, nullptr);
+  } catch (...) {
+    stopAndRethrow();
   }
 }
 
@@ -228,6 +264,11 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
   std::deque<size_t> inFlight;
   size_t inFlightBytes = 0, next = 0, acknowledged = 0;
   auto lastHeard = std::chrono::steady_clock::now(), lastPoll = lastHeard;
+  // Idle with lines sent and unacknowledged: an `ok` was lost (or a line), and
+  // the job would wait for ever.
+  bool idle = false;
+  auto idleSince = lastHeard;
+  holdRequested_ = false, resumeRequested_ = false;  // none left over from an earlier job
   try {
     while (acknowledged < lines.size()) {
       if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
@@ -273,8 +314,20 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
         if (!report)
           throw DeviceFault(FaultKind::Protocol,
                             fmt::format("{}: a malformed status report: {}", link_->name(), *line));
-        if (report->state == "Alarm")
+        if (report->state.starts_with("Alarm")) {
           throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller went into alarm");
+        }
+        if (report->state == "Idle" && !inFlight.empty()) {
+          if (!idle) idle = true, idleSince = std::chrono::steady_clock::now();
+          if (std::chrono::steady_clock::now() - idleSince > timeouts_.answer) {
+            throw DeviceFault(
+                FaultKind::Timeout,
+                fmt::format("{}: idle with {} line{} unanswered for {} ms: a reply was lost", link_->name(),
+                            inFlight.size(), inFlight.size() == 1 ? "" : "s", timeouts_.answer.count()));
+          }
+        } else {
+          idle = false;
+        }
       } else if (isBanner(*line)) {
         throw DeviceFault(FaultKind::Protocol, link_->name() + ": the controller reset itself mid-job");
       } else if (!line->empty() && !line->starts_with("[")) {
@@ -284,39 +337,45 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
       }
     }
     // Every line is in the planner: wait for the motion to end.
-    waitIdle(timeouts_.answer);
-  } catch (const DeviceFault& fault) {
-    fail(fault);
+    waitIdle(timeouts_.answer, &cancel);
+  } catch (...) {
+    stopAndRethrow();
   }
 }
 
-void GrblDriver::stopSafely() noexcept {
-  if (!link_) return;
+bool GrblDriver::stopSafely() noexcept {
+  if (!link_) return false;
   try {
     link_->write(std::string(1, kHold), Millis(500));
+    // Wait for the machine to stand still (Hold:0, or Idle): a reset while
+    // it moves would stop it as well, but lose its position (ALARM:3).
+    const auto still = std::chrono::steady_clock::now() + Millis(5000);
+    while (std::chrono::steady_clock::now() < still) {
+      link_->write(std::string(1, kStatus), Millis(500));
+      const auto line = link_->readLine(Millis(100));
+      const auto report = line ? parseStatusReport(*line) : std::nullopt;
+      if (report && (report->state == "Hold:0" || report->state == "Idle" || report->state.starts_with("Alarm"))) break;
+    }
     link_->write(std::string(1, kReset), Millis(500));
-    // The reset stops the spindle (the laser); once the banner is back, make sure.
+    // The reset stops the spindle (the laser); once the banner is back, say it again.
     const auto until = std::chrono::steady_clock::now() + Millis(3000);
     bool answered = false;
     while (!answered && std::chrono::steady_clock::now() < until) {
       const auto line = link_->readLine(Millis(100));
       answered = line && isBanner(*line);
     }
-    if (!answered) return;
+    if (!answered) return false;
     link_->write("M5 S0\n", Millis(500));
-    // ok, or error:9 in the alarm a reset during motion leaves: the laser is off either way.
+    // ok, or error:9 in an alarm: the laser is off either way.
     for (int i = 0; i < 10; ++i) {
       const auto line = link_->readLine(Millis(300));
-      if (!line || *line == "ok" || line->starts_with("error:")) break;
+      if (!line) return false;
+      if (*line == "ok" || line->starts_with("error:")) return true;
     }
+    return false;
   } catch (...) {
-    // The link is gone: nothing more can be said to the controller.
+    return false;  // the link is gone: nothing more can be said to the controller
   }
-}
-
-void GrblDriver::fail(const DeviceFault& fault) {
-  stopSafely();
-  throw fault;
 }
 
 void GrblDriver::disconnect() {

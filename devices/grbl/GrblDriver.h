@@ -49,10 +49,14 @@ class GrblDriver : public Device {
  private:
   void send(const std::string& line);  // a command and its `ok`
   std::string expectLine(Millis timeout, const char* waitingFor);
-  void waitIdle(Millis timeout);
-  // Feed hold, soft reset, M5 S0: the laser off whatever state the controller was in. Never throws.
-  void stopSafely() noexcept;
-  [[noreturn]] void fail(const DeviceFault& fault);
+  // Polls until the controller is Idle; throws on silence, an alarm or a cancel.
+  void waitIdle(Millis silence, const CancelFlag* cancel);
+  // Feed hold; once the machine has stopped (Hold:0), soft reset, which
+  // turns the laser off without the alarm a reset in motion raises; then
+  // M5 S0. Returns whether the controller answered it all. Never throws.
+  bool stopSafely() noexcept;
+  // In a catch block: stops safely and rethrows, a DeviceFault marked with whether the laser is known off.
+  [[noreturn]] void stopAndRethrow();
 
   std::function<std::unique_ptr<Link>()> open_;
   GrblTimeouts timeouts_;

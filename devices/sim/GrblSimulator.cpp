@@ -70,6 +70,15 @@ void GrblSimulator::reply(const std::string& text) {
 void GrblSimulator::loop() {
   auto last = std::chrono::steady_clock::now();
   while (!stopping_) {
+    if (unplugRequested_.exchange(false)) {
+      // The driver's side sees the port go: hang up the terminal.
+      const std::lock_guard lock(mutex_);
+      unplugged_ = true;
+      ::close(slave_);
+      slave_ = -1;
+      ::close(master_);
+      master_ = -1;
+    }
     pollfd fd{master_, POLLIN, 0};
     const int ready = unplugged_ ? 0 : ::poll(&fd, 1, 1);
     if (unplugged_) std::this_thread::sleep_for(std::chrono::milliseconds(5));
@@ -97,10 +106,11 @@ void GrblSimulator::receive(char byte) {
       reply(statusReport() + "\r\n");
       return;
     case '!':
-      if (!planner_.empty()) held_ = true;
+      // The machine decelerates before it stands (Hold:1, then Hold:0).
+      if (!planner_.empty() && !held_) held_ = true, holdSettle_ = 0.2;
       return;
     case '~':
-      held_ = false;
+      held_ = false, holdSettle_ = 0;
       return;
     case 0x18:
       reset();
@@ -122,6 +132,7 @@ void GrblSimulator::takeLines() {
     const auto newline = buffer_.find('\n');
     if (newline == std::string::npos) return;
     if (planner_.size() >= options_.plannerBlocks) return;  // the line waits in the buffer
+    if (held_) return;                                      // nothing is parsed during a hold
     std::string line = buffer_.substr(0, newline);
     buffer_.erase(0, newline + 1);
     if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -221,6 +232,7 @@ void GrblSimulator::executeLine(const std::string& raw) {
 
 void GrblSimulator::advance(double seconds) {
   record_.laserOn = false;
+  if (held_) holdSettle_ = std::max(0.0, holdSettle_ - seconds);
   while (seconds > 0 && !held_ && !alarm_ && !planner_.empty()) {
     const Block& block = planner_.front();
     if (blockDone_ == 0) startX_ = record_.x, startY_ = record_.y;
@@ -245,7 +257,7 @@ void GrblSimulator::advance(double seconds) {
 }
 
 void GrblSimulator::reset() {
-  const bool moving = !planner_.empty() && !held_;
+  const bool moving = !planner_.empty() && (!held_ || holdSettle_ > 0);
   buffer_.clear();
   planner_.clear();
   blockDone_ = 0;
@@ -260,21 +272,15 @@ void GrblSimulator::reset() {
 }
 
 std::string GrblSimulator::statusReport() const {
-  const char* state = alarm_ ? "Alarm" : held_ ? "Hold:0" : planner_.empty() ? "Idle" : "Run";
+  const char* state = alarm_             ? "Alarm"
+                      : held_            ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0")
+                      : planner_.empty() ? "Idle"
+                                         : "Run";
   return fmt::format("<{}|MPos:{:.3f},{:.3f},0.000|FS:{:.0f},{:.0f}>", state, record_.x, record_.y,
                      planner_.empty() ? 0.0 : planner_.front().feed, laserModal_ ? spindle_ : 0.0);
 }
 
-void GrblSimulator::unplug() {
-  const std::lock_guard lock(mutex_);
-  unplugged_ = true;
-  record_.laserOn = false;
-  // The driver's side sees the port go: hang up the terminal.
-  ::close(slave_);
-  slave_ = -1;
-  ::close(master_);
-  master_ = -1;
-}
+void GrblSimulator::unplug() { unplugRequested_ = true; }  // the loop thread closes the terminal
 
 void GrblSimulator::mute(bool silent) { muted_ = silent; }
 

@@ -86,6 +86,8 @@ class GrblSimulator {
   double blockDone_ = 0;            // mm of the first block covered
   double startX_ = 0, startY_ = 0;  // where the first block started
   bool held_ = false, alarm_ = false, laserModal_ = false;
+  double holdSettle_ = 0;  // simulated seconds until a hold has stopped the machine (Hold:1, then Hold:0)
+  std::atomic<bool> unplugRequested_{false};
   double feed_ = 0, spindle_ = 0;
   bool feedSet_ = false, rapid_ = true;
   size_t faultAfter_ = 0;

@@ -64,8 +64,13 @@ TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
 
 // Ctrl-C mid-job: the driver holds and resets the controller; exit 3, the laser off.
 TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
-  const CommandResult r =
-      run("timeout --preserve-status -s INT 2 " + kCli + " run " + quoted(cubeJob()) + " --device sim:grbl");
+  // SIGINT once the job streams (after "run: sheet" on stderr).
+  TempDir dir;
+  const auto err = dir.path() / "err";
+  const CommandResult r = run("(" + kCli + " run " + quoted(cubeJob()) + " --device sim:grbl 2> " + quoted(err) +
+                              " & pid=$!; for i in $(seq 200); do grep -q 'run: sheet' " + quoted(err) +
+                              " && break; sleep 0.05; done; sleep 0.3; kill -INT $pid; wait $pid; status=$?; cat " +
+                              quoted(err) + " >&2; exit $status)");
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("cancelled (cancelled; the laser is off)"), std::string::npos) << r.err;
 }

@@ -11,6 +11,7 @@
 #include <fstream>
 #include <regex>
 
+#include "TestSupport.h"
 #include "jobs/GCode.h"
 #include "jobs/SheetReader.h"
 #include "jobs/SvgWriter.h"
@@ -64,6 +65,27 @@ TEST(Toolpath, EtchThenScoreThenInnerThenOuterCutsWithTheirPasses) {
   EXPECT_NEAR(path.burnLength, 2 * std::hypot(0.5, 0.2) + 3 + 16 + 64, 1e-9);
 }
 
+// A part in another part's hole: its holes, then it, then the hole it sits in, then the outer part.
+TEST(Toolpath, NestedCutsGoFromTheInnermostOut) {
+  SheetDrawing s;
+  s.width = 15, s.height = 15;
+  for (auto op : profiles::kAllOperations) s.colours[op] = {0, 0, 0};
+  const auto square = [](double x0, double y0, double side) {
+    return std::vector<Point2>{{x0, y0}, {x0 + side, y0}, {x0 + side, y0 + side}, {x0, y0 + side}};
+  };
+  s.paths.push_back({Operation::Cut, square(1, 1, 10), true});  // the big part (depth 0)
+  s.paths.push_back({Operation::Cut, square(2, 2, 6), true});   // its hole (1)
+  s.paths.push_back({Operation::Cut, square(3, 3, 4), true});   // a part in the hole (2)
+  s.paths.push_back({Operation::Cut, square(4, 4, 1), true});   // that part's hole (3)
+  profiles::MaterialProfile material;
+  const Toolpath path = planToolpath(s, grblMachine(), material, MotionLimits{});
+  std::vector<double> sides;
+  for (const ToolpathStroke& stroke : path.strokes) {
+    if (stroke.pass == 1) sides.push_back((stroke.points[1] - stroke.points[0]).norm());
+  }
+  EXPECT_EQ(sides, (std::vector<double>{1, 4, 6, 10}));
+}
+
 TEST(Toolpath, GCodeParsesBackToTheSamePathsWithEachOperationsPowerAndFeed) {
   profiles::MaterialProfile material;
   MotionLimits limits;
@@ -111,7 +133,8 @@ TEST(Toolpath, GCodeParsesBackToTheSamePathsWithEachOperationsPowerAndFeed) {
 
 TEST(Toolpath, TheSvgSheetReadsBackAsItWasWritten) {
   const SheetDrawing written = sheet();
-  const auto file = std::filesystem::temp_directory_path() / "rotafab-toolpath-test.svg";
+  test::TempDir dir;
+  const auto file = dir.path() / "sheet.svg";
   {
     std::ofstream out(file);
     SheetDrawing titled = written;
@@ -119,7 +142,6 @@ TEST(Toolpath, TheSvgSheetReadsBackAsItWasWritten) {
     writeSvg(titled, out);
   }
   const SheetDrawing read = readSheetSvg(file);
-  std::filesystem::remove(file);
   EXPECT_EQ(read.width, written.width);
   EXPECT_EQ(read.margin, written.margin);
   ASSERT_EQ(read.paths.size(), written.paths.size());
