@@ -264,8 +264,8 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
   std::deque<size_t> inFlight;
   size_t inFlightBytes = 0, next = 0, acknowledged = 0;
   auto lastHeard = std::chrono::steady_clock::now(), lastPoll = lastHeard;
-  // Idle with lines sent and unacknowledged: an `ok` was lost (or a line), and
-  // the job would wait for ever.
+  // Idle with lines sent and unacknowledged, and no `ok` for a while: a reply
+  // was lost (or a line), and the job would wait for ever.
   bool idle = false;
   auto idleSince = lastHeard;
   holdRequested_ = false, resumeRequested_ = false;  // none left over from an earlier job
@@ -274,7 +274,8 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
       if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
       if (holdRequested_.exchange(false)) link_->write(std::string(1, kHold), timeouts_.answer);
       if (resumeRequested_.exchange(false)) link_->write(std::string(1, kResume), timeouts_.answer);
-      while (next < lines.size() && inFlightBytes + lines[next].size() + 1 <= capacity) {
+      while (next < lines.size() && inFlightBytes + lines[next].size() + 1 <= capacity &&
+             (characterCounting_ || inFlight.empty())) {
         link_->write(lines[next] + "\n", timeouts_.answer);
         inFlight.push_back(lines[next].size() + 1);
         inFlightBytes += lines[next].size() + 1;
@@ -296,6 +297,7 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
       lastHeard = std::chrono::steady_clock::now();
       if (*line == "ok") {
         if (inFlight.empty()) throw DeviceFault(FaultKind::Protocol, link_->name() + ": an `ok` for no line sent");
+        idle = false;  // a reply came: nothing is lost
         inFlightBytes -= inFlight.front();
         state.bytesAcknowledged += inFlight.front();
         inFlight.pop_front();

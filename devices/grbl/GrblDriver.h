@@ -34,6 +34,9 @@ class GrblDriver : public Device {
   void frame(const jobs::Toolpath& toolpath) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const CancelFlag& cancel) override;
+  // Send-and-wait instead of character counting: one line at a time, each
+  // after the last one's `ok` (for comparison: the benchmark).
+  void setCharacterCounting(bool on) { characterCounting_ = on; }
   void pause() override { holdRequested_ = true; }
   void resume() override { resumeRequested_ = true; }
   DeviceStatus status() override;
@@ -63,6 +66,7 @@ class GrblDriver : public Device {
   std::unique_ptr<Link> link_;
   std::map<int, double> settings_;
   size_t receiveBuffer_ = 128;
+  bool characterCounting_ = true;
   std::atomic<bool> holdRequested_{false}, resumeRequested_{false};
 };
 

@@ -59,6 +59,15 @@ GrblSimulatorRecord GrblSimulator::record() const {
 
 void GrblSimulator::reply(const std::string& text) {
   if (muted_ || unplugged_) return;
+  if (text == "ok\r\n" && loseOk_.exchange(false)) return;
+  if (options_.replyLatency.count() > 0) {
+    delayed_.emplace_back(std::chrono::steady_clock::now() + options_.replyLatency, text);
+    return;
+  }
+  writeNow(text);
+}
+
+void GrblSimulator::writeNow(const std::string& text) {
   size_t written = 0;
   while (written < text.size()) {
     const ssize_t n = ::write(master_, text.data() + written, text.size() - written);
@@ -69,6 +78,7 @@ void GrblSimulator::reply(const std::string& text) {
 
 void GrblSimulator::loop() {
   auto last = std::chrono::steady_clock::now();
+  double lineBudget = 0;  // bytes the paced serial line has carried and not yet delivered
   while (!stopping_) {
     if (unplugRequested_.exchange(false)) {
       // The driver's side sees the port go: hang up the terminal.
@@ -87,10 +97,24 @@ void GrblSimulator::loop() {
       const std::lock_guard lock(mutex_);
       if (ready > 0 && (fd.revents & POLLIN)) {
         char bytes[256];
-        const ssize_t n = ::read(master_, bytes, sizeof bytes);
+        size_t want = sizeof bytes;
+        if (options_.baud > 0) {
+          const auto now = std::chrono::steady_clock::now();
+          lineBudget = std::min(lineBudget + std::chrono::duration<double>(now - paced_).count() * options_.baud / 10,
+                                static_cast<double>(sizeof bytes));
+          paced_ = now;
+          want = static_cast<size_t>(lineBudget);
+        }
+        if (want == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));  // the line is busy
+        const ssize_t n = want > 0 ? ::read(master_, bytes, want) : 0;
+        if (n > 0 && options_.baud > 0) lineBudget -= static_cast<double>(n);
         for (ssize_t i = 0; i < n && !muted_; ++i) receive(bytes[i]);
       }
       if (!muted_ && !unplugged_) takeLines();
+      while (!delayed_.empty() && delayed_.front().first <= std::chrono::steady_clock::now() && !unplugged_) {
+        writeNow(delayed_.front().second);
+        delayed_.pop_front();
+      }
       const auto now = std::chrono::steady_clock::now();
       advance(std::chrono::duration<double>(now - last).count() * options_.timeScale);
       last = now;
@@ -283,6 +307,8 @@ std::string GrblSimulator::statusReport() const {
 void GrblSimulator::unplug() { unplugRequested_ = true; }  // the loop thread closes the terminal
 
 void GrblSimulator::mute(bool silent) { muted_ = silent; }
+
+void GrblSimulator::loseNextOk() { loseOk_ = true; }
 
 void GrblSimulator::sendGarbage() {
   const std::lock_guard lock(mutex_);

@@ -11,6 +11,8 @@
 // Faults can be injected: unplug, stop answering, garbage bytes, an alarm.
 
 #include <atomic>
+#include <chrono>
+#include <deque>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -27,6 +29,8 @@ struct GrblSimulatorOptions {
   double acceleration = 500;   // $120, $121 mm/s^2
   size_t receiveBuffer = 128;  // as [OPT:] reports it; holds one byte less
   size_t plannerBlocks = 15;
+  unsigned baud = 0;  // > 0: bytes from the driver arrive no faster than this serial line carries (10 bits a byte)
+  std::chrono::milliseconds replyLatency{0};  // each reply reaches the driver this much later (a USB adapter's)
 };
 
 // What a test checks after a run.
@@ -58,6 +62,7 @@ class GrblSimulator {
   void mute(bool silent);     // stops reading and answering, as a hung controller
   void sendGarbage();         // bytes no GRBL sends
   void raiseAlarm(int code);  // e.g. 1: a hard limit; motion stops, the laser goes off
+  void loseNextOk();          // the next `ok` never arrives (line noise)
   void afterLines(size_t lines, std::function<void(GrblSimulator&)> fault);  // inject once that many lines ran
 
  private:
@@ -78,7 +83,7 @@ class GrblSimulator {
   int master_ = -1, slave_ = -1;
   std::string path_;
   std::thread thread_;
-  std::atomic<bool> stopping_{false}, muted_{false}, unplugged_{false};
+  std::atomic<bool> stopping_{false}, muted_{false}, unplugged_{false}, loseOk_{false};
   mutable std::recursive_mutex mutex_;
   GrblSimulatorRecord record_;
   std::string buffer_;  // the receive buffer
@@ -91,6 +96,9 @@ class GrblSimulator {
   double feed_ = 0, spindle_ = 0;
   bool feedSet_ = false, rapid_ = true;
   size_t faultAfter_ = 0;
+  std::chrono::steady_clock::time_point paced_ = std::chrono::steady_clock::now();
+  std::deque<std::pair<std::chrono::steady_clock::time_point, std::string>> delayed_;  // replies on their way
+  void writeNow(const std::string& text);
   std::function<void(GrblSimulator&)> fault_;
 };
 

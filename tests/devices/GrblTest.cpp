@@ -169,6 +169,29 @@ TEST(Grbl, AControllerThatStopsAnsweringTimesOut) {
       FaultKind::Timeout, [](sim::GrblSimulator& s) { s.mute(true); }, "no answer");
 }
 
+// A lost `ok`: the controller goes idle with a line still unanswered; the
+// driver says so instead of waiting for ever, and the controller, which still
+// answers, takes M5.
+TEST(Grbl, ALostReplyIsFoundAndTheLaserTurnedOff) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 40;
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  driver->connect();
+  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  simulator.afterLines(20, [](sim::GrblSimulator& s) { s.loseNextOk(); });
+  CancelFlag cancel;
+  try {
+    driver->run(path, nullptr, cancel);
+    FAIL() << "the job ran to its end";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Timeout) << fault.what();
+    EXPECT_NE(std::string(fault.what()).find("a reply was lost"), std::string::npos) << fault.what();
+    EXPECT_TRUE(fault.laserOffConfirmed);
+  }
+  EXPECT_FALSE(simulator.record().spindleEnabled);
+}
+
 TEST(Grbl, UnpluggedMidJobIsADisconnect) {
   expectFault(
       FaultKind::Disconnected, [](sim::GrblSimulator& s) { s.unplug(); }, "");
