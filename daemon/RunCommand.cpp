@@ -16,6 +16,7 @@
 #include "devices/DeviceUri.h"
 #include "devices/Discovery.h"
 #include "devices/grbl/GrblDriver.h"
+#include "devices/m2nano/Lhymicro.h"
 #include "devices/spool/SpoolDevice.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/EpsWriter.h"
@@ -98,10 +99,10 @@ int runRun(const RunOptions& options) {
         throw UserError(error.what());
       }
     }();
-    if (uri.driver == "m2nano") {
+    if (uri.driver == "m2nano" && !options.dryRun) {
       throw UserError(
-          fmt::format("--device {}: the m2nano driver is not built yet (issue 5: the M2 Nano over USB "
-                      "is still to come)",
+          fmt::format("--device {}: driving the M2 Nano over USB is not built yet (issue 5); "
+                      "--dry-run --out JOB.egv writes its LHYMICRO-GL for K40 Whisperer or MeerK40t",
                       options.device));
     }
     if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
@@ -144,7 +145,8 @@ int runRun(const RunOptions& options) {
     std::map<jobs::Operation, jobs::Rgb> colours;
     for (profiles::Operation operation : profiles::kAllOperations)
       colours[operation] = machine.settingFor(operation).rgb;
-    if (!options.dryRun || uri.transport == "sim") {
+    if (uri.driver == "m2nano") limits = devices::m2nano::motionLimits();
+    if (!options.dryRun || (uri.transport == "sim" && uri.driver == "grbl")) {
       device = devices::openDevice(uri, colours);
       identity = device->connect();
       if (auto* grbl = dynamic_cast<devices::grbl::GrblDriver*>(device.get())) {
@@ -153,7 +155,9 @@ int runRun(const RunOptions& options) {
       }
       fmt::print(stderr, "run: {}: {}\n", options.device, identity);
     } else {
-      fmt::print(stderr, "run: dry run: S and F for GRBL's default settings ($30=1000, $110=500 mm/min)\n");
+      if (uri.driver == "grbl") {
+        fmt::print(stderr, "run: dry run: S and F for GRBL's default settings ($30=1000, $110=500 mm/min)\n");
+      }
     }
 
     std::vector<jobs::Toolpath> toolpaths;
@@ -163,6 +167,18 @@ int runRun(const RunOptions& options) {
       } catch (const std::invalid_argument& error) {
         throw UserError(error.what());
       }
+    }
+    if (options.dryRun && uri.driver == "m2nano") {
+      // The LHYMICRO-GL the board would get, as an .egv file (SPEC, "Devices").
+      std::vector<std::string> lines;
+      for (const jobs::Toolpath& toolpath : toolpaths) {
+        const auto sheet = devices::m2nano::jobLines(toolpath);
+        lines.insert(lines.end(), sheet.begin(), sheet.end());
+      }
+      jobs::writeFileAtomically(options.out, devices::m2nano::egvFile(lines));
+      fmt::print("{}: LHYMICRO-GL for {} sheet{} (an .egv file K40 Whisperer and MeerK40t open)\n", options.out,
+                 toolpaths.size(), toolpaths.size() == 1 ? "" : "s");
+      return kSuccess;
     }
     if (options.dryRun && uri.driver == "spool") {
       // The bytes the spool writes: each sheet's EPS, one after another.

@@ -63,6 +63,26 @@ TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
 }
 
 // Ctrl-C mid-job: the driver holds and resets the controller; exit 3, the laser off.
+// The M2 Nano's dry run: an .egv file with the header K40 Whisperer and
+// MeerK40t expect, and nothing but LHYMICRO-GL in its body.
+TEST(RunCli, M2NanoDryRunWritesAnEgvFile) {
+  TempDir dir;
+  const auto job = dir.path() / "k40";
+  const CommandResult made = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                 " --structure band --machine k40-m2nano --size 4in --time 0 --out " + quoted(job));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto egv = dir.path() / "cube.egv";
+  const CommandResult r =
+      run(kCli + " run " + quoted(job) + " --device m2nano://usb/1a86:5512 --dry-run --out " + quoted(egv));
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string text = readFile(egv);
+  EXPECT_EQ(text.rfind("Document type : LHYMICRO-GL file\nFile version: 1.0.01\nCopyright: Unknown\n", 0), 0u);
+  EXPECT_NE(text.find("\n\n%0%0%0%0%\nIPP\nI"), std::string::npos);
+  EXPECT_TRUE(text.ends_with("FNSE\nIPP\n"));
+  const std::string body = text.substr(text.find("%0%0%0%0%\n") + 10);
+  EXPECT_EQ(body.find_first_not_of("ABCDEFGILMNPRSTUVabcdefghijklmnopqrstuvwxyz|0123456789@\n"), std::string::npos);
+}
+
 TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
   // SIGINT once the job streams (after "run: sheet" on stderr).
   TempDir dir;
@@ -97,7 +117,7 @@ TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
   fails(quoted(cubeJob()) + " --device sim:grbl --dry-run", 1, "--dry-run needs --out");
   fails(quoted(dir.path()) + " --device sim:grbl", 1, "no manifest.json");
   fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port", 3, "cannot open it");
-  fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512", 1, "not built yet");
+  fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512 --machine grbl-diode-400", 1, "not built yet");
 }
 
 }  // namespace

@@ -1,0 +1,57 @@
+#pragma once
+// LHYMICRO-GL, the command language of the Lihuiyu M2 Nano board (K40
+// lasers), as MeerK40t, K40 Whisperer and LibLaserCut speak it (learnt from
+// them, written anew; issue 5): distances in mils (1/1000 in) as letters and
+// digits, direction letters, laser on (D) and off (U), speed codes, and the
+// 30-byte packets with their CRC-8 that go over USB. The board has no power
+// control (the machine's dial sets it): speed and passes are what it varies.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "jobs/Toolpath.h"
+
+namespace rotafab::devices::m2nano {
+
+// CRC-8/MAXIM (1-Wire: reflected polynomial 0x8C, init 0) of a packet's 30 payload bytes.
+uint8_t crc8(const uint8_t* bytes, size_t count);
+
+// One USB bulk transfer: 0xA6 0x00, the 30-byte payload (padded with 'F'), 0xA6, the CRC.
+using Packet = std::array<uint8_t, 34>;
+Packet packet(const std::string& payload);  // payload: at most 30 bytes
+// A command line cut into packets of 30 bytes, the last one padded with 'F'.
+std::vector<Packet> packets(const std::string& line);
+
+// A distance of `mils` steps: 'z' per 255, then 52..254 as three digits, 26..51 as '|' and a letter, 1..25 a..y.
+std::string distance(long mils);
+
+// The vector speed code for `mmPerSecond` on the M2 board, in the low-speed
+// ("suffix C") form MeerK40t uses by default: "CV2502451021000015C" for 20 mm/s.
+std::string speedCode(double mmPerSecond);
+
+// A line of (dx, dy) mils in compact (cut) mode, with the laser on or off,
+// from `state`; returns the commands and updates the state.
+struct CompactState {
+  int xDirection = 1;  // B (+x, right) or T (-x)
+  int yDirection = 1;  // R (+y, toward the front) or L (-y)
+  char engaged = 'x';  // 'x', 'y' or 'm' (diagonal): which letters are in effect
+  bool laser = false;
+};
+std::string compactLine(long dx, long dy, bool laser, CompactState& state);
+
+// The whole job for one sheet, one command line each (each line starts its own
+// packets): home, then compact mode at each stroke's speed (a speed change is
+// "@NSE" and a new code), travel with the laser off, each stroke burnt, FNSE,
+// home. Sheet coordinates (y up) become the board's (home at the back left, y
+// toward the front). `maxSpeed`: the machine's 100% speed, mm/s.
+std::vector<std::string> jobLines(const jobs::Toolpath& toolpath);
+
+// The .egv file K40 Whisperer and MeerK40t open (SPEC, "Devices").
+std::string egvFile(const std::vector<std::string>& lines);
+
+// The M2's motion limits for the toolpath: a profile's 100% speed is 100 mm/s.
+jobs::MotionLimits motionLimits();
+
+}  // namespace rotafab::devices::m2nano
