@@ -10,6 +10,8 @@
 #include <regex>
 #include <thread>
 
+#include "jobs/SheetDrawing.h"
+
 #include "devices/grbl/GrblDriver.h"
 #include "devices/sim/GrblSimulator.h"
 #include "jobs/GCode.h"
@@ -195,6 +197,58 @@ TEST(Grbl, ALostReplyIsFoundAndTheLaserTurnedOff) {
 TEST(Grbl, UnpluggedMidJobIsADisconnect) {
   expectFault(
       FaultKind::Disconnected, [](sim::GrblSimulator& s) { s.unplug(); }, "");
+}
+
+// Framing traces the toolpath's box with rapid moves and the laser off.
+TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 40;
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  driver->connect();
+  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  driver->frame(path);
+  const auto record = simulator.record();
+  const std::vector<std::string> framed(record.lines.end() - 8, record.lines.end());
+  const auto box = jobs::toolpathBounds(path);
+  const auto mm = [](double inches) { return jobs::formatDecimal(inches * 25.4, 3); };
+  EXPECT_EQ(framed,
+            (std::vector<std::string>{"M5S0", "G21", "G90", "G0X" + mm(box[0]) + "Y" + mm(box[1]),
+                                      "G0X" + mm(box[2]) + "Y" + mm(box[1]), "G0X" + mm(box[2]) + "Y" + mm(box[3]),
+                                      "G0X" + mm(box[0]) + "Y" + mm(box[3]), "G0X" + mm(box[0]) + "Y" + mm(box[1])}));
+  EXPECT_EQ(record.litSeconds, 0);
+  EXPECT_EQ(record.state, "Idle");
+}
+
+// A hold from another thread stops the machine (and its laser) mid-job; a
+// resume lets the job run to its end.
+TEST(Grbl, PauseHoldsAndResumeFinishes) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 40;
+  sim::GrblSimulator simulator(options);
+  auto driver = driverFor(simulator);
+  driver->connect();
+  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  CancelFlag cancel;
+  std::thread job([&] { driver->run(path, nullptr, cancel); });
+  while (simulator.record().linesExecuted < 10) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  driver->pause();
+  bool held = false;
+  for (int i = 0; i < 200 && !held; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    held = simulator.record().state == "Hold:0";
+  }
+  EXPECT_TRUE(held);
+  const size_t linesWhileHeld = simulator.record().linesExecuted;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_FALSE(simulator.record().laserOn);
+  EXPECT_EQ(simulator.record().linesExecuted, linesWhileHeld) << "nothing is parsed during a hold";
+  driver->resume();
+  job.join();
+  const auto record = simulator.record();
+  EXPECT_EQ(record.state, "Idle");
+  EXPECT_FALSE(record.spindleEnabled);
+  EXPECT_GT(record.linesExecuted, linesWhileHeld);
 }
 
 TEST(Grbl, StatusReportsParse) {
