@@ -57,6 +57,24 @@ std::unique_ptr<grbl::GrblDriver> driverFor(const sim::GrblSimulator& simulator)
   return std::make_unique<grbl::GrblDriver>([path] { return openSerialLink(path, 115200); }, quick());
 }
 
+// A simulated GRBL moving `timeScale` times faster than real, a driver
+// connected to it, and the test sheet's toolpath for its settings.
+struct Rig {
+  explicit Rig(double timeScale)
+      : simulator([&] {
+          sim::GrblSimulatorOptions options;
+          options.timeScale = timeScale;
+          return options;
+        }()),
+        driver(driverFor(simulator)) {
+    driver->connect();
+    path = toolpath(driver->motionLimits());
+  }
+  sim::GrblSimulator simulator;
+  std::unique_ptr<grbl::GrblDriver> driver;
+  jobs::Toolpath path;
+};
+
 TEST(Grbl, ConnectReadsTheSettingsAndTheBuffer) {
   sim::GrblSimulator simulator;
   auto driver = driverFor(simulator);
@@ -84,12 +102,8 @@ TEST(Grbl, RefusesToCutWithLaserModeOff) {
 // The whole job: every line taken in order, the buffer kept full and never
 // overflowed, the laser lit only while cutting and off at the end.
 TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
-  sim::GrblSimulatorOptions options;
-  options.timeScale = 40;
-  sim::GrblSimulator simulator(options);
-  auto driver = driverFor(simulator);
-  driver->connect();
-  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
   const auto lines = jobs::gcodeLines(path, driver->gcodeOptions());
   std::vector<Progress> seen;
   CancelFlag cancel;
@@ -118,12 +132,8 @@ TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
 // Each fault: the driver throws its kind, and the controller is left with the laser off.
 void expectFault(FaultKind kind, const std::function<void(sim::GrblSimulator&)>& inject, const std::string& says,
                  bool cancelIt = false) {
-  sim::GrblSimulatorOptions options;
-  options.timeScale = 2;  // slow: the fault comes mid-job
-  sim::GrblSimulator simulator(options);
-  auto driver = driverFor(simulator);
-  driver->connect();
-  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  Rig rig(2);
+  auto& [simulator, driver, path] = rig;
   CancelFlag cancel;
   simulator.afterLines(12, [&](sim::GrblSimulator& s) {
     if (cancelIt) cancel.cancel();
@@ -175,12 +185,8 @@ TEST(Grbl, AControllerThatStopsAnsweringTimesOut) {
 // driver says so instead of waiting for ever, and the controller, which still
 // answers, takes M5.
 TEST(Grbl, ALostReplyIsFoundAndTheLaserTurnedOff) {
-  sim::GrblSimulatorOptions options;
-  options.timeScale = 40;
-  sim::GrblSimulator simulator(options);
-  auto driver = driverFor(simulator);
-  driver->connect();
-  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
   simulator.afterLines(20, [](sim::GrblSimulator& s) { s.loseNextOk(); });
   CancelFlag cancel;
   try {
@@ -201,12 +207,8 @@ TEST(Grbl, UnpluggedMidJobIsADisconnect) {
 
 // Framing traces the toolpath's box with rapid moves and the laser off.
 TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
-  sim::GrblSimulatorOptions options;
-  options.timeScale = 40;
-  sim::GrblSimulator simulator(options);
-  auto driver = driverFor(simulator);
-  driver->connect();
-  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
   driver->frame(path);
   const auto record = simulator.record();
   const std::vector<std::string> framed(record.lines.end() - 8, record.lines.end());
@@ -223,12 +225,8 @@ TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
 // A hold from another thread stops the machine (and its laser) mid-job; a
 // resume lets the job run to its end.
 TEST(Grbl, PauseHoldsAndResumeFinishes) {
-  sim::GrblSimulatorOptions options;
-  options.timeScale = 40;
-  sim::GrblSimulator simulator(options);
-  auto driver = driverFor(simulator);
-  driver->connect();
-  const jobs::Toolpath path = toolpath(driver->motionLimits());
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
   CancelFlag cancel;
   std::thread job([&] { driver->run(path, nullptr, cancel); });
   while (simulator.record().linesExecuted < 10) std::this_thread::sleep_for(std::chrono::milliseconds(5));
