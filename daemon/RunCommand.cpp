@@ -1,6 +1,7 @@
 #include "daemon/RunCommand.h"
 
 #include <fmt/format.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -85,6 +86,22 @@ std::vector<std::pair<int, std::filesystem::path>> sheetsOf(const RunOptions& op
   return sheets;
 }
 
+// Waits for a line on standard input while watching for Ctrl-C (a read
+// restarted after the signal would not see it). False on a cancel or the end of input.
+bool waitForEnter(const devices::CancelFlag& cancel) {
+  for (;;) {
+    if (cancel.cancelled()) return false;
+    pollfd input{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&input, 1, 200) > 0) {
+      char byte = 0;
+      while (::read(STDIN_FILENO, &byte, 1) == 1) {
+        if (byte == '\n') return true;
+      }
+      return false;
+    }
+  }
+}
+
 std::string minutes(double seconds) {
   const int s = static_cast<int>(std::lround(seconds));
   return s >= 60 ? fmt::format("{}m {:02}s", s / 60, s % 60) : fmt::format("{}s", s);
@@ -117,6 +134,10 @@ int runRun(const RunOptions& options) {
       if (it == catalogue.machines.end())
         throw UserError(fmt::format("no machine profile for the {} driver; give --machine", uri.driver));
       machine = *it;
+    }
+    if (machine.driver != uri.driver) {
+      throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver", machine.name,
+                                  machine.driver, options.device, uri.driver));
     }
     const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
     std::vector<jobs::SheetDrawing> drawings;
@@ -167,6 +188,11 @@ int runRun(const RunOptions& options) {
       } catch (const std::invalid_argument& error) {
         throw UserError(error.what());
       }
+    }
+    if (options.dryRun && toolpaths.size() > 1) {
+      // One file of several sheets would be cut back to back, onto one sheet.
+      throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
+                                  toolpaths.size()));
     }
     if (options.dryRun && uri.driver == "m2nano") {
       // The LHYMICRO-GL the board would get, as an .egv file (SPEC, "Devices").
@@ -240,8 +266,7 @@ int runRun(const RunOptions& options) {
         if (s > 0) {
           if (::isatty(STDIN_FILENO)) {
             fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", toolpath.sheet);
-            std::string ignored;
-            if (!std::getline(std::cin, ignored)) cancel.cancel();  // end of input: stop, do not cut blind
+            if (!waitForEnter(cancel)) cancel.cancel();  // Ctrl-C or end of input: stop, do not cut blind
           }
         }
         if (cancel.cancelled())

@@ -189,6 +189,7 @@ DeviceStatus GrblDriver::status() {
 
 void GrblDriver::waitIdle(Millis silence, const CancelFlag* cancel) {
   // As long as status reports come, the machine is working (or held).
+  bool idleBefore = false;
   for (;;) {
     if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
     if (holdRequested_.exchange(false)) link_->write(std::string(1, kHold), timeouts_.answer);
@@ -211,7 +212,9 @@ void GrblDriver::waitIdle(Millis silence, const CancelFlag* cancel) {
       }
       report = parseStatusReport(*line);
     }
-    if (report->state == "Idle") return;
+    // Two Idle reports in a row: one may have been on its way from before the last lines ran.
+    if (report->state == "Idle" && idleBefore) return;
+    idleBefore = report->state == "Idle";
     if (report->state.starts_with("Alarm")) {
       throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller is in alarm");
     }
@@ -351,16 +354,17 @@ bool GrblDriver::stopSafely() noexcept {
     link_->write(std::string(1, kHold), Millis(500));
     // Wait for the machine to stand still (Hold:0, or Idle): a reset while
     // it moves would stop it as well, but lose its position (ALARM:3).
-    const auto still = std::chrono::steady_clock::now() + Millis(5000);
+    const auto still = std::chrono::steady_clock::now() + timeouts_.stopHold;
     while (std::chrono::steady_clock::now() < still) {
       link_->write(std::string(1, kStatus), Millis(500));
       const auto line = link_->readLine(Millis(100));
       const auto report = line ? parseStatusReport(*line) : std::nullopt;
-      if (report && (report->state == "Hold:0" || report->state == "Idle" || report->state.starts_with("Alarm"))) break;
+      // (Idle is no proof: a report on its way from before the hold can say it while the machine moves.)
+      if (report && (report->state == "Hold:0" || report->state.starts_with("Alarm"))) break;
     }
     link_->write(std::string(1, kReset), Millis(500));
     // The reset stops the spindle (the laser); once the banner is back, say it again.
-    const auto until = std::chrono::steady_clock::now() + Millis(3000);
+    const auto until = std::chrono::steady_clock::now() + timeouts_.stopReset;
     bool answered = false;
     while (!answered && std::chrono::steady_clock::now() < until) {
       const auto line = link_->readLine(Millis(100));

@@ -19,10 +19,12 @@
 namespace rotafab::devices::grbl {
 
 struct GrblTimeouts {
-  Millis banner{5000};    // after opening (an Arduino resets and waits in its bootloader first)
-  Millis answer{5000};    // for `ok` to a command, or any line while a job streams
-  Millis homing{120000};  // for `$H`
-  Millis poll{200};       // between status polls while streaming
+  Millis banner{5000};     // after opening (an Arduino resets and waits in its bootloader first)
+  Millis answer{5000};     // for `ok` to a command, or any line while a job streams
+  Millis homing{120000};   // for `$H`
+  Millis poll{200};        // between status polls while streaming
+  Millis stopHold{5000};   // after a fault: for the machine to stand in its hold
+  Millis stopReset{3000};  // after a fault: for the banner after the reset
 };
 
 class GrblDriver : public Device {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <utility>
 
 namespace rotafab::devices::m2nano {
 
@@ -123,11 +124,16 @@ jobs::MotionLimits motionLimits() {
 std::vector<std::string> jobLines(const jobs::Toolpath& toolpath) {
   // Mils on the board: x right, y toward the front from the back-left home.
   const auto mils = [&](const jobs::Point2& p) {
+    if (p.x() < -1e-9 || p.y() < -1e-9 || p.x() > toolpath.width + 1e-9 || p.y() > toolpath.height + 1e-9) {
+      throw std::invalid_argument(fmt::format("sheet {}: a point ({:.4g}, {:.4g}) off the {:.4g} x {:.4g} in bed",
+                                              toolpath.sheet, p.x(), p.y(), toolpath.width, toolpath.height));
+    }
     return std::pair{std::lround(p.x() * 1000), std::lround((toolpath.height - p.y()) * 1000)};
   };
+  // One line (its own packets, padded with 'F') per compact-mode section:
+  // a line ends only after "@NSE" or "FNSE", where padding is harmless.
   std::vector<std::string> lines{"IPP"};
-  std::string line;
-  std::string speed;
+  std::string line, speed;
   CompactState state;
   long atX = 0, atY = 0;
   for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
@@ -136,7 +142,14 @@ std::vector<std::string> jobLines(const jobs::Toolpath& toolpath) {
       // Compact mode at this speed (first from default mode, "I"; then from
       // compact mode without finishing, "@NSE"), stating the directions: y
       // toward the front, then x right, the last the major axis.
-      line = (speed.empty() ? "I" : "@NSE") + code + "NRBS1E";
+      if (speed.empty()) {
+        line.push_back('I');
+      } else {
+        line += "@NSE";
+        lines.push_back(std::exchange(line, std::string()));
+      }
+      line += code;
+      line += "NRBS1E";
       speed = code;
       state = CompactState{};
     }
@@ -149,11 +162,13 @@ std::vector<std::string> jobLines(const jobs::Toolpath& toolpath) {
       atX = x, atY = y;
     }
     if (state.laser) line += 'U', state.laser = false;
-    lines.push_back(line);
-    line.clear();
   }
-  if (!speed.empty()) lines.push_back("FNSE");
-  lines.push_back("IPP");
+  // The board runs on after FNSE; homing must wait until it reports the job
+  // finished (status 236), which a file cannot: the driver homes, not the job.
+  if (!speed.empty()) {
+    line += "FNSE";
+    lines.push_back(std::move(line));
+  }
   return lines;
 }
 

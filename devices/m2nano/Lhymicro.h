@@ -41,11 +41,12 @@ struct CompactState {
 };
 std::string compactLine(long dx, long dy, bool laser, CompactState& state);
 
-// The whole job for one sheet, one command line each (each line starts its own
-// packets): home, then compact mode at each stroke's speed (a speed change is
-// "@NSE" and a new code), travel with the laser off, each stroke burnt, FNSE,
-// home. Sheet coordinates (y up) become the board's (home at the back left, y
-// toward the front). `maxSpeed`: the machine's 100% speed, mm/s.
+// The whole job for one sheet, one command line per compact-mode section
+// (each line starts its own packets): home, then compact mode at each
+// stroke's speed (a speed change is "@NSE" and a new code), travel with the
+// laser off, each stroke burnt, FNSE. Sheet coordinates (y up) become the
+// board's (home at the back left, y toward the front). Throws
+// std::invalid_argument for a point off the toolpath's bed.
 std::vector<std::string> jobLines(const jobs::Toolpath& toolpath);
 
 // The .egv file K40 Whisperer and MeerK40t open (SPEC, "Devices").

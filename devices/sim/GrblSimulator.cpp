@@ -52,7 +52,7 @@ GrblSimulator::~GrblSimulator() {
 GrblSimulatorRecord GrblSimulator::record() const {
   const std::lock_guard lock(mutex_);
   GrblSimulatorRecord copy = record_;
-  copy.state = alarm_ ? "Alarm" : held_ ? "Hold:0" : planner_.empty() ? "Idle" : "Run";
+  copy.state = alarm_ ? "Alarm" : held_ ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0") : planner_.empty() ? "Idle" : "Run";
   copy.spindleEnabled = laserModal_;
   return copy;
 }
@@ -93,19 +93,22 @@ void GrblSimulator::loop() {
     const int ready = unplugged_ ? 0 : ::poll(&fd, 1, 1);
     if (unplugged_) std::this_thread::sleep_for(std::chrono::milliseconds(5));
     std::function<void(GrblSimulator&)> fault;
+    bool lineBusy = false;
     {
       const std::lock_guard lock(mutex_);
       if (ready > 0 && (fd.revents & POLLIN)) {
         char bytes[256];
         size_t want = sizeof bytes;
         if (options_.baud > 0) {
+          // The line carries baud/10 bytes a second while bytes wait; idle
+          // time earns no credit, and at most 4 ms' worth is banked (46 bytes
+          // at 115200 baud: a burst never skips the line's time).
           const auto now = std::chrono::steady_clock::now();
           lineBudget = std::min(lineBudget + std::chrono::duration<double>(now - paced_).count() * options_.baud / 10,
-                                static_cast<double>(sizeof bytes));
+                                std::max(1.0, options_.baud / 10.0 * 0.004));
           paced_ = now;
           want = static_cast<size_t>(lineBudget);
         }
-        if (want == 0) std::this_thread::sleep_for(std::chrono::microseconds(200));  // the line is busy
         const ssize_t n = want > 0 ? ::read(master_, bytes, want) : 0;
         if (n > 0 && options_.baud > 0) lineBudget -= static_cast<double>(n);
         for (ssize_t i = 0; i < n && !muted_; ++i) receive(bytes[i]);
@@ -119,7 +122,10 @@ void GrblSimulator::loop() {
       advance(std::chrono::duration<double>(now - last).count() * options_.timeScale);
       last = now;
       if (fault_ && record_.linesExecuted >= faultAfter_) fault = std::exchange(fault_, nullptr);
+      if (ready <= 0 || !(fd.revents & POLLIN)) paced_ = now;  // nothing waiting: the line is idle
+      lineBusy = options_.baud > 0 && ready > 0 && (fd.revents & POLLIN) && lineBudget < 1;
     }
+    if (lineBusy) std::this_thread::sleep_for(std::chrono::microseconds(200));  // the line is busy
     if (fault) fault(*this);
   }
 }
@@ -131,7 +137,8 @@ void GrblSimulator::receive(char byte) {
       return;
     case '!':
       // The machine decelerates before it stands (Hold:1, then Hold:0).
-      if (!planner_.empty() && !held_) held_ = true, holdSettle_ = 0.2;
+      // (Idle, it holds at once: Hold:0.)
+      if (!held_) held_ = true, holdSettle_ = planner_.empty() ? 0 : 0.2;
       return;
     case '~':
       held_ = false, holdSettle_ = 0;

@@ -4,6 +4,7 @@
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <cerrno>
 #include <fstream>
 
 #include "jobs/AtomicFile.h"
@@ -57,9 +58,9 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     throw DeviceFault(FaultKind::Disconnected, fmt::format("spool:{}: {}", folder_.string(), error.what()));
   }
   if (!printer_.empty()) {
-    // lp -d PRINTER -t TITLE FILE, without a shell.
+    // lp -d PRINTER -t TITLE -- FILE, without a shell (a file named "-x" is no option).
     const std::string title = sheet.title, file = lastFile_.string();
-    std::vector<std::string> args{"lp", "-d", printer_, "-t", title, file};
+    std::vector<std::string> args{"lp", "-d", printer_, "-t", title, "--", file};
     std::vector<char*> argv;
     for (std::string& arg : args) argv.push_back(arg.data());
     argv.push_back(nullptr);
@@ -68,8 +69,11 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
       throw DeviceFault(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
     }
     int status = 0;
-    waitpid(pid, &status, 0);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    pid_t waited = 0;
+    do {
+      waited = waitpid(pid, &status, 0);
+    } while (waited < 0 && errno == EINTR);
+    if (waited != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       throw DeviceFault(FaultKind::Refused, fmt::format("spool: lp -d {} refused {} (exit status {})", printer_, file,
                                                         WIFEXITED(status) ? WEXITSTATUS(status) : -1));
     }

@@ -82,17 +82,26 @@ TEST(Lhymicro, AJobForOneSheet) {
   square.points = {{1, 14}, {2, 14}, {2, 13}, {1, 13}, {1, 14}};  // y up: the board's (1000,1000) to (2000,2000)
   path.strokes.push_back(square);
   const auto lines = jobLines(path);
-  ASSERT_EQ(lines.size(), 4u);
+  ASSERT_EQ(lines.size(), 2u);
   EXPECT_EQ(lines[0], "IPP");
-  EXPECT_EQ(lines[1], "ICV2502451021000015CNRBS1EMzzz235BDzzz235Rzzz235Tzzz235Lzzz235U");
-  EXPECT_EQ(lines[2], "FNSE");
-  EXPECT_EQ(lines[3], "IPP");
+  EXPECT_EQ(lines[1], "ICV2502451021000015CNRBS1EMzzz235BDzzz235Rzzz235Tzzz235Lzzz235UFNSE");
+  // A second stroke at another speed: the first section ends "@NSE", the next states its speed and directions.
+  jobs::ToolpathStroke faster = square;
+  faster.speed = 10 / 25.4;
+  path.strokes.push_back(faster);
+  const auto two = jobLines(path);
+  ASSERT_EQ(two.size(), 3u);
+  EXPECT_TRUE(two[1].ends_with("Lzzz235U@NSE")) << two[1];
+  EXPECT_TRUE(two[2].starts_with("CV2452421011000060CNRBS1E")) << two[2];
+  EXPECT_TRUE(two[2].ends_with("UFNSE")) << two[2];
+  path.strokes[0].points[0] = {16, 14};
+  EXPECT_THROW(jobLines(path), std::invalid_argument);
   const std::string egv = egvFile(lines);
   EXPECT_EQ(egv.rfind("Document type : LHYMICRO-GL file\nFile version: 1.0.01\nCopyright: Unknown\n"
                       "Creator-Software: rotafab\n\n%0%0%0%0%\nIPP\n",
                       0),
             0u);
-  EXPECT_TRUE(egv.ends_with("FNSE\nIPP\n"));
+  EXPECT_TRUE(egv.ends_with("UFNSE\n"));
 }
 
 }  // namespace
