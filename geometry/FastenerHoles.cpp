@@ -75,8 +75,9 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
   static_cast<std::invalid_argument&>(*this) = std::invalid_argument(
       bandsWithoutRoom +
       (std::isfinite(scaleNeeded)
-           ? fmt::format("; a fastener of {:.3f} in or less, or the mesh {:.2f} times larger, would give every band room",
-                         std::floor(diameter / scaleNeeded * 1000) / 1000, scaleNeeded)
+           ? fmt::format(
+                 "; a fastener of {:.3f} in or less, or the mesh {:.2f} times larger, would give every band room",
+                 std::floor(diameter / scaleNeeded * 1000) / 1000, scaleNeeded)
            : "; use a smaller --fastener or a larger --size"));
 }
 

@@ -90,8 +90,8 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
       }
       group = *named, inGroup = true;
       sheet.colours[group] = {static_cast<uint8_t>(std::stoi(m[2], nullptr, 16)),
-                               static_cast<uint8_t>(std::stoi(m[3], nullptr, 16)),
-                               static_cast<uint8_t>(std::stoi(m[4], nullptr, 16))};
+                              static_cast<uint8_t>(std::stoi(m[3], nullptr, 16)),
+                              static_cast<uint8_t>(std::stoi(m[4], nullptr, 16))};
     } else if (line == "</g>") {
       inGroup = false;
     }
