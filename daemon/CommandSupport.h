@@ -1,12 +1,14 @@
 #pragma once
-// What the command-line verbs share: the one-line user error and length options.
+// What the command-line verbs share: the one-line user error, length options and error reporting.
 
 #include <fmt/format.h>
 
 #include <stdexcept>
 #include <string>
 
+#include "daemon/ExitCode.h"
 #include "profiles/Length.h"
+#include "profiles/Profiles.h"
 
 namespace rotafab::cli {
 
@@ -25,6 +27,24 @@ inline double lengthOption(const std::string& text, const char* option, bool pos
                                 positive ? "positive " : ""));
   }
   return *value;
+}
+
+// Runs a command's body and reports the errors every command reports alike,
+// as one line on stderr with exit status 1: a UserError or an invalid profile
+// as it is, anything else after `subject` (the file the command works on).
+// The body catches its own first (a device fault, an invalid mesh).
+template <typename Body>
+int reportingErrors(const std::string& subject, Body&& body) {
+  try {
+    return body();
+  } catch (const UserError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+  } catch (const profiles::ProfileError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "error: {}: {}\n", subject, error.what());
+  }
+  return kUserError;
 }
 
 }  // namespace rotafab::cli

@@ -79,209 +79,202 @@ int runMake(const MakeOptions& options) {
     return elapsed;
   };
   const auto progress = [](const std::string& line) { fmt::print(stderr, "make: {}\n", line); };
-  try {
-    if (options.structure == "weave") {
-      throw UserError("--structure weave: plain-woven structures (dissertation ch. IV) are not built yet; use band");
-    }
-    const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
-    const profiles::MachineProfile machine = profiles::findMachine(catalogue, options.machine);
-    const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
-
-    // Import.
-    geometry::ImportedMesh imported = geometry::importMesh(options.mesh);
-    for (const auto& warning : imported.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
-    geometry::PolygonMesh& mesh = imported.mesh;
-    geometry::MeshAnalysis analysis = geometry::analyzeMesh(mesh);
-    for (const auto& note : analysis.notes) fmt::print(stderr, "note: {}: {}\n", options.mesh, note);
+  return reportingErrors(options.mesh, [&]() -> int {
     try {
-      geometry::requireUsable(analysis);
+      if (options.structure == "weave") {
+        throw UserError("--structure weave: plain-woven structures (dissertation ch. IV) are not built yet; use band");
+      }
+      const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+      const profiles::MachineProfile machine = profiles::findMachine(catalogue, options.machine);
+      const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
+
+      // Import.
+      geometry::ImportedMesh imported = geometry::importMesh(options.mesh);
+      for (const auto& warning : imported.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
+      geometry::PolygonMesh& mesh = imported.mesh;
+      geometry::MeshAnalysis analysis = geometry::analyzeMesh(mesh);
+      for (const auto& note : analysis.notes) fmt::print(stderr, "note: {}: {}\n", options.mesh, note);
+      try {
+        geometry::requireUsable(analysis);
+      } catch (const geometry::InvalidMeshError& error) {
+        throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
+      }
+      if (analysis.topology.boundaryLoops > 0) {
+        const int loops = analysis.topology.boundaryLoops;
+        if (options.holes == "error") {
+          throw UserError(fmt::format("{}: the surface is open ({} boundary loop{}); --holes keep or fill builds it",
+                                      options.mesh, loops, loops == 1 ? "" : "s"));
+        }
+        if (options.holes == "fill") {
+          capBoundaryLoops(mesh);
+          analysis = geometry::analyzeMesh(mesh);
+          try {
+            geometry::requireUsable(analysis);
+          } catch (const geometry::InvalidMeshError& error) {
+            throw UserError(fmt::format("{}: with its {} hole{} filled: {}", options.mesh, loops, loops == 1 ? "" : "s",
+                                        error.what()));
+          }
+          progress(fmt::format("filled {} hole{} with one face each", loops, loops == 1 ? "" : "s"));
+        }
+      }
+      // The mesh as built (after --holes fill): one panel per face.
+      const geometry::MeshTopology topology = analysis.topology;
+      const double scale = geometry::constructionScale(
+          mesh, options.size.empty() ? std::nullopt : std::optional(lengthOption(options.size, "--size", true)),
+          options.scale);
+      if (!(scale > 0) || !std::isfinite(scale)) throw UserError("--scale: expected a positive number");
+      for (geometry::Point3& p : mesh.positions) p *= scale;
+      const double importSeconds = seconds();
+
+      // Geometry.
+      geometry::BandOptions band;
+      band.tension = options.tension;
+      band.samples = options.samples;
+      band.fastener =
+          options.fastener.empty() ? material.fastenerDiameter : lengthOption(options.fastener, "--fastener", true);
+      band.start = options.start;
+      band.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
+      band.scoreFolds = options.scoreFolds;
+      band.progress = progress;
+      geometry::BandStructure structure;
+      try {
+        structure = geometry::buildBandStructure(mesh, band);
+      } catch (const geometry::NoRoomForHoleError& error) {
+        // The same advice as the options that give it: the largest side --size needs.
+        Eigen::AlignedBox3d box;
+        for (const geometry::Point3& p : mesh.positions) box.extend(p);
+        std::string advice = "use a smaller --fastener or a larger --size";
+        if (std::isfinite(error.scaleNeeded)) {
+          // --scale excludes --size: advise the option the user gave.
+          const std::string larger =
+              options.scale ? fmt::format("--scale {:.4g}", *options.scale * error.scaleNeeded)
+                            : fmt::format("--size {:.0f}in", std::ceil(box.sizes().maxCoeff() * error.scaleNeeded));
+          const double smaller = std::floor(band.fastener / error.scaleNeeded * 1000) / 1000;
+          advice = smaller > 0
+                       ? fmt::format("--fastener {:.3f}in or smaller, or {} or larger, would give every band room",
+                                     smaller, larger)
+                       : fmt::format("{} or larger would give every band room", larger);
+        }
+        throw UserError(fmt::format("{}: {}; {}", options.mesh, error.bandsWithoutRoom, advice));
+      } catch (const std::invalid_argument& error) {
+        throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
+      }
+      for (const auto& warning : structure.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
+      const double geometrySeconds = seconds();
+
+      // Nesting.
+      jobs::PlanOptions plan;
+      plan.kerf = options.kerf.empty() ? material.kerf : lengthOption(options.kerf, "--kerf");
+      plan.seconds = options.seconds;
+      plan.order = options.order == "strict" ? jobs::OrderMode::Strict
+                   : options.order == "free" ? jobs::OrderMode::Free
+                                             : jobs::OrderMode::Window;
+      plan.window = options.window;
+      plan.rows = options.layout == "rows";
+      plan.title = fmt::format("{} (band)", std::filesystem::path(options.mesh).stem().string());
+      plan.progress = [&](const std::string& line) { progress("nesting: " + line); };
+      progress(fmt::format("{} {} panels on {} x {} in beds", plan.rows ? "laying out in rows" : "nesting",
+                           structure.panels.size(), machine.bed.width, machine.bed.height));
+      const std::vector<jobs::Part> parts = jobs::bandParts(structure);
+      jobs::SheetPlan sheets;
+      try {
+        sheets = jobs::planSheets(parts, machine, plan);
+      } catch (const std::invalid_argument& error) {
+        throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
+      }
+      const double nestingSeconds = seconds();
+
+      // Writing.
+      const std::filesystem::path out =
+          options.out.empty() ? std::filesystem::path(std::filesystem::path(options.mesh).stem().string() + "-band")
+                              : std::filesystem::path(options.out);
+      progress(fmt::format("writing {} sheets to {}", sheets.sheets.size(), out.string()));
+      // Everything is written into a hidden folder inside `out` first (the
+      // same file system, whatever links lead there), and moves in only when
+      // all is written: a failure leaves the folder as it was. Each new file
+      // then replaces its old namesake in one rename, and only after that are
+      // the old job's files that the new one does not have (a stale
+      // sheet-009.eps beside a new 8-sheet job) removed.
+      std::filesystem::path target = out;
+      if (target.filename().empty()) target = target.parent_path();  // "dir/"
+      std::filesystem::create_directories(target);
+      const std::filesystem::path staging = target / fmt::format(".rotafab-partial-{}", ::getpid());
+      std::filesystem::remove_all(staging);
+      std::filesystem::create_directories(staging);
+      struct Cleanup {
+        std::filesystem::path folder;
+        ~Cleanup() {
+          std::error_code ignored;
+          std::filesystem::remove_all(folder, ignored);
+        }
+      } cleanup{staging};
+      const auto files = jobs::writeSheets(sheets, staging);
+      geometry::PolygonMesh surface;
+      for (const geometry::Panel& panel : structure.panels) {
+        for (const auto& polygon : panel.surface) {
+          std::vector<int> face;
+          for (const geometry::Point3& p : polygon) {
+            face.push_back(surface.vertexCount());
+            surface.positions.push_back(p);
+          }
+          surface.faces.push_back(std::move(face));
+        }
+      }
+      jobs::writeFileAtomically(staging / "structure.obj", [&](std::ostream& stream) {
+        geometry::writeObj(
+            stream, surface,
+            fmt::format("rotafab band structure of {}: {} panels, inches", options.mesh, structure.panels.size()));
+      });
+      const nlohmann::ordered_json manifest = jobs::bandManifest(
+          structure, {topology.vertices, topology.edges, topology.faces, topology.genus}, machine.bed, sheets, files);
+      jobs::writeFileAtomically(staging / "manifest.json", manifest.dump(1) + "\n");
+      jobs::writeFileAtomically(staging / "manifest.txt", jobs::manifestText(manifest));
+      std::set<std::string> written;
+      for (const auto& entry : std::filesystem::directory_iterator(staging)) {
+        written.insert(entry.path().filename().string());
+      }
+      // manifest.json last: until it moves in, the folder's manifest is the old job's.
+      for (const std::string& name : written) {
+        if (name != "manifest.json") std::filesystem::rename(staging / name, target / name);
+      }
+      std::filesystem::rename(staging / "manifest.json", target / "manifest.json");
+      static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
+      for (const auto& entry : std::filesystem::directory_iterator(target)) {
+        const std::string name = entry.path().filename().string();
+        if (entry.is_regular_file() && std::regex_match(name, ours) && !written.count(name)) {
+          std::filesystem::remove(entry.path());
+        }
+      }
+      const double writingSeconds = seconds();
+
+      if (options.json) {
+        nlohmann::ordered_json summary = {{"panels", structure.panels.size()},
+                                          {"sheets", sheets.sheets.size()},
+                                          {"fasteners", structure.fasteners},
+                                          {"utilization", sheets.utilization},
+                                          {"seconds",
+                                           {{"import", importSeconds},
+                                            {"geometry", geometrySeconds},
+                                            {"nesting", nestingSeconds},
+                                            {"writing", writingSeconds}}}};
+        std::cout << summary.dump() << '\n';
+      } else {
+        fmt::print("{}: {} panels on {} sheet{} ({:.1f}% of the usable bed area), {} fasteners; written to {}/\n",
+                   options.mesh, structure.panels.size(), sheets.sheets.size(), sheets.sheets.size() == 1 ? "" : "s",
+                   100 * sheets.utilization, structure.fasteners, target.string());
+        fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, writing {:.2f} s\n", importSeconds,
+                   geometrySeconds, nestingSeconds, writingSeconds);
+        fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", target.string(), target.string());
+      }
+      return kSuccess;
     } catch (const geometry::InvalidMeshError& error) {
-      throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
+      fmt::print(stderr, "error: {}\n", error.what());
+      return kUserError;
+    } catch (const std::bad_alloc&) {
+      fmt::print(stderr, "error: {}: the structure does not fit in memory\n", options.mesh);
+      return kUserError;
     }
-    if (analysis.topology.boundaryLoops > 0) {
-      const int loops = analysis.topology.boundaryLoops;
-      if (options.holes == "error") {
-        throw UserError(fmt::format("{}: the surface is open ({} boundary loop{}); --holes keep or fill builds it",
-                                    options.mesh, loops, loops == 1 ? "" : "s"));
-      }
-      if (options.holes == "fill") {
-        capBoundaryLoops(mesh);
-        analysis = geometry::analyzeMesh(mesh);
-        try {
-          geometry::requireUsable(analysis);
-        } catch (const geometry::InvalidMeshError& error) {
-          throw UserError(fmt::format("{}: with its {} hole{} filled: {}", options.mesh, loops, loops == 1 ? "" : "s",
-                                      error.what()));
-        }
-        progress(fmt::format("filled {} hole{} with one face each", loops, loops == 1 ? "" : "s"));
-      }
-    }
-    // The mesh as built (after --holes fill): one panel per face.
-    const geometry::MeshTopology topology = analysis.topology;
-    const double scale = geometry::constructionScale(
-        mesh, options.size.empty() ? std::nullopt : std::optional(lengthOption(options.size, "--size", true)),
-        options.scale);
-    if (!(scale > 0) || !std::isfinite(scale)) throw UserError("--scale: expected a positive number");
-    for (geometry::Point3& p : mesh.positions) p *= scale;
-    const double importSeconds = seconds();
-
-    // Geometry.
-    geometry::BandOptions band;
-    band.tension = options.tension;
-    band.samples = options.samples;
-    band.fastener =
-        options.fastener.empty() ? material.fastenerDiameter : lengthOption(options.fastener, "--fastener", true);
-    band.start = options.start;
-    band.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
-    band.scoreFolds = options.scoreFolds;
-    band.progress = progress;
-    geometry::BandStructure structure;
-    try {
-      structure = geometry::buildBandStructure(mesh, band);
-    } catch (const geometry::NoRoomForHoleError& error) {
-      // The same advice as the options that give it: the largest side --size needs.
-      Eigen::AlignedBox3d box;
-      for (const geometry::Point3& p : mesh.positions) box.extend(p);
-      std::string advice = "use a smaller --fastener or a larger --size";
-      if (std::isfinite(error.scaleNeeded)) {
-        // --scale excludes --size: advise the option the user gave.
-        const std::string larger =
-            options.scale ? fmt::format("--scale {:.4g}", *options.scale * error.scaleNeeded)
-                          : fmt::format("--size {:.0f}in", std::ceil(box.sizes().maxCoeff() * error.scaleNeeded));
-        const double smaller = std::floor(band.fastener / error.scaleNeeded * 1000) / 1000;
-        advice = smaller > 0
-                     ? fmt::format("--fastener {:.3f}in or smaller, or {} or larger, would give every band room",
-                                   smaller, larger)
-                     : fmt::format("{} or larger would give every band room", larger);
-      }
-      throw UserError(fmt::format("{}: {}; {}", options.mesh, error.bandsWithoutRoom, advice));
-    } catch (const std::invalid_argument& error) {
-      throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
-    }
-    for (const auto& warning : structure.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
-    const double geometrySeconds = seconds();
-
-    // Nesting.
-    jobs::PlanOptions plan;
-    plan.kerf = options.kerf.empty() ? material.kerf : lengthOption(options.kerf, "--kerf");
-    plan.seconds = options.seconds;
-    plan.order = options.order == "strict" ? jobs::OrderMode::Strict
-                 : options.order == "free" ? jobs::OrderMode::Free
-                                           : jobs::OrderMode::Window;
-    plan.window = options.window;
-    plan.rows = options.layout == "rows";
-    plan.title = fmt::format("{} (band)", std::filesystem::path(options.mesh).stem().string());
-    plan.progress = [&](const std::string& line) { progress("nesting: " + line); };
-    progress(fmt::format("{} {} panels on {} x {} in beds", plan.rows ? "laying out in rows" : "nesting",
-                         structure.panels.size(), machine.bed.width, machine.bed.height));
-    const std::vector<jobs::Part> parts = jobs::bandParts(structure);
-    jobs::SheetPlan sheets;
-    try {
-      sheets = jobs::planSheets(parts, machine, plan);
-    } catch (const std::invalid_argument& error) {
-      throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
-    }
-    const double nestingSeconds = seconds();
-
-    // Writing.
-    const std::filesystem::path out =
-        options.out.empty() ? std::filesystem::path(std::filesystem::path(options.mesh).stem().string() + "-band")
-                            : std::filesystem::path(options.out);
-    progress(fmt::format("writing {} sheets to {}", sheets.sheets.size(), out.string()));
-    // Everything is written into a hidden folder inside `out` first (the
-    // same file system, whatever links lead there), and moves in only when
-    // all is written: a failure leaves the folder as it was. Each new file
-    // then replaces its old namesake in one rename, and only after that are
-    // the old job's files that the new one does not have (a stale
-    // sheet-009.eps beside a new 8-sheet job) removed.
-    std::filesystem::path target = out;
-    if (target.filename().empty()) target = target.parent_path();  // "dir/"
-    std::filesystem::create_directories(target);
-    const std::filesystem::path staging = target / fmt::format(".rotafab-partial-{}", ::getpid());
-    std::filesystem::remove_all(staging);
-    std::filesystem::create_directories(staging);
-    struct Cleanup {
-      std::filesystem::path folder;
-      ~Cleanup() {
-        std::error_code ignored;
-        std::filesystem::remove_all(folder, ignored);
-      }
-    } cleanup{staging};
-    const auto files = jobs::writeSheets(sheets, staging);
-    geometry::PolygonMesh surface;
-    for (const geometry::Panel& panel : structure.panels) {
-      for (const auto& polygon : panel.surface) {
-        std::vector<int> face;
-        for (const geometry::Point3& p : polygon) {
-          face.push_back(surface.vertexCount());
-          surface.positions.push_back(p);
-        }
-        surface.faces.push_back(std::move(face));
-      }
-    }
-    jobs::writeFileAtomically(staging / "structure.obj", [&](std::ostream& stream) {
-      geometry::writeObj(
-          stream, surface,
-          fmt::format("rotafab band structure of {}: {} panels, inches", options.mesh, structure.panels.size()));
-    });
-    const nlohmann::ordered_json manifest = jobs::bandManifest(
-        structure, {topology.vertices, topology.edges, topology.faces, topology.genus}, machine.bed, sheets, files);
-    jobs::writeFileAtomically(staging / "manifest.json", manifest.dump(1) + "\n");
-    jobs::writeFileAtomically(staging / "manifest.txt", jobs::manifestText(manifest));
-    std::set<std::string> written;
-    for (const auto& entry : std::filesystem::directory_iterator(staging)) {
-      written.insert(entry.path().filename().string());
-    }
-    // manifest.json last: until it moves in, the folder's manifest is the old job's.
-    for (const std::string& name : written) {
-      if (name != "manifest.json") std::filesystem::rename(staging / name, target / name);
-    }
-    std::filesystem::rename(staging / "manifest.json", target / "manifest.json");
-    static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
-    for (const auto& entry : std::filesystem::directory_iterator(target)) {
-      const std::string name = entry.path().filename().string();
-      if (entry.is_regular_file() && std::regex_match(name, ours) && !written.count(name)) {
-        std::filesystem::remove(entry.path());
-      }
-    }
-    const double writingSeconds = seconds();
-
-    if (options.json) {
-      nlohmann::ordered_json summary = {{"panels", structure.panels.size()},
-                                        {"sheets", sheets.sheets.size()},
-                                        {"fasteners", structure.fasteners},
-                                        {"utilization", sheets.utilization},
-                                        {"seconds",
-                                         {{"import", importSeconds},
-                                          {"geometry", geometrySeconds},
-                                          {"nesting", nestingSeconds},
-                                          {"writing", writingSeconds}}}};
-      std::cout << summary.dump() << '\n';
-    } else {
-      fmt::print("{}: {} panels on {} sheet{} ({:.1f}% of the usable bed area), {} fasteners; written to {}/\n",
-                 options.mesh, structure.panels.size(), sheets.sheets.size(), sheets.sheets.size() == 1 ? "" : "s",
-                 100 * sheets.utilization, structure.fasteners, target.string());
-      fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, writing {:.2f} s\n", importSeconds,
-                 geometrySeconds, nestingSeconds, writingSeconds);
-      fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", target.string(), target.string());
-    }
-    return kSuccess;
-  } catch (const UserError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const profiles::ProfileError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const geometry::InvalidMeshError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const std::bad_alloc&) {
-    fmt::print(stderr, "error: {}: the structure does not fit in memory\n", options.mesh);
-    return kUserError;
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "error: {}: {}\n", options.mesh, error.what());
-    return kUserError;
-  }
+  });
 }
 
 int runManifest(const std::string& folder, const std::string& format) {

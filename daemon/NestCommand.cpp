@@ -37,7 +37,7 @@ struct NestOptions {
 };
 
 int runNest(const NestOptions& options) {
-  try {
+  return reportingErrors(options.instance, [&]() -> int {
     const auto start = std::chrono::steady_clock::now();
     jobs::NestingInstance instance;
     try {
@@ -147,16 +147,7 @@ int runNest(const NestOptions& options) {
                  result.evaluations, seconds);
     }
     return kSuccess;
-  } catch (const UserError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const profiles::ProfileError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "error: {}: {}\n", options.instance, error.what());
-    return kUserError;
-  }
+  });
 }
 
 }  // namespace

@@ -108,223 +108,216 @@ std::string minutes(double seconds) {
 }
 
 int runRun(const RunOptions& options) {
-  try {
-    const devices::DeviceUri uri = [&] {
-      try {
-        return devices::parseDeviceUri(options.device);
-      } catch (const std::invalid_argument& error) {
-        throw UserError(error.what());
-      }
-    }();
-    if (uri.driver == "m2nano" && !options.dryRun) {
-      throw UserError(
-          fmt::format("--device {}: driving the M2 Nano over USB is not built yet (issue 5); "
-                      "--dry-run --out JOB.egv writes its LHYMICRO-GL for K40 Whisperer or MeerK40t",
-                      options.device));
-    }
-    if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
-    const auto sheets = sheetsOf(options);
-    const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
-    profiles::MachineProfile machine;
-    if (!options.machine.empty()) {
-      machine = profiles::findMachine(catalogue, options.machine);
-    } else {
-      const auto it = std::find_if(catalogue.machines.begin(), catalogue.machines.end(),
-                                   [&](const auto& m) { return m.driver == uri.driver; });
-      if (it == catalogue.machines.end())
-        throw UserError(fmt::format("no machine profile for the {} driver; give --machine", uri.driver));
-      machine = *it;
-    }
-    if (machine.driver != uri.driver) {
-      throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver", machine.name,
-                                  machine.driver, options.device, uri.driver));
-    }
-    const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
-    std::vector<jobs::SheetDrawing> drawings;
-    for (const auto& [index, file] : sheets) {
-      try {
-        drawings.push_back(jobs::readSheetSvg(file));
-      } catch (const std::invalid_argument& error) {
-        throw UserError(error.what());
-      }
-      const jobs::SheetDrawing& sheet = drawings.back();
-      if (sheet.width > machine.bed.width + 1e-6 || sheet.height > machine.bed.height + 1e-6) {
-        throw UserError(
-            fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
-                        "make it for this machine (`rotafab make ... --machine {}`)",
-                        file.string(), sheet.width, sheet.height, machine.name, machine.bed.width, machine.bed.height,
-                        machine.name));
-      }
-    }
-
-    // A dry run opens no real port: S and F follow GRBL's defaults ($30=1000,
-    // $110=500 mm/min) unless the device is the simulator, which it asks.
-    std::unique_ptr<devices::Device> device;
-    jobs::GCodeOptions gcode;
-    jobs::MotionLimits limits;
-    std::string identity;
-    std::map<jobs::Operation, jobs::Rgb> colours;
-    for (profiles::Operation operation : profiles::kAllOperations)
-      colours[operation] = machine.settingFor(operation).rgb;
-    if (uri.driver == "m2nano") limits = devices::m2nano::motionLimits();
-    if (!options.dryRun || (uri.transport == "sim" && uri.driver == "grbl")) {
-      device = devices::openDevice(uri, colours);
-      identity = device->connect();
-      if (auto* grbl = dynamic_cast<devices::grbl::GrblDriver*>(device.get())) {
-        gcode = grbl->gcodeOptions();
-        limits = grbl->motionLimits();
-      }
-      fmt::print(stderr, "run: {}: {}\n", options.device, identity);
-    } else {
-      if (uri.driver == "grbl") {
-        fmt::print(stderr, "run: dry run: S and F for GRBL's default settings ($30=1000, $110=500 mm/min)\n");
-      }
-    }
-
-    std::vector<jobs::Toolpath> toolpaths;
-    for (const jobs::SheetDrawing& sheet : drawings) {
-      try {
-        toolpaths.push_back(jobs::planToolpath(sheet, machine, material, limits));
-      } catch (const std::invalid_argument& error) {
-        throw UserError(error.what());
-      }
-    }
-    if (options.dryRun && toolpaths.size() > 1) {
-      // One file of several sheets would be cut back to back, onto one sheet.
-      throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
-                                  toolpaths.size()));
-    }
-    if (options.dryRun && uri.driver == "m2nano") {
-      // The LHYMICRO-GL the board would get, as an .egv file (SPEC, "Devices").
-      std::vector<std::string> lines;
-      for (const jobs::Toolpath& toolpath : toolpaths) {
-        const auto sheet = devices::m2nano::jobLines(toolpath);
-        lines.insert(lines.end(), sheet.begin(), sheet.end());
-      }
-      jobs::writeFileAtomically(options.out, devices::m2nano::egvFile(lines));
-      fmt::print("{}: LHYMICRO-GL for {} sheet{} (an .egv file K40 Whisperer and MeerK40t open)\n", options.out,
-                 toolpaths.size(), toolpaths.size() == 1 ? "" : "s");
-      return kSuccess;
-    }
-    if (options.dryRun && uri.driver == "spool") {
-      // The bytes the spool writes: each sheet's EPS, one after another.
-      jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
-        for (const jobs::Toolpath& toolpath : toolpaths)
-          jobs::writeEps(devices::spool::drawingOf(toolpath, colours), out);
-      });
-      fmt::print("{}: EPS for {} sheet{}, as the spool would write it\n", options.out, toolpaths.size(),
-                 toolpaths.size() == 1 ? "" : "s");
-      return kSuccess;
-    }
-    if (options.dryRun) {
-      jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
-        for (const jobs::Toolpath& toolpath : toolpaths) {
-          for (const std::string& line : jobs::gcodeLines(toolpath, gcode)) out << line << '\n';
-        }
-      });
-      fmt::print("{}: G-code for {} sheet{} ({} strokes), as the driver would send it\n", options.out, toolpaths.size(),
-                 toolpaths.size() == 1 ? "" : "s", [&] {
-                   size_t n = 0;
-                   for (const auto& t : toolpaths) n += t.strokes.size();
-                   return n;
-                 }());
-      return kSuccess;
-    }
-
-    if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
-      throw UserError(
-          fmt::format("{}: {} sheets, and no terminal to ask before each one that the next is loaded: "
-                      "run them one at a time with --sheet N",
-                      options.target, toolpaths.size()));
-    }
-    devices::CancelFlag cancel;
-    // Ctrl-C and SIGTERM cancel the job while it runs; the old handlers come back after.
-    struct InterruptGuard {
-      struct sigaction oldInt {
-      }, oldTerm{};
-      explicit InterruptGuard(devices::CancelFlag& flag) {
-        interruptFlag = &flag;
-        struct sigaction action {};
-        action.sa_handler = onInterrupt;
-        action.sa_flags = SA_RESTART;
-        sigaction(SIGINT, &action, &oldInt);
-        sigaction(SIGTERM, &action, &oldTerm);
-      }
-      ~InterruptGuard() {
-        sigaction(SIGINT, &oldInt, nullptr);
-        sigaction(SIGTERM, &oldTerm, nullptr);
-        interruptFlag = nullptr;
-      }
-    } guard(cancel);
-    const bool terminal = ::isatty(STDERR_FILENO) != 0;
-    double burnt = 0, seconds = 0;
-    size_t strokes = 0;
-    const auto started = std::chrono::steady_clock::now();
+  return reportingErrors(options.target, [&]() -> int {
     try {
-      for (size_t s = 0; s < toolpaths.size(); ++s) {
-        const jobs::Toolpath& toolpath = toolpaths[s];
-        if (s > 0) {
-          if (::isatty(STDIN_FILENO)) {
-            fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", toolpath.sheet);
-            if (!waitForEnter(cancel)) cancel.cancel();  // Ctrl-C or end of input: stop, do not cut blind
-          }
+      const devices::DeviceUri uri = [&] {
+        try {
+          return devices::parseDeviceUri(options.device);
+        } catch (const std::invalid_argument& error) {
+          throw UserError(error.what());
         }
-        if (cancel.cancelled())
-          throw devices::DeviceFault(devices::FaultKind::Cancelled, options.device + ": cancelled");
-        fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}\n", toolpath.sheet, s + 1,
-                   toolpaths.size(), toolpath.strokes.size(), toolpath.burnLength, minutes(toolpath.seconds));
-        if (options.frame) {
-          fmt::print(stderr, "run: framing (laser off)\n");
-          device->frame(toolpath);
-        }
-        auto lastShown = std::chrono::steady_clock::time_point{};
-        int lastPercent = -1;
-        device->run(
-            toolpath,
-            [&](const devices::Progress& p) {
-              const int percent = static_cast<int>(100 * p.bytesAcknowledged / std::max<size_t>(p.bytesTotal, 1));
-              const auto now = std::chrono::steady_clock::now();
-              if (terminal ? now - lastShown < std::chrono::milliseconds(200) && percent != 100
-                           : percent / 10 == lastPercent / 10) {
-                return;
-              }
-              lastShown = now, lastPercent = percent;
-              const int filled = percent / 5;
-              fmt::print(stderr, "{}run: sheet {} [{}{}] {:3}%  stroke {} of {}, {} left{}", terminal ? "\r" : "",
-                         p.sheet, std::string(filled, '#'), std::string(20 - filled, '.'), percent, p.stroke, p.strokes,
-                         minutes(p.secondsLeft), terminal ? "" : "\n");
-            },
-            cancel);
-        if (terminal) fmt::print(stderr, "\n");
-        burnt += toolpath.burnLength, seconds += toolpath.seconds, strokes += toolpath.strokes.size();
+      }();
+      if (uri.driver == "m2nano" && !options.dryRun) {
+        throw UserError(
+            fmt::format("--device {}: driving the M2 Nano over USB is not built yet (issue 5); "
+                        "--dry-run --out JOB.egv writes its LHYMICRO-GL for K40 Whisperer or MeerK40t",
+                        options.device));
       }
+      if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
+      const auto sheets = sheetsOf(options);
+      const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+      profiles::MachineProfile machine;
+      if (!options.machine.empty()) {
+        machine = profiles::findMachine(catalogue, options.machine);
+      } else {
+        const auto it = std::find_if(catalogue.machines.begin(), catalogue.machines.end(),
+                                     [&](const auto& m) { return m.driver == uri.driver; });
+        if (it == catalogue.machines.end())
+          throw UserError(fmt::format("no machine profile for the {} driver; give --machine", uri.driver));
+        machine = *it;
+      }
+      if (machine.driver != uri.driver) {
+        throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver", machine.name,
+                                    machine.driver, options.device, uri.driver));
+      }
+      const profiles::MaterialProfile material = profiles::findMaterial(catalogue, options.material);
+      std::vector<jobs::SheetDrawing> drawings;
+      for (const auto& [index, file] : sheets) {
+        try {
+          drawings.push_back(jobs::readSheetSvg(file));
+        } catch (const std::invalid_argument& error) {
+          throw UserError(error.what());
+        }
+        const jobs::SheetDrawing& sheet = drawings.back();
+        if (sheet.width > machine.bed.width + 1e-6 || sheet.height > machine.bed.height + 1e-6) {
+          throw UserError(
+              fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
+                          "make it for this machine (`rotafab make ... --machine {}`)",
+                          file.string(), sheet.width, sheet.height, machine.name, machine.bed.width, machine.bed.height,
+                          machine.name));
+        }
+      }
+
+      // A dry run opens no real port: S and F follow GRBL's defaults ($30=1000,
+      // $110=500 mm/min) unless the device is the simulator, which it asks.
+      std::unique_ptr<devices::Device> device;
+      jobs::GCodeOptions gcode;
+      jobs::MotionLimits limits;
+      std::string identity;
+      std::map<jobs::Operation, jobs::Rgb> colours;
+      for (profiles::Operation operation : profiles::kAllOperations)
+        colours[operation] = machine.settingFor(operation).rgb;
+      if (uri.driver == "m2nano") limits = devices::m2nano::motionLimits();
+      if (!options.dryRun || (uri.transport == "sim" && uri.driver == "grbl")) {
+        device = devices::openDevice(uri, colours);
+        identity = device->connect();
+        if (auto* grbl = dynamic_cast<devices::grbl::GrblDriver*>(device.get())) {
+          gcode = grbl->gcodeOptions();
+          limits = grbl->motionLimits();
+        }
+        fmt::print(stderr, "run: {}: {}\n", options.device, identity);
+      } else {
+        if (uri.driver == "grbl") {
+          fmt::print(stderr, "run: dry run: S and F for GRBL's default settings ($30=1000, $110=500 mm/min)\n");
+        }
+      }
+
+      std::vector<jobs::Toolpath> toolpaths;
+      for (const jobs::SheetDrawing& sheet : drawings) {
+        try {
+          toolpaths.push_back(jobs::planToolpath(sheet, machine, material, limits));
+        } catch (const std::invalid_argument& error) {
+          throw UserError(error.what());
+        }
+      }
+      if (options.dryRun && toolpaths.size() > 1) {
+        // One file of several sheets would be cut back to back, onto one sheet.
+        throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
+                                    toolpaths.size()));
+      }
+      if (options.dryRun && uri.driver == "m2nano") {
+        // The LHYMICRO-GL the board would get, as an .egv file (SPEC, "Devices").
+        std::vector<std::string> lines;
+        for (const jobs::Toolpath& toolpath : toolpaths) {
+          const auto sheet = devices::m2nano::jobLines(toolpath);
+          lines.insert(lines.end(), sheet.begin(), sheet.end());
+        }
+        jobs::writeFileAtomically(options.out, devices::m2nano::egvFile(lines));
+        fmt::print("{}: LHYMICRO-GL for {} sheet{} (an .egv file K40 Whisperer and MeerK40t open)\n", options.out,
+                   toolpaths.size(), toolpaths.size() == 1 ? "" : "s");
+        return kSuccess;
+      }
+      if (options.dryRun && uri.driver == "spool") {
+        // The bytes the spool writes: each sheet's EPS, one after another.
+        jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
+          for (const jobs::Toolpath& toolpath : toolpaths)
+            jobs::writeEps(devices::spool::drawingOf(toolpath, colours), out);
+        });
+        fmt::print("{}: EPS for {} sheet{}, as the spool would write it\n", options.out, toolpaths.size(),
+                   toolpaths.size() == 1 ? "" : "s");
+        return kSuccess;
+      }
+      if (options.dryRun) {
+        jobs::writeFileAtomically(options.out, [&](std::ostream& out) {
+          for (const jobs::Toolpath& toolpath : toolpaths) {
+            for (const std::string& line : jobs::gcodeLines(toolpath, gcode)) out << line << '\n';
+          }
+        });
+        fmt::print("{}: G-code for {} sheet{} ({} strokes), as the driver would send it\n", options.out,
+                   toolpaths.size(), toolpaths.size() == 1 ? "" : "s", [&] {
+                     size_t n = 0;
+                     for (const auto& t : toolpaths) n += t.strokes.size();
+                     return n;
+                   }());
+        return kSuccess;
+      }
+
+      if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
+        throw UserError(
+            fmt::format("{}: {} sheets, and no terminal to ask before each one that the next is loaded: "
+                        "run them one at a time with --sheet N",
+                        options.target, toolpaths.size()));
+      }
+      devices::CancelFlag cancel;
+      // Ctrl-C and SIGTERM cancel the job while it runs; the old handlers come back after.
+      struct InterruptGuard {
+        struct sigaction oldInt {
+        }, oldTerm{};
+        explicit InterruptGuard(devices::CancelFlag& flag) {
+          interruptFlag = &flag;
+          struct sigaction action {};
+          action.sa_handler = onInterrupt;
+          action.sa_flags = SA_RESTART;
+          sigaction(SIGINT, &action, &oldInt);
+          sigaction(SIGTERM, &action, &oldTerm);
+        }
+        ~InterruptGuard() {
+          sigaction(SIGINT, &oldInt, nullptr);
+          sigaction(SIGTERM, &oldTerm, nullptr);
+          interruptFlag = nullptr;
+        }
+      } guard(cancel);
+      const bool terminal = ::isatty(STDERR_FILENO) != 0;
+      double burnt = 0, seconds = 0;
+      size_t strokes = 0;
+      const auto started = std::chrono::steady_clock::now();
+      try {
+        for (size_t s = 0; s < toolpaths.size(); ++s) {
+          const jobs::Toolpath& toolpath = toolpaths[s];
+          if (s > 0) {
+            if (::isatty(STDIN_FILENO)) {
+              fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", toolpath.sheet);
+              if (!waitForEnter(cancel)) cancel.cancel();  // Ctrl-C or end of input: stop, do not cut blind
+            }
+          }
+          if (cancel.cancelled())
+            throw devices::DeviceFault(devices::FaultKind::Cancelled, options.device + ": cancelled");
+          fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}\n", toolpath.sheet,
+                     s + 1, toolpaths.size(), toolpath.strokes.size(), toolpath.burnLength, minutes(toolpath.seconds));
+          if (options.frame) {
+            fmt::print(stderr, "run: framing (laser off)\n");
+            device->frame(toolpath);
+          }
+          auto lastShown = std::chrono::steady_clock::time_point{};
+          int lastPercent = -1;
+          device->run(
+              toolpath,
+              [&](const devices::Progress& p) {
+                const int percent = static_cast<int>(100 * p.bytesAcknowledged / std::max<size_t>(p.bytesTotal, 1));
+                const auto now = std::chrono::steady_clock::now();
+                if (terminal ? now - lastShown < std::chrono::milliseconds(200) && percent != 100
+                             : percent / 10 == lastPercent / 10) {
+                  return;
+                }
+                lastShown = now, lastPercent = percent;
+                const int filled = percent / 5;
+                fmt::print(stderr, "{}run: sheet {} [{}{}] {:3}%  stroke {} of {}, {} left{}", terminal ? "\r" : "",
+                           p.sheet, std::string(filled, '#'), std::string(20 - filled, '.'), percent, p.stroke,
+                           p.strokes, minutes(p.secondsLeft), terminal ? "" : "\n");
+              },
+              cancel);
+          if (terminal) fmt::print(stderr, "\n");
+          burnt += toolpath.burnLength, seconds += toolpath.seconds, strokes += toolpath.strokes.size();
+        }
+      } catch (const devices::DeviceFault& fault) {
+        if (terminal) fmt::print(stderr, "\n");
+        fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
+                   fault.laserOffConfirmed
+                       ? "the laser is off"
+                       : "the controller did not confirm the laser off: switch it off at the machine");
+        return kDeviceFault;
+      }
+      device->disconnect();
+      fmt::print("{}: {} sheet{} cut on {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target,
+                 toolpaths.size(), toolpaths.size() == 1 ? "" : "s", options.device, strokes, burnt,
+                 minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
+                 minutes(seconds));
+      return kSuccess;
     } catch (const devices::DeviceFault& fault) {
-      if (terminal) fmt::print(stderr, "\n");
-      fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
-                 fault.laserOffConfirmed
-                     ? "the laser is off"
-                     : "the controller did not confirm the laser off: switch it off at the machine");
+      fmt::print(stderr, "error: {} ({})\n", fault.what(), devices::faultName(fault.kind));
       return kDeviceFault;
     }
-    device->disconnect();
-    fmt::print("{}: {} sheet{} cut on {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target,
-               toolpaths.size(), toolpaths.size() == 1 ? "" : "s", options.device, strokes, burnt,
-               minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
-               minutes(seconds));
-    return kSuccess;
-  } catch (const UserError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const profiles::ProfileError& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
-    return kUserError;
-  } catch (const devices::DeviceFault& fault) {
-    fmt::print(stderr, "error: {} ({})\n", fault.what(), devices::faultName(fault.kind));
-    return kDeviceFault;
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "error: {}: {}\n", options.target, error.what());
-    return kUserError;
-  }
+  });
 }
 
 int runDevices(bool json) {
