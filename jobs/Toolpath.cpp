@@ -208,7 +208,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
 }
 
 double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits) {
-  const double travel = limits.travelSpeed > 0 ? limits.travelSpeed : limits.maxSpeed;
+  const double travel = limits.maxSpeed;  // moves with the laser off go at the machine's full speed
   double seconds = 0;
   Point2 head(0, 0);
   for (const ToolpathStroke& stroke : toolpath.strokes) {

@@ -27,7 +27,6 @@ namespace rotafab::jobs {
 // What the machine can do; the speeds of the colour table are percentages of `maxSpeed`.
 struct MotionLimits {
   double maxSpeed = 500.0 / 25.4 / 60;  // in/s (GRBL's default $110, 500 mm/min)
-  double travelSpeed = 0;               // in/s for moves with the laser off; 0: maxSpeed
   double acceleration = 10.0 / 25.4;    // in/s^2 (GRBL's default $120, 10 mm/s^2)
 };
 

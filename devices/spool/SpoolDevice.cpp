@@ -51,15 +51,15 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
                       const CancelFlag& cancel) {
   if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, "spool: cancelled");
   const jobs::SheetDrawing sheet = drawingOf(toolpath, colours_);
-  lastFile_ = folder_ / fmt::format("sheet-{:03}.eps", toolpath.sheet);
+  const std::filesystem::path eps = folder_ / fmt::format("sheet-{:03}.eps", toolpath.sheet);
   try {
-    jobs::writeFileAtomically(lastFile_, [&](std::ostream& out) { jobs::writeEps(sheet, out); });
+    jobs::writeFileAtomically(eps, [&](std::ostream& out) { jobs::writeEps(sheet, out); });
   } catch (const std::exception& error) {
     throw DeviceFault(FaultKind::Disconnected, fmt::format("spool:{}: {}", folder_.string(), error.what()));
   }
   if (!printer_.empty()) {
     // lp -d PRINTER -t TITLE -- FILE, without a shell (a file named "-x" is no option).
-    const std::string title = sheet.title, file = lastFile_.string();
+    const std::string title = sheet.title, file = eps.string();
     std::vector<std::string> args{"lp", "-d", printer_, "-t", title, "--", file};
     std::vector<char*> argv;
     for (std::string& arg : args) argv.push_back(arg.data());
@@ -82,7 +82,7 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     Progress done;
     done.sheet = toolpath.sheet;
     done.stroke = done.strokes = toolpath.strokes.size();
-    done.bytesAcknowledged = done.bytesTotal = std::filesystem::file_size(lastFile_);
+    done.bytesAcknowledged = done.bytesTotal = std::filesystem::file_size(eps);
     progress(done);
   }
 }

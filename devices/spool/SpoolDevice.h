@@ -32,14 +32,10 @@ class SpoolDevice : public Device {
   DeviceStatus status() override { return {"Idle", 0, 0}; }
   void disconnect() override {}
 
-  // The file the last run() wrote.
-  [[nodiscard]] const std::filesystem::path& lastFile() const { return lastFile_; }
-
  private:
   std::filesystem::path folder_;
   std::string printer_;
   std::map<jobs::Operation, jobs::Rgb> colours_;
-  std::filesystem::path lastFile_;
 };
 
 }  // namespace rotafab::devices::spool
