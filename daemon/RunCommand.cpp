@@ -18,6 +18,7 @@
 #include "devices/Discovery.h"
 #include "devices/grbl/GrblDriver.h"
 #include "devices/m2nano/Lhymicro.h"
+#include "devices/sim/M2NanoSimulator.h"
 #include "devices/spool/SpoolDevice.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/EpsWriter.h"
@@ -107,7 +108,7 @@ std::string minutes(double seconds) {
   return s >= 60 ? fmt::format("{}m {:02}s", s / 60, s % 60) : fmt::format("{}s", s);
 }
 
-int runRun(const RunOptions& options) {
+int runRun(const RunOptions& options, char** argv) {
   return reportingErrors(options.target, [&]() -> int {
     try {
       const devices::DeviceUri uri = [&] {
@@ -117,11 +118,14 @@ int runRun(const RunOptions& options) {
           throw UserError(error.what());
         }
       }();
-      if (uri.driver == "m2nano" && !options.dryRun) {
-        throw UserError(
-            fmt::format("--device {}: driving the M2 Nano over USB is not built yet (issue 5); "
-                        "--dry-run --out JOB.egv writes its LHYMICRO-GL for K40 Whisperer or MeerK40t",
-                        options.device));
+      if (uri.driver == "m2nano" && uri.transport == "sim" && !options.dryRun) {
+        // The simulated board is plugged in through umockdev's preloaded
+        // library: the program starts again with it (before it has done anything).
+        try {
+          devices::sim::runUnderUmockdev(argv);
+        } catch (const std::runtime_error& error) {
+          throw UserError(fmt::format("--device {}: {}", options.device, error.what()));
+        }
       }
       if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
       const auto sheets = sheetsOf(options);
@@ -355,7 +359,7 @@ int runDevices(bool json) {
 
 }  // namespace
 
-void addRunCommand(CLI::App& app, int& status) {
+void addRunCommand(CLI::App& app, int& status, char** argv) {
   auto json = std::make_shared<bool>(false);
   CLI::App* devicesCommand =
       app.add_subcommand("devices", "List the serial ports and cutters plugged in, and the driver for each");
@@ -368,8 +372,8 @@ void addRunCommand(CLI::App& app, int& status) {
   run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
   run->add_option("--device", options->device,
                   "Device URI: grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
-                  "sim:grbl?speed=50 moves 50 times faster), spool:DIR[?printer=NAME] (EPS for a print driver, "
-                  "sent to lp)")
+                  "sim:grbl?speed=50 moves 50 times faster), m2nano://usb/1a86:5512 (a K40's M2 Nano board), "
+                  "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)")
       ->required();
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
@@ -380,13 +384,17 @@ void addRunCommand(CLI::App& app, int& status) {
       ->capture_default_str();
   run->footer(
       "Cuts etch, then score, then inner cuts, then outer cuts, each with the machine profile's power, speed and\n"
-      "passes. Ctrl-C stops the job: feed hold, reset, laser off. Exit status 3 on a device fault.\n\n"
+      "passes. Ctrl-C stops the job and leaves the laser off (GRBL: feed hold, reset, M5; M2 Nano: \"I\", which\n"
+      "drops the board's queue). Exit status 3 on a device fault.\n\n"
       "Examples:\n"
       "  rotafab make examples/cube.obj --structure band --machine grbl-diode-400 --out cube/\n"
       "  rotafab run cube/ --device sim:grbl\n"
       "  rotafab run cube/ --sheet 1 --device grbl:///dev/ttyUSB0 --frame\n"
-      "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode");
-  run->callback([options, &status] { status = runRun(*options); });
+      "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode\n"
+      "  rotafab make examples/cube.obj --structure band --machine k40-m2nano --out k40/\n"
+      "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512\n"
+      "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512 --dry-run --out sheet1.egv");
+  run->callback([options, &status, argv] { status = runRun(*options, argv); });
 }
 
 }  // namespace rotafab::cli

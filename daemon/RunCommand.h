@@ -7,6 +7,7 @@
 
 namespace rotafab::cli {
 
-void addRunCommand(CLI::App& app, int& status);
+// `argv`: the program's own, to run it again under umockdev for the simulated M2 Nano (sim:m2nano).
+void addRunCommand(CLI::App& app, int& status, char** argv);
 
 }  // namespace rotafab::cli

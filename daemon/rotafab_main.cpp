@@ -25,7 +25,7 @@ int main(int argc, char** argv) {
   addMakeCommand(app, status);
   addNestCommand(app, status);
   addProfilesCommand(app, status);
-  addRunCommand(app, status);
+  addRunCommand(app, status, argv);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

@@ -22,4 +22,16 @@ std::string_view faultName(FaultKind kind) {
   return "fault";
 }
 
+void stopAndRethrow(const std::function<bool()>& stopSafely) {
+  try {
+    throw;
+  } catch (DeviceFault& fault) {
+    fault.laserOffConfirmed = stopSafely();
+    throw;
+  } catch (...) {
+    stopSafely();
+    throw;
+  }
+}
+
 }  // namespace rotafab::devices

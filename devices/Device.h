@@ -60,6 +60,11 @@ class CancelFlag {
   std::atomic<bool> cancelled_{false};
 };
 
+// In a catch block: runs `stopSafely` (the driver's way to leave the laser
+// off; it returns whether the controller confirmed it, and never throws),
+// then rethrows, a DeviceFault marked with that answer.
+[[noreturn]] void stopAndRethrow(const std::function<bool()>& stopSafely);
+
 class Device {
  public:
   virtual ~Device() = default;

@@ -6,7 +6,9 @@
 #include <stdexcept>
 
 #include "devices/grbl/GrblDriver.h"
+#include "devices/m2nano/M2NanoDriver.h"
 #include "devices/sim/GrblSimulator.h"
+#include "devices/sim/M2NanoSimulator.h"
 #include "devices/spool/SpoolDevice.h"
 
 namespace rotafab::devices {
@@ -22,6 +24,26 @@ class SimulatedGrbl : public grbl::GrblDriver {
  private:
   std::unique_ptr<sim::GrblSimulator> simulator_;
 };
+
+// An M2 Nano driver that owns the simulated board it talks to (over libusb, through umockdev).
+class SimulatedM2Nano : public m2nano::M2NanoDriver {
+ public:
+  explicit SimulatedM2Nano(std::unique_ptr<sim::M2NanoSimulator> simulator)
+      : M2NanoDriver([match = simulator->match()] { return UsbLink::open(match, 0); }),
+        simulator_(std::move(simulator)) {}
+  ~SimulatedM2Nano() override { disconnect(); }  // libusb lets go of the device before it goes
+
+ private:
+  std::unique_ptr<sim::M2NanoSimulator> simulator_;
+};
+
+// "1a86" as a USB vendor or product id.
+std::optional<uint16_t> hexId(const std::string& text) {
+  unsigned value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value, 16);
+  if (text.size() != 4 || error != std::errc() || end != text.data() + text.size()) return std::nullopt;
+  return static_cast<uint16_t>(value);
+}
 
 }  // namespace
 
@@ -91,7 +113,36 @@ DeviceUri parseDeviceUri(const std::string& uri) {
     return parsed;
   }
   if (uri.starts_with("m2nano://")) {
-    parsed.driver = "m2nano", parsed.transport = "usb", parsed.path = uri.substr(9);
+    // m2nano://usb/1a86:5512[?bus=B&address=A]
+    parsed.driver = "m2nano", parsed.transport = "usb";
+    std::string rest = uri.substr(9);
+    const auto query = rest.find('?');
+    std::string options = query == std::string::npos ? "" : rest.substr(query + 1);
+    if (query != std::string::npos) rest.erase(query);
+    const auto colon = rest.find(':');
+    const bool usb = rest.starts_with("usb/") && colon != std::string::npos && colon > 4;
+    const auto vendor = usb ? hexId(rest.substr(4, colon - 4)) : std::nullopt;
+    const auto product = usb ? hexId(rest.substr(colon + 1)) : std::nullopt;
+    if (!vendor || !product) {
+      throw bad("the M2 Nano is m2nano://usb/VENDOR:PRODUCT in hex, e.g. m2nano://usb/1a86:5512");
+    }
+    parsed.usbVendor = *vendor, parsed.usbProduct = *product;
+    while (!options.empty()) {
+      const auto amp = options.find('&');
+      const std::string option = options.substr(0, amp);
+      options = amp == std::string::npos ? "" : options.substr(amp + 1);
+      const auto equals = option.find('=');
+      const std::string key = option.substr(0, equals),
+                        value = equals == std::string::npos ? "" : option.substr(equals + 1);
+      int number = 0;
+      const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
+      if ((key != "bus" && key != "address") || value.empty() || error != std::errc() ||
+          end != value.data() + value.size() || number <= 0) {
+        throw bad(
+            fmt::format("\"{}\": the M2 Nano takes bus=N and address=N (as `rotafab devices` shows them)", option));
+      }
+      (key == "bus" ? parsed.usbBus : parsed.usbAddress) = number;
+    }
     return parsed;
   }
   throw bad("not a device URI this program knows");
@@ -110,8 +161,16 @@ std::unique_ptr<Device> openDevice(const DeviceUri& uri, const std::map<jobs::Op
   if (uri.driver == "grbl" && uri.transport == "tcp") {
     return std::make_unique<grbl::GrblDriver>([uri] { return openTcpLink(uri.path, uri.port, Millis(5000)); });
   }
-  throw std::invalid_argument(
-      fmt::format("the {} driver is not built yet (issue 5: the M2 Nano over USB is still to come)", uri.driver));
+  if (uri.driver == "m2nano" && uri.transport == "sim") {
+    sim::M2NanoSimulatorOptions options;
+    options.timeScale = uri.simulatedSpeed;
+    return std::make_unique<SimulatedM2Nano>(std::make_unique<sim::M2NanoSimulator>(options));
+  }
+  if (uri.driver == "m2nano" && uri.transport == "usb") {
+    const UsbMatch match{uri.usbVendor, uri.usbProduct, uri.usbBus, uri.usbAddress};
+    return std::make_unique<m2nano::M2NanoDriver>([match] { return UsbLink::open(match, 0); });
+  }
+  throw std::invalid_argument(fmt::format("no {} driver over {}", uri.driver, uri.transport));
 }
 
 }  // namespace rotafab::devices

@@ -146,18 +146,6 @@ void GrblDriver::send(const std::string& line) {
   }
 }
 
-void GrblDriver::stopAndRethrow() {
-  try {
-    throw;
-  } catch (DeviceFault& fault) {
-    fault.laserOffConfirmed = stopSafely();
-    throw;
-  } catch (...) {
-    stopSafely();
-    throw;
-  }
-}
-
 void GrblDriver::home() {
   if (!link_) connect();
   try {
@@ -174,7 +162,7 @@ void GrblDriver::home() {
       }
     }
   } catch (...) {
-    stopAndRethrow();
+    stopAndRethrow([this] { return stopSafely(); });
   }
 }
 
@@ -237,7 +225,7 @@ void GrblDriver::frame(const jobs::Toolpath& toolpath) {
     }
     waitIdle(timeouts_.answer, nullptr);
   } catch (...) {
-    stopAndRethrow();
+    stopAndRethrow([this] { return stopSafely(); });
   }
 }
 
@@ -344,7 +332,7 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
     // Every line is in the planner: wait for the motion to end.
     waitIdle(timeouts_.answer, &cancel);
   } catch (...) {
-    stopAndRethrow();
+    stopAndRethrow([this] { return stopSafely(); });
   }
 }
 

@@ -60,8 +60,6 @@ class GrblDriver : public Device {
   // turns the laser off without the alarm a reset in motion raises; then
   // M5 S0. Returns whether the controller answered it all. Never throws.
   bool stopSafely() noexcept;
-  // In a catch block: stops safely and rethrows, a DeviceFault marked with whether the laser is known off.
-  [[noreturn]] void stopAndRethrow();
 
   std::function<std::unique_ptr<Link>()> open_;
   GrblTimeouts timeouts_;

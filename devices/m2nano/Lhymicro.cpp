@@ -121,55 +121,82 @@ jobs::MotionLimits motionLimits() {
   return limits;
 }
 
-std::vector<std::string> jobLines(const jobs::Toolpath& toolpath) {
-  // Mils on the board: x right, y toward the front from the back-left home.
-  const auto mils = [&](const jobs::Point2& p) {
-    if (p.x() < -1e-9 || p.y() < -1e-9 || p.x() > toolpath.width + 1e-9 || p.y() > toolpath.height + 1e-9) {
-      throw std::invalid_argument(fmt::format("sheet {}: a point ({:.4g}, {:.4g}) off the {:.4g} x {:.4g} in bed",
-                                              toolpath.sheet, p.x(), p.y(), toolpath.width, toolpath.height));
-    }
-    return std::pair{std::lround(p.x() * 1000), std::lround((toolpath.height - p.y()) * 1000)};
-  };
+namespace {
+
+// A sheet point in mils on the board: x right, y toward the front from the back-left home.
+std::pair<long, long> boardMils(const jobs::Toolpath& toolpath, const jobs::Point2& p) {
+  if (p.x() < -1e-9 || p.y() < -1e-9 || p.x() > toolpath.width + 1e-9 || p.y() > toolpath.height + 1e-9) {
+    throw std::invalid_argument(fmt::format("sheet {}: a point ({:.4g}, {:.4g}) off the {:.4g} x {:.4g} in bed",
+                                            toolpath.sheet, p.x(), p.y(), toolpath.width, toolpath.height));
+  }
+  return {std::lround(p.x() * 1000), std::lround((toolpath.height - p.y()) * 1000)};
+}
+
+// Compact mode at a speed: the code, then the directions (y toward the
+// front, then x right; the last one names the major axis).
+std::string enterCompact(const std::string& code) { return code + "NRBS1E"; }
+
+}  // namespace
+
+LhymicroJob jobProgram(const jobs::Toolpath& toolpath) {
   // One line (its own packets, padded with 'F') per compact-mode section:
   // a line ends only after "@NSE" or "FNSE", where padding is harmless.
-  std::vector<std::string> lines{"IPP"};
+  LhymicroJob job;
+  job.lines.push_back("IPP");
+  size_t before = 3;  // the bytes of the lines already closed
   std::string line, speed;
   CompactState state;
   long atX = 0, atY = 0;
   for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
     const std::string code = speedCode(std::max(stroke.speed * 25.4, 1.0));
     if (code != speed) {
-      // Compact mode at this speed (first from default mode, "I"; then from
-      // compact mode without finishing, "@NSE"), stating the directions: y
-      // toward the front, then x right, the last the major axis.
+      // First from default mode ("I"), then from compact mode without finishing ("@NSE").
       if (speed.empty()) {
         line.push_back('I');
       } else {
         line += "@NSE";
-        lines.push_back(std::exchange(line, std::string()));
+        before += line.size();
+        job.lines.push_back(std::exchange(line, std::string()));
       }
-      line += code;
-      line += "NRBS1E";
+      line += enterCompact(code);
       speed = code;
       state = CompactState{};
     }
-    const auto [x0, y0] = mils(stroke.points.front());
+    const auto [x0, y0] = boardMils(toolpath, stroke.points.front());
     line += compactLine(x0 - atX, y0 - atY, false, state);
     atX = x0, atY = y0;
     for (size_t i = 1; i < stroke.points.size(); ++i) {
-      const auto [x, y] = mils(stroke.points[i]);
+      const auto [x, y] = boardMils(toolpath, stroke.points[i]);
       line += compactLine(x - atX, y - atY, true, state);
       atX = x, atY = y;
     }
     if (state.laser) line += 'U', state.laser = false;
+    job.strokeEnds.push_back(before + line.size());
   }
   // The board runs on after FNSE; homing must wait until it reports the job
   // finished (status 236), which a file cannot: the driver homes, not the job.
   if (!speed.empty()) {
     line += "FNSE";
-    lines.push_back(std::move(line));
+    job.lines.push_back(std::move(line));
   }
-  return lines;
+  return job;
+}
+
+std::vector<std::string> jobLines(const jobs::Toolpath& toolpath) { return jobProgram(toolpath).lines; }
+
+std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPerSecond) {
+  const auto box = jobs::toolpathBounds(toolpath);
+  const auto [left, front] = boardMils(toolpath, jobs::Point2(box[0], box[1]));
+  const auto [right, back] = boardMils(toolpath, jobs::Point2(box[2], box[3]));
+  std::string line = "I" + enterCompact(speedCode(mmPerSecond));
+  CompactState state;
+  long atX = 0, atY = 0;
+  for (const auto& [x, y] : {std::pair{left, back}, {right, back}, {right, front}, {left, front}, {left, back}}) {
+    line += compactLine(x - atX, y - atY, false, state);
+    atX = x, atY = y;
+  }
+  line += "FNSE";
+  return {"IPP", line};
 }
 
 std::string egvFile(const std::vector<std::string>& lines) {

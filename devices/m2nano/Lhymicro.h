@@ -24,6 +24,12 @@ Packet packet(const std::string& payload);  // payload: at most 30 bytes
 // A command line cut into packets of 30 bytes, the last one padded with 'F'.
 std::vector<Packet> packets(const std::string& line);
 
+// The board's answers to a status request (the second byte of six): the
+// packet taken, and room for the next; busy (checking the packet, or no
+// room); the packet arrived corrupted, send it again; the job has finished;
+// a power fault.
+enum BoardStatus : int { kOk = 206, kBusy = 238, kCrcError = 207, kFinished = 236, kPowerFault = 239 };
+
 // A distance of `mils` steps: 'z' per 255, then 52..254 as three digits, 26..51 as '|' and a letter, 1..25 a..y.
 std::string distance(long mils);
 
@@ -48,6 +54,17 @@ std::string compactLine(long dx, long dy, bool laser, CompactState& state);
 // board's (home at the back left, y toward the front). Throws
 // std::invalid_argument for a point off the toolpath's bed.
 std::vector<std::string> jobLines(const jobs::Toolpath& toolpath);
+
+// The same lines, and where each stroke's commands end, counted in bytes of
+// the lines one after another (for progress by strokes).
+struct LhymicroJob {
+  std::vector<std::string> lines;
+  std::vector<size_t> strokeEnds;
+};
+LhymicroJob jobProgram(const jobs::Toolpath& toolpath);
+
+// Framing: home, then the box of the strokes traced in compact mode with the laser off.
+std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPerSecond);
 
 // The .egv file K40 Whisperer and MeerK40t open (SPEC, "Devices").
 std::string egvFile(const std::vector<std::string>& lines);

@@ -6,8 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <sstream>
 
 #include "TestSupport.h"
@@ -18,19 +18,21 @@ namespace {
 const std::string kCli = ROTAFAB_CLI;
 const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
 
-// One make of the cube for the GRBL machine's bed, shared by the tests.
-const std::filesystem::path& cubeJob() {
+// The cube's bands made once for each set of `make` options, shared by the tests.
+std::filesystem::path madeCube(const std::string& options) {
   static TempDir dir;
-  static const auto out = dir.path() / "cube";
-  static const bool made = [] {
+  static std::map<std::string, std::filesystem::path> made;
+  const auto [it, fresh] = made.try_emplace(options, dir.path() / ("cube-" + std::to_string(made.size())));
+  if (fresh) {
     const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
-                                " --structure band --machine grbl-diode-400 --time 0 --out " + quoted(out));
+                                " --structure band --time 0 " + options + " --out " + quoted(it->second));
     EXPECT_EQ(r.status, 0) << r.err;
-    return true;
-  }();
-  EXPECT_TRUE(made);
-  return out;
+  }
+  return it->second;
 }
+// For the GRBL machine's bed, and for the K40's (M2 Nano).
+std::filesystem::path cubeJob() { return madeCube("--machine grbl-diode-400"); }
+std::filesystem::path k40Job() { return madeCube("--machine k40-m2nano --size 4in"); }
 
 TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
   const CommandResult r = run(kCli + " run " + quoted(cubeJob()) + " --device 'sim:grbl?speed=200'");
@@ -62,18 +64,13 @@ TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
   EXPECT_EQ(rapids, 108 + 1);  // one per stroke, and home
 }
 
-// Ctrl-C mid-job: the driver holds and resets the controller; exit 3, the laser off.
 // The M2 Nano's dry run: an .egv file with the header K40 Whisperer and
 // MeerK40t expect, and nothing but LHYMICRO-GL in its body.
 TEST(RunCli, M2NanoDryRunWritesAnEgvFile) {
   TempDir dir;
-  const auto job = dir.path() / "k40";
-  const CommandResult made = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
-                                 " --structure band --machine k40-m2nano --size 4in --time 0 --out " + quoted(job));
-  ASSERT_EQ(made.status, 0) << made.err;
   const auto egv = dir.path() / "cube.egv";
-  const CommandResult r =
-      run(kCli + " run " + quoted(job) + " --device m2nano://usb/1a86:5512 --dry-run --out " + quoted(egv));
+  const CommandResult r = run(kCli + " run " + quoted(k40Job()) + " --sheet 1 --device m2nano://usb/1a86:5512 " +
+                              "--dry-run --out " + quoted(egv));
   ASSERT_EQ(r.status, 0) << r.err;
   const std::string text = readFile(egv);
   EXPECT_EQ(text.rfind("Document type : LHYMICRO-GL file\nFile version: 1.0.01\nCopyright: Unknown\n", 0), 0u);
@@ -83,18 +80,44 @@ TEST(RunCli, M2NanoDryRunWritesAnEgvFile) {
   EXPECT_EQ(body.find_first_not_of("ABCDEFGILMNPRSTUVabcdefghijklmnopqrstuvwxyz|0123456789@\n"), std::string::npos);
 }
 
-TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
+// The simulated M2 Nano, plugged in through umockdev: the program starts
+// again under umockdev's preload and drives it over libusb to the end.
+TEST(RunCli, CutsAMakeOutputOnTheSimulatedM2NanoToTheEnd) {
+  const CommandResult r = run(kCli + " run " + quoted(k40Job()) + " --sheet 1 --device 'sim:m2nano?speed=100'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("Lihuiyu M2 Nano on usb 001:004 (1a86:5512), CH341 version 48"), std::string::npos) << r.err;
+  // "] 100%  stroke N of N": every stroke acknowledged.
+  const auto at = r.err.find("] 100%  stroke ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  std::istringstream counts(r.err.substr(at + 15));
+  size_t done = 0, of = 0;
+  std::string word;
+  counts >> done >> word >> of;
+  EXPECT_EQ(word, "of");
+  EXPECT_GT(done, 10u);
+  EXPECT_EQ(done, of);
+  EXPECT_NE(r.out.find("1 sheet cut on sim:m2nano?speed=100: " + std::to_string(done) + " strokes"), std::string::npos)
+      << r.out;
+}
+
+// Ctrl-C mid-job: the driver stops the machine; exit 3, the laser off.
+void interruptMidJob(const std::filesystem::path& job, const std::string& device) {
   // SIGINT once the job streams (after "run: sheet" on stderr).
   TempDir dir;
   const auto err = dir.path() / "err";
   const CommandResult r =
-      run("(" + kCli + " run " + quoted(cubeJob()) + " --device sim:grbl 2> " + quoted(err) +
+      run("(" + kCli + " run " + quoted(job) + " --sheet 1 --device " + device + " 2> " + quoted(err) +
           " & pid=$!; for i in $(seq 400); do grep -q 'run: sheet' " + quoted(err) +
           " && break; sleep 0.05; done; grep -q 'run: sheet' " + quoted(err) +
           " || { kill -KILL $pid; exit 99; }; sleep 0.3; kill -INT $pid; wait $pid; status=$?; cat " + quoted(err) +
           " >&2; exit $status)");
-  EXPECT_EQ(r.status, 3) << r.err;
-  EXPECT_NE(r.err.find("cancelled (cancelled; the laser is off)"), std::string::npos) << r.err;
+  EXPECT_EQ(r.status, 3) << device << ": " << r.err;
+  EXPECT_NE(r.err.find("cancelled (cancelled; the laser is off)"), std::string::npos) << device << ": " << r.err;
+}
+
+TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
+  interruptMidJob(cubeJob(), "sim:grbl");
+  interruptMidJob(k40Job(), "sim:m2nano");
 }
 
 TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
@@ -122,7 +145,9 @@ TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
   fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512 --machine grbl-diode-400 --dry-run --out " +
             quoted(dir.path() / "x.egv"),
         1, "is driven by grbl");
-  fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512", 1, "not built yet");
+  fails(quoted(k40Job()) + " --sheet 1 --device m2nano://usb/1a86:5512?bus=250", 3, "no such USB device");
+  fails(quoted(k40Job()) + " --device m2nano://usb/1a86", 1, "m2nano://usb/VENDOR:PRODUCT");
+  fails(quoted(k40Job()) + " --device 'm2nano://usb/1a86:5512?port=2'", 1, "bus=N and address=N");
 }
 
 }  // namespace
@@ -177,9 +202,13 @@ TEST(RunCli, TheSpoolWritesEpsAndHandsItToLp) {
   ASSERT_EQ(r.status, 0) << r.err;
   const CommandResult gs = run("gs -q -dNOPAUSE -dBATCH -sDEVICE=bbox " + quoted(spool / "sheet-001.eps"));
   ASSERT_EQ(gs.status, 0) << gs.err;
-  std::smatch box;
-  ASSERT_TRUE(std::regex_search(gs.err, box, std::regex(R"(%%BoundingBox: (\d+) (\d+) (\d+) (\d+))"))) << gs.err;
-  EXPECT_LE(std::stoi(box[3]), 32 * 72 + 1);
+  const auto at = gs.err.find("%%BoundingBox: ");
+  ASSERT_NE(at, std::string::npos) << gs.err;
+  std::istringstream box(gs.err.substr(at + 15));
+  int left = -1, bottom = -1, right = -1;
+  box >> left >> bottom >> right;
+  EXPECT_GE(right, 0) << gs.err;
+  EXPECT_LE(right, 32 * 72 + 1);
   EXPECT_NE(readFile(spool / "sheet-001.eps").find("% cut\n0 0 1 c\n"), std::string::npos) << "cuts in blue";
 
   const auto bin = dir.path() / "bin";

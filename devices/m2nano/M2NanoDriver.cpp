@@ -1,0 +1,272 @@
+#include "devices/m2nano/M2NanoDriver.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <thread>
+
+namespace rotafab::devices::m2nano {
+namespace {
+
+constexpr uint8_t kOut = 0x02, kIn = 0x82;  // the CH341's bulk endpoints
+constexpr uint8_t kStatusRequest = 0xA0;    // the CH341's "read parallel status" command
+
+using Clock = std::chrono::steady_clock;
+
+std::string_view statusWord(int status) {
+  switch (status) {
+    case kOk:
+      return "OK";
+    case kBusy:
+      return "Busy";
+    case kCrcError:
+      return "CRC error";
+    case kFinished:
+      return "Finished";
+    case kPowerFault:
+      return "Power fault";
+    default:
+      return "Unknown";
+  }
+}
+
+}  // namespace
+
+M2NanoDriver::M2NanoDriver(std::function<std::unique_ptr<UsbLink>()> open, M2NanoTimeouts timeouts)
+    : open_(std::move(open)), timeouts_(timeouts) {}
+
+std::string M2NanoDriver::connect() {
+  link_.reset();
+  link_ = open_();
+  // The CH341's parallel port in EPP 1.9 mode, as every K40 program starts it.
+  link_->control(0x40, 0xB1, 0x0102, 0, nullptr, 0, timeouts_.transfer);
+  std::string chip;
+  try {
+    uint8_t version[2] = {0, 0};
+    if (link_->control(0xC0, 0x5F, 0, 0, version, 2, timeouts_.transfer) == 2) {
+      chip = fmt::format(", CH341 version {}", version[0] | version[1] << 8);
+    }
+  } catch (const DeviceFault& fault) {
+    if (fault.kind == FaultKind::Disconnected) throw;  // the version is only informative
+  }
+  const auto until = Clock::now() + timeouts_.ready;
+  for (;;) {
+    const int status = readStatus();
+    // A CRC error or "finished" left from an earlier job is ready too.
+    if (status == kOk || status == kFinished || status == kCrcError) break;
+    if (status == kPowerFault) {
+      throw DeviceFault(FaultKind::Refused, link_->name() +
+                                                ": the board reports a power fault (status 239): is the laser's "
+                                                "power supply on?");
+    }
+    if (Clock::now() > until) {
+      throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the board stayed busy for {} ms after connecting",
+                                                        link_->name(), timeouts_.ready.count()));
+    }
+    std::this_thread::sleep_for(timeouts_.poll);
+  }
+  resends_ = 0;
+  paused_ = false;
+  return fmt::format("Lihuiyu M2 Nano on {}{}", link_->name(), chip);
+}
+
+int M2NanoDriver::readStatus() {
+  for (int attempt = 1;; ++attempt) {
+    link_->bulkWrite(kOut, &kStatusRequest, 1, timeouts_.transfer);
+    uint8_t reply[32] = {};  // the board sends 6 bytes; a larger buffer cannot overflow
+    const auto got = link_->bulkRead(kIn, reply, sizeof reply, timeouts_.transfer);
+    if (got && *got >= 2) {
+      const int status = reply[1];
+      if (status != kOk && status != kBusy && status != kCrcError && status != kFinished && status != kPowerFault) {
+        throw DeviceFault(FaultKind::Protocol, fmt::format("{}: status {} (0x{:02x}), which no M2 Nano reports",
+                                                           link_->name(), status, status));
+      }
+      return status;
+    }
+    if (got) {
+      throw DeviceFault(FaultKind::Protocol,
+                        fmt::format("{}: a status reply of {} byte (the board sends 6)", link_->name(), *got));
+    }
+    if (attempt == 3) {
+      throw DeviceFault(FaultKind::Timeout, fmt::format("{}: no answer to 3 status requests of {} ms each",
+                                                        link_->name(), timeouts_.transfer.count()));
+    }
+  }
+}
+
+void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
+  finishedSeen_ = false;
+  for (int rejected = 0;;) {
+    link_->bulkWrite(kOut, packet.data(), packet.size(), timeouts_.transfer);
+    // Busy (238) means the board is still checking the packet or has no room
+    // for another yet: ask again until it says OK, or that the packet arrived corrupted.
+    const auto until = Clock::now() + timeouts_.busy;
+    int status = readStatus();
+    for (int polls = 1; status != kOk && status != kCrcError; ++polls) {
+      // The board can finish (FNSE, a home) before it says OK to the packet that ended the job.
+      if (status == kFinished) finishedSeen_ = true;
+      if (status == kPowerFault) {
+        throw DeviceFault(FaultKind::Alarm, link_->name() + ": the board reports a power fault (status 239)");
+      }
+      if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+      if (Clock::now() > until) {
+        throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the board stayed busy for {} s", link_->name(),
+                                                          timeouts_.busy.count() / 1000));
+      }
+      // A packet is checked in moments, a full queue drains at the speed of the cut.
+      if (polls > 10) std::this_thread::sleep_for(timeouts_.poll);
+      status = readStatus();
+    }
+    if (status == kOk) return;
+    ++resends_;
+    if (++rejected >= timeouts_.crcResends) {
+      throw DeviceFault(FaultKind::Protocol, fmt::format("{}: the board rejected the same packet {} times (CRC "
+                                                         "errors): check the USB cable",
+                                                         link_->name(), rejected));
+    }
+  }
+}
+
+void M2NanoDriver::serviceRequests() {
+  // Pause and resume are the same packet, "PN", which the board toggles on.
+  if (pauseRequested_.exchange(false) && !paused_) {
+    send(packet("PN"), nullptr);
+    paused_ = true;
+  }
+  if (resumeRequested_.exchange(false) && paused_) {
+    send(packet("PN"), nullptr);
+    paused_ = false;
+  }
+}
+
+void M2NanoDriver::sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel) {
+  for (const std::string& line : lines) {
+    for (const Packet& p : packets(line)) send(p, cancel);
+  }
+}
+
+void M2NanoDriver::waitFinished(Millis limit, const CancelFlag* cancel, const std::function<void()>& tick) {
+  auto until = Clock::now() + limit;
+  for (;;) {
+    if (std::exchange(finishedSeen_, false)) return;
+    if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+    const bool wasPaused = paused_;
+    const auto before = Clock::now();
+    serviceRequests();
+    const int status = readStatus();
+    if (status == kFinished) return;
+    if (status == kPowerFault) {
+      throw DeviceFault(FaultKind::Alarm, link_->name() + ": the board reports a power fault (status 239)");
+    }
+    if (tick) tick();
+    std::this_thread::sleep_for(paused_ ? Millis(100) : timeouts_.poll);
+    if (wasPaused) until += Clock::now() - before;  // time held does not count
+    if (Clock::now() > until) {
+      throw DeviceFault(FaultKind::Timeout,
+                        fmt::format("{}: the board did not report the job finished within {} s", link_->name(),
+                                    std::chrono::duration_cast<std::chrono::seconds>(limit).count()));
+    }
+  }
+}
+
+bool M2NanoDriver::stopSafely() noexcept {
+  // "I" alone (K40 Whisperer's emergency stop): the board drops what it has
+  // queued and leaves compact mode, where alone it fires the laser. Sent at
+  // once, without waiting for the board to be ready.
+  try {
+    if (!link_) return false;
+    paused_ = false;
+    const Packet stop = packet("I");
+    const auto until = Clock::now() + timeouts_.ready;
+    for (int sent = 0; sent < 5 && Clock::now() < until; ++sent) {
+      link_->bulkWrite(kOut, stop.data(), stop.size(), timeouts_.transfer);
+      for (;;) {
+        const int status = readStatus();
+        if (status == kOk || status == kFinished) return true;
+        if (status == kCrcError || Clock::now() > until) break;
+        std::this_thread::sleep_for(timeouts_.poll);
+      }
+    }
+    return false;
+  } catch (...) {
+    return false;
+  }
+}
+
+void M2NanoDriver::home() {
+  if (!link_) connect();
+  try {
+    sendLines({"IPP"}, nullptr);
+    waitFinished(Millis(60000), nullptr, {});
+  } catch (...) {
+    stopAndRethrow([this] { return stopSafely(); });
+  }
+}
+
+void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
+  if (!link_) connect();
+  try {
+    const double mmPerSecond = 30;  // slow enough to follow with the eye
+    sendLines(frameLines(toolpath, mmPerSecond), nullptr);
+    const auto box = jobs::toolpathBounds(toolpath);
+    const double seconds = (2 * (box[2] - box[0] + box[3] - box[1]) + box[2] + box[3]) * 25.4 / mmPerSecond;
+    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * seconds * 1000)), nullptr, {});
+  } catch (...) {
+    stopAndRethrow([this] { return stopSafely(); });
+  }
+}
+
+void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+                       const CancelFlag& cancel) {
+  if (!link_) connect();
+  try {
+    const LhymicroJob job = jobProgram(toolpath);
+    Progress report;
+    report.sheet = toolpath.sheet;
+    report.strokes = toolpath.strokes.size();
+    for (const std::string& line : job.lines) report.bytesTotal += line.size();
+    const auto tell = [&] {
+      const double done = static_cast<double>(report.bytesAcknowledged) / std::max<size_t>(report.bytesTotal, 1);
+      report.secondsLeft = toolpath.seconds * (1 - done);  // the board queues only a few packets
+      while (report.stroke < job.strokeEnds.size() && job.strokeEnds[report.stroke] <= report.bytesAcknowledged)
+        ++report.stroke;
+      if (progress) progress(report);
+    };
+    for (const std::string& line : job.lines) {
+      for (size_t at = 0; at < line.size(); at += 30) {
+        serviceRequests();
+        while (paused_) {  // no packet while held: the board's queue would fill and stay full
+          if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+          std::this_thread::sleep_for(Millis(100));
+          readStatus();  // the board must still answer
+          serviceRequests();
+        }
+        if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+        send(packet(line.substr(at, 30)), &cancel);
+        report.bytesAcknowledged += std::min<size_t>(30, line.size() - at);
+        tell();
+      }
+    }
+    // The board has the whole job queued; it has cut it when it says "finished".
+    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * toolpath.seconds * 1000)), &cancel, tell);
+    report.stroke = report.strokes;
+    report.secondsLeft = 0;
+    if (progress) progress(report);
+    // Home, so that the next sheet starts from a known place.
+    sendLines({"IPP"}, &cancel);
+    waitFinished(Millis(60000), &cancel, {});
+  } catch (...) {
+    stopAndRethrow([this] { return stopSafely(); });
+  }
+}
+
+DeviceStatus M2NanoDriver::status() {
+  if (!link_) connect();
+  DeviceStatus status;
+  status.state = std::string(statusWord(readStatus()));
+  return status;  // the board does not say where the head is
+}
+
+void M2NanoDriver::disconnect() { link_.reset(); }
+
+}  // namespace rotafab::devices::m2nano

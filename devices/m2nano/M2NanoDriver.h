@@ -1,0 +1,68 @@
+#pragma once
+// The Lihuiyu M2 Nano board (K40 lasers) over USB (issue 5). The board sits
+// behind a CH341 bridge in parallel mode (1a86:5512): the driver initialises
+// it with one control transfer, sends each 30-byte LHYMICRO-GL packet
+// (Lhymicro.h) as a 34-byte bulk transfer, and after each one asks for the
+// status (0xA0 out, six bytes in, the second one the status): 206 OK, the
+// packet is taken; 238 busy, ask again; 207 the packet arrived corrupted,
+// send it again; 236 the job has finished; 239 a power fault. Learnt from
+// MeerK40t, K40 Whisperer and LibLaserCut (none of their code is used).
+// On any fault or cancel the driver sends "I", which drops what the board
+// has queued and leaves compact mode, so the laser is off.
+
+#include <atomic>
+#include <functional>
+#include <memory>
+
+#include "devices/Device.h"
+#include "devices/m2nano/Lhymicro.h"
+#include "devices/transport/UsbLink.h"
+
+namespace rotafab::devices::m2nano {
+
+struct M2NanoTimeouts {
+  Millis transfer{1500};   // any one USB transfer
+  Millis ready{5000};      // for the board to report OK after connecting or an abort
+  Millis busy{60000};      // for a busy board to take the next packet (its queue drains as it cuts)
+  Millis poll{20};         // between status requests while the board is busy
+  int crcResends = 50;     // a packet rejected this many times in a row is a fault
+  double finishSlack = 3;  // wait this many times the estimated time (plus a minute) for the job to finish
+};
+
+class M2NanoDriver : public Device {
+ public:
+  M2NanoDriver(std::function<std::unique_ptr<UsbLink>()> open, M2NanoTimeouts timeouts = {});
+  std::string connect() override;
+  void home() override;
+  void frame(const jobs::Toolpath& toolpath) override;
+  void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
+           const CancelFlag& cancel) override;
+  void pause() override { pauseRequested_ = true; }
+  void resume() override { resumeRequested_ = true; }
+  DeviceStatus status() override;
+  void disconnect() override;
+
+  // Packets the board asked for again (CRC errors), since connect().
+  [[nodiscard]] size_t resends() const { return resends_; }
+
+ private:
+  int readStatus();
+  // Sends one packet until the board takes it (status OK).
+  void send(const Packet& packet, const CancelFlag* cancel);
+  void sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel);
+  // Polls until the board reports the job finished (236).
+  void waitFinished(Millis limit, const CancelFlag* cancel, const std::function<void()>& tick);
+  // "I" (and the status after it); whether the board took it. Never throws.
+  bool stopSafely() noexcept;
+  void serviceRequests();
+
+  std::function<std::unique_ptr<UsbLink>()> open_;
+  M2NanoTimeouts timeouts_;
+  std::unique_ptr<UsbLink> link_;
+  std::atomic<bool> pauseRequested_{false}, resumeRequested_{false};
+  bool paused_ = false;
+  bool finishedSeen_ = false;  // the board said "finished" after the last packet sent
+  size_t resends_ = 0;
+};
+
+}  // namespace rotafab::devices::m2nano
