@@ -11,6 +11,14 @@
 #include <regex>
 #include <thread>
 
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <termios.h>
+#include <unistd.h>
+
 #include "jobs/SheetDrawing.h"
 
 #include "devices/grbl/GrblDriver.h"
@@ -259,6 +267,125 @@ TEST(Grbl, PauseHoldsAndResumeFinishes) {
   EXPECT_EQ(record.state, "Idle");
   EXPECT_FALSE(record.spindleEnabled);
   EXPECT_GT(record.linesExecuted, linesWhileHeld);
+}
+
+// ser2net in miniature: a TCP port on this machine whose one connection is
+// joined byte for byte to the simulator's pseudo-terminal, as an ESP32 board
+// or ser2net joins a telnet port to a GRBL controller's serial line.
+class TcpBridge {
+ public:
+  explicit TcpBridge(const std::string& ptyPath) {
+    listener_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t length = sizeof address;
+    if (listener_ < 0 || ::bind(listener_, reinterpret_cast<sockaddr*>(&address), length) != 0 ||
+        ::listen(listener_, 1) != 0 || ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &length) != 0) {
+      throw std::runtime_error("no TCP port for the bridge");
+    }
+    port_ = std::to_string(ntohs(address.sin_port));
+    thread_ = std::thread([this, ptyPath] { forward(ptyPath); });
+  }
+  ~TcpBridge() {
+    stop_ = true;
+    thread_.join();
+    ::close(listener_);
+  }
+  [[nodiscard]] const std::string& port() const { return port_; }
+  void drop() { drop_ = true; }  // the network goes away: the connection closes
+
+ private:
+  void forward(const std::string& ptyPath) {
+    int client = -1;
+    while (!stop_ && client < 0) {
+      pollfd waiting{listener_, POLLIN, 0};
+      if (::poll(&waiting, 1, 50) > 0) client = ::accept(listener_, nullptr, nullptr);
+    }
+    const int pty = ::open(ptyPath.c_str(), O_RDWR | O_NOCTTY);
+    termios raw{};
+    if (pty >= 0 && ::tcgetattr(pty, &raw) == 0) {
+      ::cfmakeraw(&raw);
+      ::tcsetattr(pty, TCSANOW, &raw);
+    }
+    char buffer[512];
+    while (!stop_ && !drop_ && client >= 0 && pty >= 0) {
+      pollfd both[2] = {{client, POLLIN, 0}, {pty, POLLIN, 0}};
+      if (::poll(both, 2, 20) <= 0) continue;
+      for (int i = 0; i < 2; ++i) {
+        if (!(both[i].revents & (POLLIN | POLLHUP))) continue;
+        const ssize_t n = ::read(both[i].fd, buffer, sizeof buffer);
+        if (n <= 0) drop_ = true;
+        if (n > 0 && ::write(both[1 - i].fd, buffer, static_cast<size_t>(n)) != n) drop_ = true;
+      }
+    }
+    if (client >= 0) ::close(client);
+    if (pty >= 0) ::close(pty);
+  }
+
+  int listener_ = -1;
+  std::string port_;
+  std::atomic<bool> stop_{false}, drop_{false};
+  std::thread thread_;
+};
+
+// GRBL over TCP (grbl+tcp://): the same driver and job through a socket.
+TEST(Grbl, StreamsOverTcpAsOverSerial) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 40;
+  sim::GrblSimulator simulator(options);
+  TcpBridge bridge(simulator.path());
+  grbl::GrblDriver driver([&] { return openTcpLink("127.0.0.1", bridge.port(), std::chrono::milliseconds(2000)); },
+                          quick());
+  EXPECT_NE(driver.connect().find("Grbl 1.1h"), std::string::npos);
+  const jobs::Toolpath path = toolpath(driver.motionLimits());
+  CancelFlag cancel;
+  driver.run(path, nullptr, cancel);
+  const auto record = simulator.record();
+  const auto lines = jobs::gcodeLines(path, driver.gcodeOptions());
+  ASSERT_GE(record.lines.size(), lines.size());
+  EXPECT_EQ(record.lines.back(), "G0X0Y0");
+  EXPECT_FALSE(record.overflowed);
+  EXPECT_FALSE(record.spindleEnabled);
+  EXPECT_EQ(record.state, "Idle");
+}
+
+TEST(Grbl, ADroppedTcpConnectionIsADisconnectNotAHang) {
+  sim::GrblSimulatorOptions options;
+  options.timeScale = 2;
+  sim::GrblSimulator simulator(options);
+  TcpBridge bridge(simulator.path());
+  grbl::GrblDriver driver([&] { return openTcpLink("127.0.0.1", bridge.port(), std::chrono::milliseconds(2000)); },
+                          quick());
+  driver.connect();
+  const size_t before = simulator.record().linesExecuted;
+  simulator.afterLines(before + 12, [&](sim::GrblSimulator&) { bridge.drop(); });
+  const auto started = std::chrono::steady_clock::now();
+  CancelFlag cancel;
+  try {
+    driver.run(toolpath(driver.motionLimits()), nullptr, cancel);
+    FAIL() << "the job ran to its end";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Disconnected) << fault.what();
+    EXPECT_NE(std::string(fault.what()).find("127.0.0.1:" + bridge.port()), std::string::npos) << fault.what();
+    EXPECT_FALSE(fault.laserOffConfirmed);
+  }
+  EXPECT_GE(simulator.record().linesExecuted, before + 12) << "the job had begun";
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(15)) << "no hang";
+}
+
+// $H with homing off ($22=0, GRBL's default): refused, with the fix.
+TEST(Grbl, HomingOffIsRefusedWithTheFix) {
+  Rig rig(40);
+  try {
+    rig.driver->home();
+    FAIL() << "homed without homing switches";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Refused) << fault.what();
+    EXPECT_NE(std::string(fault.what()).find("$22"), std::string::npos) << fault.what();
+    EXPECT_TRUE(fault.laserOffConfirmed);
+  }
+  EXPECT_EQ(rig.simulator.record().state, "Idle");
 }
 
 TEST(Grbl, StatusReportsParse) {
