@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <tuple>
 #include <utility>
 
 namespace rotafab::devices::m2nano {
@@ -138,16 +139,22 @@ std::string enterCompact(const std::string& code) { return code + "NRBS1E"; }
 
 }  // namespace
 
-LhymicroJob jobProgram(const jobs::Toolpath& toolpath) {
+LhymicroJob jobProgram(const jobs::Toolpath& toolpath, size_t firstStroke) {
   // One line (its own packets, padded with 'F') per compact-mode section:
   // a line ends only after "@NSE" or "FNSE", where padding is harmless.
   LhymicroJob job;
-  job.lines.push_back("IPP");
-  size_t before = 3;  // the bytes of the lines already closed
+  size_t before = 0;  // the bytes of the lines already closed
+  long atX = 0, atY = 0;
+  if (firstStroke == 0) {
+    job.lines.push_back("IPP");
+    before = 3;
+  } else {
+    std::tie(atX, atY) = boardMils(toolpath, toolpath.strokes.at(firstStroke - 1).points.back());
+  }
   std::string line, speed;
   CompactState state;
-  long atX = 0, atY = 0;
-  for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
+  for (size_t s = firstStroke; s < toolpath.strokes.size(); ++s) {
+    const jobs::ToolpathStroke& stroke = toolpath.strokes[s];
     const std::string code = speedCode(std::max(stroke.speed * 25.4, 1.0));
     if (code != speed) {
       // First from default mode ("I"), then from compact mode without finishing ("@NSE").
@@ -188,7 +195,8 @@ std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPer
   const auto box = jobs::toolpathBounds(toolpath);
   const auto [left, front] = boardMils(toolpath, jobs::Point2(box[0], box[1]));
   const auto [right, back] = boardMils(toolpath, jobs::Point2(box[2], box[3]));
-  std::string line = "I" + enterCompact(speedCode(mmPerSecond));
+  std::string line(1, 'I');  // (appended, not "I" + ...: GCC 12 warns falsely on that)
+  line += enterCompact(speedCode(mmPerSecond));
   CompactState state;
   long atX = 0, atY = 0;
   for (const auto& [x, y] : {std::pair{left, back}, {right, back}, {right, front}, {left, front}, {left, back}}) {

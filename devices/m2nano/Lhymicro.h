@@ -56,12 +56,15 @@ std::string compactLine(long dx, long dy, bool laser, CompactState& state);
 std::vector<std::string> jobLines(const jobs::Toolpath& toolpath);
 
 // The same lines, and where each stroke's commands end, counted in bytes of
-// the lines one after another (for progress by strokes).
+// the lines one after another (for progress by strokes; each stroke ends
+// with the laser off, so a driver can hold there). From `firstStroke` on,
+// the program resumes a job held after the stroke before it: no home, from
+// where that stroke ended.
 struct LhymicroJob {
   std::vector<std::string> lines;
   std::vector<size_t> strokeEnds;
 };
-LhymicroJob jobProgram(const jobs::Toolpath& toolpath);
+LhymicroJob jobProgram(const jobs::Toolpath& toolpath, size_t firstStroke = 0);
 
 // Framing: home, then the box of the strokes traced in compact mode with the laser off.
 std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPerSecond);

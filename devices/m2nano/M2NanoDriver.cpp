@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <optional>
 #include <thread>
 
 namespace rotafab::devices::m2nano {
@@ -36,7 +38,16 @@ M2NanoDriver::M2NanoDriver(std::function<std::unique_ptr<UsbLink>()> open, M2Nan
     : open_(std::move(open)), timeouts_(timeouts) {}
 
 std::string M2NanoDriver::connect() {
+  // The link is kept only once the board answers: a half-set-up one would
+  // let run() skip connecting.
   link_.reset();
+  struct Keep {
+    std::unique_ptr<UsbLink>& link;
+    bool connected = false;
+    ~Keep() {
+      if (!connected) link.reset();
+    }
+  } keep{link_};
   link_ = open_();
   // The CH341's parallel port in EPP 1.9 mode, as every K40 program starts it.
   link_->control(0x40, 0xB1, 0x0102, 0, nullptr, 0, timeouts_.transfer);
@@ -67,6 +78,8 @@ std::string M2NanoDriver::connect() {
   }
   resends_ = 0;
   paused_ = false;
+  pauseRequested_ = false, resumeRequested_ = false;
+  keep.connected = true;
   return fmt::format("Lihuiyu M2 Nano on {}{}", link_->name(), chip);
 }
 
@@ -100,7 +113,7 @@ void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
     link_->bulkWrite(kOut, packet.data(), packet.size(), timeouts_.transfer);
     // Busy (238) means the board is still checking the packet or has no room
     // for another yet: ask again until it says OK, or that the packet arrived corrupted.
-    const auto until = Clock::now() + timeouts_.busy;
+    const auto until = Clock::now() + busy_;
     int status = readStatus();
     for (int polls = 1; status != kOk && status != kCrcError; ++polls) {
       // The board can finish (FNSE, a home) before it says OK to the packet that ended the job.
@@ -110,8 +123,8 @@ void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
       }
       if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
       if (Clock::now() > until) {
-        throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the board stayed busy for {} s", link_->name(),
-                                                          timeouts_.busy.count() / 1000));
+        throw DeviceFault(FaultKind::Timeout,
+                          fmt::format("{}: the board stayed busy for {} s", link_->name(), busy_.count() / 1000));
       }
       // A packet is checked in moments, a full queue drains at the speed of the cut.
       if (polls > 10) std::this_thread::sleep_for(timeouts_.poll);
@@ -127,40 +140,23 @@ void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
   }
 }
 
-void M2NanoDriver::serviceRequests() {
-  // Pause and resume are the same packet, "PN", which the board toggles on.
-  if (pauseRequested_.exchange(false) && !paused_) {
-    send(packet("PN"), nullptr);
-    paused_ = true;
-  }
-  if (resumeRequested_.exchange(false) && paused_) {
-    send(packet("PN"), nullptr);
-    paused_ = false;
-  }
-}
-
 void M2NanoDriver::sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel) {
   for (const std::string& line : lines) {
     for (const Packet& p : packets(line)) send(p, cancel);
   }
 }
 
-void M2NanoDriver::waitFinished(Millis limit, const CancelFlag* cancel, const std::function<void()>& tick) {
-  auto until = Clock::now() + limit;
+void M2NanoDriver::waitFinished(Millis limit, const CancelFlag* cancel) {
+  const auto until = Clock::now() + limit;
   for (;;) {
     if (std::exchange(finishedSeen_, false)) return;
     if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
-    const bool wasPaused = paused_;
-    const auto before = Clock::now();
-    serviceRequests();
     const int status = readStatus();
     if (status == kFinished) return;
     if (status == kPowerFault) {
       throw DeviceFault(FaultKind::Alarm, link_->name() + ": the board reports a power fault (status 239)");
     }
-    if (tick) tick();
-    std::this_thread::sleep_for(paused_ ? Millis(100) : timeouts_.poll);
-    if (wasPaused) until += Clock::now() - before;  // time held does not count
+    std::this_thread::sleep_for(timeouts_.poll);
     if (Clock::now() > until) {
       throw DeviceFault(FaultKind::Timeout,
                         fmt::format("{}: the board did not report the job finished within {} s", link_->name(),
@@ -170,24 +166,35 @@ void M2NanoDriver::waitFinished(Millis limit, const CancelFlag* cancel, const st
 }
 
 bool M2NanoDriver::stopSafely() noexcept {
-  // "I" alone (K40 Whisperer's emergency stop): the board drops what it has
-  // queued and leaves compact mode, where alone it fires the laser. Sent at
-  // once, without waiting for the board to be ready.
+  // "I" alone (K40 Whisperer's emergency stop): the board leaves compact
+  // mode, where alone the laser fires, and drops what it has queued. Sent at
+  // once, without waiting for the board to be ready. A board that took it
+  // says OK; one that has run it (even behind what it had queued) can then
+  // home ("IPP") and say it has finished: only that confirms the laser off.
   try {
     if (!link_) return false;
     paused_ = false;
+    busy_ = timeouts_.busy;
+    const auto until = Clock::now() + timeouts_.stop;
     const Packet stop = packet("I");
-    const auto until = Clock::now() + timeouts_.ready;
-    for (int sent = 0; sent < 5 && Clock::now() < until; ++sent) {
+    bool taken = false;
+    for (int sent = 0; sent < 5 && !taken && Clock::now() < until; ++sent) {
       link_->bulkWrite(kOut, stop.data(), stop.size(), timeouts_.transfer);
-      for (;;) {
-        const int status = readStatus();
-        if (status == kOk || status == kFinished) return true;
-        if (status == kCrcError || Clock::now() > until) break;
+      int status = readStatus();
+      while ((status == kBusy || status == kFinished) && Clock::now() < until) {
         std::this_thread::sleep_for(timeouts_.poll);
+        status = readStatus();
       }
+      if (status == kPowerFault) return false;  // it may not have taken it
+      taken = status == kOk;
     }
-    return false;
+    if (!taken) return false;
+    send(packet("IPP"), nullptr);
+    for (;;) {
+      if (std::exchange(finishedSeen_, false) || readStatus() == kFinished) return true;
+      if (Clock::now() > until) return false;
+      std::this_thread::sleep_for(timeouts_.poll);
+    }
   } catch (...) {
     return false;
   }
@@ -197,7 +204,7 @@ void M2NanoDriver::home() {
   if (!link_) connect();
   try {
     sendLines({"IPP"}, nullptr);
-    waitFinished(Millis(60000), nullptr, {});
+    waitFinished(Millis(60000), nullptr);
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }
@@ -210,7 +217,7 @@ void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
     sendLines(frameLines(toolpath, mmPerSecond), nullptr);
     const auto box = jobs::toolpathBounds(toolpath);
     const double seconds = (2 * (box[2] - box[0] + box[3] - box[1]) + box[2] + box[3]) * 25.4 / mmPerSecond;
-    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * seconds * 1000)), nullptr, {});
+    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * seconds * 1000)), nullptr);
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }
@@ -219,43 +226,91 @@ void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
 void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
                        const CancelFlag& cancel) {
   if (!link_) connect();
+  pauseRequested_ = false, resumeRequested_ = false;  // requests from before the job are not for it
   try {
-    const LhymicroJob job = jobProgram(toolpath);
+    // A packet's moves can take long at a slow speed ('z' is 255 mils): a
+    // full board makes room only when it has run one.
+    double slowest = 100;
+    for (const jobs::ToolpathStroke& stroke : toolpath.strokes) slowest = std::min(slowest, stroke.speed * 25.4);
+    busy_ = std::max(timeouts_.busy, Millis(static_cast<long>(2 * 30 * 255 * 0.0254 / std::max(slowest, 1.0) * 1000)));
+    const LhymicroJob whole = jobProgram(toolpath);
     Progress report;
     report.sheet = toolpath.sheet;
     report.strokes = toolpath.strokes.size();
-    for (const std::string& line : job.lines) report.bytesTotal += line.size();
-    const auto tell = [&] {
-      const double done = static_cast<double>(report.bytesAcknowledged) / std::max<size_t>(report.bytesTotal, 1);
-      report.secondsLeft = toolpath.seconds * (1 - done);  // the board queues only a few packets
-      while (report.stroke < job.strokeEnds.size() && job.strokeEnds[report.stroke] <= report.bytesAcknowledged)
-        ++report.stroke;
-      if (progress) progress(report);
-    };
-    for (const std::string& line : job.lines) {
-      for (size_t at = 0; at < line.size(); at += 30) {
-        serviceRequests();
-        while (paused_) {  // no packet while held: the board's queue would fill and stay full
+    for (const std::string& line : whole.lines) report.bytesTotal += line.size();
+    // The program sent: the whole job, or after a hold, the rest of it from stroke `first` on.
+    bool finishing = false;  // the job's end (FNSE) has been sent
+    for (size_t first = 0;;) {
+      const LhymicroJob job = first == 0 ? whole : jobProgram(toolpath, first);
+      size_t programBytes = 0, sent = 0;
+      for (const std::string& line : job.lines) programBytes += line.size();
+      const size_t base = first == 0 ? 0 : whole.strokeEnds[first - 1];
+      const auto tell = [&] {
+        report.bytesAcknowledged =
+            base + static_cast<size_t>(static_cast<double>(sent) * static_cast<double>(report.bytesTotal - base) /
+                                       static_cast<double>(std::max<size_t>(programBytes, 1)));
+        report.stroke =
+            first + static_cast<size_t>(std::upper_bound(job.strokeEnds.begin(), job.strokeEnds.end(), sent) -
+                                        job.strokeEnds.begin());
+        report.secondsLeft =  // the board queues only a few packets
+            toolpath.seconds * (1 - static_cast<double>(report.bytesAcknowledged) /
+                                        static_cast<double>(std::max<size_t>(report.bytesTotal, 1)));
+        if (progress) progress(report);
+      };
+      std::optional<size_t> heldAfter;  // the stroke of `job` after which the job is held
+      for (const std::string& line : job.lines) {
+        const size_t lineStart = sent;
+        for (size_t at = 0; at < line.size() && !heldAfter;) {
           if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
-          std::this_thread::sleep_for(Millis(100));
-          readStatus();  // the board must still answer
-          serviceRequests();
+          // A hold comes at the end of the next stroke in this line, where
+          // the laser is off: the rest of the stroke, then "@NSE" (compact
+          // mode left, the job not finished), then nothing until the resume.
+          // (The board's own pause, "PN", could stop it with the laser lit.)
+          const auto end = std::lower_bound(job.strokeEnds.begin(), job.strokeEnds.end(), lineStart + at);
+          if (pauseRequested_ && end != job.strokeEnds.end() && *end <= lineStart + line.size()) {
+            pauseRequested_ = false;
+            for (const Packet& p : packets(line.substr(at, *end - lineStart - at) + "@NSE")) send(p, &cancel);
+            sent = *end;
+            heldAfter = static_cast<size_t>(end - job.strokeEnds.begin());
+            tell();
+            break;
+          }
+          const size_t upTo = std::min(line.size(), at + 30);
+          send(packet(line.substr(at, upTo - at)), &cancel);
+          sent += upTo - at, at = upTo;
+          tell();
         }
-        if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
-        send(packet(line.substr(at, 30)), &cancel);
-        report.bytesAcknowledged += std::min<size_t>(30, line.size() - at);
-        tell();
+        if (heldAfter) break;
       }
+      if (!heldAfter) {
+        finishing = !job.strokeEnds.empty();
+        break;
+      }
+      paused_ = true;
+      while (!resumeRequested_.exchange(false)) {
+        if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
+        std::this_thread::sleep_for(Millis(100));
+        readStatus();  // the board must still answer
+      }
+      paused_ = false;
+      first += *heldAfter + 1;
+      if (first == toolpath.strokes.size()) break;  // held after the last stroke: nothing left to cut
     }
-    // The board has the whole job queued; it has cut it when it says "finished".
-    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * toolpath.seconds * 1000)), &cancel, tell);
+    // The board has the rest of the job queued; it has cut it when it says
+    // "finished" (a job held after its last stroke never says it: the home does).
+    if (finishing) {
+      waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * toolpath.seconds * 1000)), &cancel);
+    }
     report.stroke = report.strokes;
+    report.bytesAcknowledged = report.bytesTotal;
     report.secondsLeft = 0;
     if (progress) progress(report);
     // Home, so that the next sheet starts from a known place.
     sendLines({"IPP"}, &cancel);
-    waitFinished(Millis(60000), &cancel, {});
+    waitFinished(Millis(60000), &cancel);
+    busy_ = timeouts_.busy;
   } catch (...) {
+    busy_ = timeouts_.busy;
     stopAndRethrow([this] { return stopSafely(); });
   }
 }

@@ -8,7 +8,9 @@
 // send it again; 236 the job has finished; 239 a power fault. Learnt from
 // MeerK40t, K40 Whisperer and LibLaserCut (none of their code is used).
 // On any fault or cancel the driver sends "I", which drops what the board
-// has queued and leaves compact mode, so the laser is off.
+// has queued and leaves compact mode, so the laser is off; that is
+// confirmed when the board has homed after it. A pause holds the job at the
+// end of a stroke, the laser off, and a resume sends the rest.
 
 #include <atomic>
 #include <functional>
@@ -23,7 +25,8 @@ namespace rotafab::devices::m2nano {
 struct M2NanoTimeouts {
   Millis transfer{1500};   // any one USB transfer
   Millis ready{5000};      // for the board to report OK after connecting or an abort
-  Millis busy{60000};      // for a busy board to take the next packet (its queue drains as it cuts)
+  Millis busy{60000};      // for a busy board to take the next packet (its queue drains as it cuts; more for slow jobs)
+  Millis stop{30000};      // after a fault: for the board to take "I" and home
   Millis poll{20};         // between status requests while the board is busy
   int crcResends = 50;     // a packet rejected this many times in a row is a fault
   double finishSlack = 3;  // wait this many times the estimated time (plus a minute) for the job to finish
@@ -51,17 +54,17 @@ class M2NanoDriver : public Device {
   void send(const Packet& packet, const CancelFlag* cancel);
   void sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel);
   // Polls until the board reports the job finished (236).
-  void waitFinished(Millis limit, const CancelFlag* cancel, const std::function<void()>& tick);
-  // "I" (and the status after it); whether the board took it. Never throws.
+  void waitFinished(Millis limit, const CancelFlag* cancel);
+  // "I", then a home; whether the board confirmed both. Never throws.
   bool stopSafely() noexcept;
-  void serviceRequests();
 
   std::function<std::unique_ptr<UsbLink>()> open_;
   M2NanoTimeouts timeouts_;
   std::unique_ptr<UsbLink> link_;
   std::atomic<bool> pauseRequested_{false}, resumeRequested_{false};
-  bool paused_ = false;
-  bool finishedSeen_ = false;  // the board said "finished" after the last packet sent
+  bool paused_ = false;           // held at the end of a stroke
+  bool finishedSeen_ = false;     // the board said "finished" after the last packet sent
+  Millis busy_ = timeouts_.busy;  // this job's limit for a busy board
   size_t resends_ = 0;
 };
 

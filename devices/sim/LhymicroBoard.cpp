@@ -30,7 +30,7 @@ void LhymicroBoard::accept(const std::array<uint8_t, 30>& payload) {
   size_t end = payload.size();
   while (end > 0 && payload[end - 1] == 'F') --end;
   const std::string_view text(reinterpret_cast<const char*>(payload.data()), end);
-  if (text == "I") {
+  if (text == "I" && options_.abortAtOnce) {
     ++packetsExecuted_;
     abort();
     return;

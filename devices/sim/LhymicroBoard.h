@@ -11,6 +11,9 @@
 //   it drops every queued packet and stops the move in progress where the
 //   head is (K40 Whisperer sends it without waiting; queued behind the job it
 //   would abort nothing). An 'I' inside a longer packet resets in turn.
+//   Whether a real board takes it at once is not documented: with
+//   `abortAtOnce` off, it waits its turn like any packet (the driver must
+//   not call the laser off before the board has run it).
 // - A packet that is only "P" or "PN" toggles the pause at once, even when the
 //   buffer is full: queued behind a paused executor, the resume could never run.
 //   A move in progress freezes where it is and continues on resume.
@@ -56,6 +59,7 @@ struct LhymicroBoardOptions {
   double rapidMmPerSecond = 100;                    // default-mode moves and compact-mode jogs
   double homeSeconds = 0.5;                         // "IPP", wherever the head is
   size_t capacityPackets = 8;                       // the board's buffer (its real depth is unknown)
+  bool abortAtOnce = true;                          // a lone "I" acts on arrival (see above)
 };
 
 class LhymicroBoard {

@@ -131,6 +131,7 @@ struct M2NanoSimulator::State {
 
   void takePacket(const uint8_t* bytes) {
     checking = true;
+    wasFinished = false;  // a "finished" from now on is a new one
     bool good = bytes[0] == 0xA6 && bytes[1] == 0x00 && bytes[32] == 0xA6 && m2nano::crc8(bytes + 2, 30) == bytes[33];
     if (good && corrupt > 0) --corrupt, good = false;  // as if a byte flipped on the way
     rejected = !good;
@@ -324,14 +325,23 @@ bool umockdevPreloaded() {
 }
 
 void runUnderUmockdev(char** argv) {
-  if (umockdevPreloaded()) return;
-  if (std::getenv("ROTAFAB_UMOCKDEV_RESTARTED")) {
-    throw std::runtime_error("umockdev's preload library did not load (is Debian's libumockdev0 installed?)");
+  if (umockdevPreloaded()) {
+    ::unsetenv("ROTAFAB_UMOCKDEV_RESTARTED");
+    return;
+  }
+  // Where Debian's libumockdev0 puts it (pkg-config's libdir at build time).
+  const std::string library = ROTAFAB_UMOCKDEV_PRELOAD;
+  if (std::getenv("ROTAFAB_UMOCKDEV_RESTARTED") || ::access(library.c_str(), R_OK) != 0) {
+    throw std::runtime_error(
+        fmt::format("umockdev's preload library {} is not there or did not load (is Debian's "
+                    "libumockdev0 installed?)",
+                    library));
   }
   ::setenv("ROTAFAB_UMOCKDEV_RESTARTED", "1", 1);
+  // After what is preloaded already (a sanitizer's runtime must come first).
   const char* preload = std::getenv("LD_PRELOAD");
-  std::string libraries = "libumockdev-preload.so.0";
-  if (preload && *preload) libraries.append(":").append(preload);
+  std::string libraries = preload && *preload ? std::string(preload) + ":" : std::string();
+  libraries += library;
   ::setenv("LD_PRELOAD", libraries.c_str(), 1);
   // In a sanitizer build the preload comes before the sanitizer's runtime, which it would refuse.
   std::string asan = std::getenv("ASAN_OPTIONS") ? std::getenv("ASAN_OPTIONS") : "";
@@ -366,6 +376,8 @@ M2NanoSimulator::M2NanoSimulator(M2NanoSimulatorOptions options) : state_(std::m
 }
 
 M2NanoSimulator::~M2NanoSimulator() {
+  // No request reaches the state once it is gone (a driver may still hold the device open).
+  g_signal_handlers_disconnect_by_data(state_->handler, state_.get());
   umockdev_testbed_detach_ioctl(state_->testbed, kDeviceNode, nullptr);
   g_object_unref(state_->testbed);
   g_object_unref(state_->handler);

@@ -8,6 +8,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <set>
 #include <thread>
@@ -45,7 +46,7 @@ jobs::Toolpath toolpath() {
 
 m2nano::M2NanoTimeouts quick() {
   m2nano::M2NanoTimeouts t;
-  t.transfer = std::chrono::milliseconds(300);
+  t.transfer = std::chrono::milliseconds(1500);
   t.ready = std::chrono::milliseconds(2000);
   t.busy = std::chrono::milliseconds(5000);
   t.poll = std::chrono::milliseconds(5);
@@ -54,13 +55,13 @@ m2nano::M2NanoTimeouts quick() {
 
 // A simulated board running `timeScale` times faster than real, and a driver connected to it.
 struct Rig {
-  explicit Rig(double timeScale)
+  explicit Rig(double timeScale, m2nano::M2NanoTimeouts timeouts = quick())
       : simulator([&] {
           sim::M2NanoSimulatorOptions options;
           options.timeScale = timeScale;
           return options;
         }()),
-        driver([match = simulator.match()] { return UsbLink::open(match, 0); }, quick()) {
+        driver([match = simulator.match()] { return UsbLink::open(match, 0); }, timeouts) {
     identity = driver.connect();
   }
   ~Rig() { driver.disconnect(); }  // before the device goes
@@ -150,8 +151,13 @@ TEST(M2Nano, CutsTheSheetAsDrawnAndHomes) {
     EXPECT_GE(reports[i].bytesAcknowledged, reports[i - 1].bytesAcknowledged);
     EXPECT_GE(reports[i].stroke, reports[i - 1].stroke);
   }
-  EXPECT_EQ(reports.back().stroke, path.strokes.size());
-  EXPECT_EQ(reports.back().bytesAcknowledged, reports.back().bytesTotal);
+  // (The last report, once the board has finished, says so regardless; the
+  // one before counts the strokes the board took.)
+  ASSERT_GE(reports.size(), 3u);
+  const Progress& sent = reports[reports.size() - 2];
+  EXPECT_EQ(sent.stroke, path.strokes.size());
+  EXPECT_EQ(sent.bytesAcknowledged, sent.bytesTotal);
+  EXPECT_LT(reports.front().stroke, path.strokes.size() / 2);
   EXPECT_EQ(rig.driver.resends(), 0u);
 }
 
@@ -244,12 +250,14 @@ TEST(M2Nano, UnplugMidJobIsADisconnectNotAHang) {
 }
 
 TEST(M2Nano, ABoardThatStopsAnsweringIsATimeoutAndStillGetsTheStop) {
-  Rig rig(40);
+  auto timeouts = quick();
+  timeouts.transfer = std::chrono::milliseconds(300);  // a silent board: three requests of 300 ms
+  Rig rig(40, timeouts);
   const Outcome outcome = runInto(rig, 4, [](sim::M2NanoSimulator& s) { s.mute(true); });
   EXPECT_EQ(outcome.kind, FaultKind::Timeout) << outcome.what;
   EXPECT_FALSE(outcome.laserOffConfirmed);
   EXPECT_LT(outcome.seconds, 15);
-  // The board still took the stop packet ("I"): its laser is off and its queue dropped.
+  // The board still took the stop packet ("I"), unconfirmed: its laser is off and its queue dropped.
   const auto record = rig.simulator.record();
   EXPECT_FALSE(record.laser);
   EXPECT_EQ(record.mode, sim::BoardMode::Default);
@@ -276,31 +284,85 @@ TEST(M2Nano, APowerFaultIsAnAlarm) {
   EXPECT_NE(record.mode, sim::BoardMode::Compact);
 }
 
-TEST(M2Nano, PauseHoldsTheHeadAndResumeFinishesTheJob) {
+// A pause holds the job at the end of a stroke: the board runs what it has,
+// leaves compact mode and stands with its laser off; a resume sends the
+// rest, and every stroke is burnt once, whole.
+TEST(M2Nano, PauseHoldsAtAStrokesEndWithTheLaserOffAndResumeFinishes) {
   Rig rig(20);
   const jobs::Toolpath path = toolpath();
   CancelFlag cancel;
-  std::atomic<bool> paused{false};
-  std::thread job([&] { rig.driver.run(path, {}, cancel); });
-  // Pause once the board has started burning.
-  const auto until = Clock::now() + std::chrono::seconds(20);
+  std::exception_ptr failed;
+  std::thread job([&] {
+    try {
+      rig.driver.run(path, {}, cancel);
+    } catch (...) {
+      failed = std::current_exception();
+    }
+  });
+  const auto until = Clock::now() + std::chrono::seconds(30);
   while (burns(rig.simulator.record().trace).empty() && Clock::now() < until)
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   rig.driver.pause();
-  while (!rig.simulator.record().paused && Clock::now() < until)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  const auto held = rig.simulator.record();
-  EXPECT_TRUE(held.paused);
+  auto held = rig.simulator.record();
+  while ((held.busy || held.mode != sim::BoardMode::Default) && Clock::now() < until) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    held = rig.simulator.record();
+  }
+  EXPECT_FALSE(held.busy);
+  EXPECT_EQ(held.mode, sim::BoardMode::Default);
+  EXPECT_FALSE(held.laser);
+  // The head stands where a stroke ended.
+  bool atAStrokesEnd = false;
+  for (const jobs::ToolpathStroke& stroke : path.strokes) {
+    atAStrokesEnd |= held.x == std::lround(stroke.points.back().x() * 1000) &&
+                     held.y == std::lround((path.height - stroke.points.back().y()) * 1000);
+  }
+  EXPECT_TRUE(atAStrokesEnd) << held.x << ", " << held.y;
+  const size_t burntWhenHeld = burns(held.trace).size();
+  EXPECT_LT(burntWhenHeld, path.strokes.size());
   std::this_thread::sleep_for(std::chrono::milliseconds(400));
-  const auto stillHeld = rig.simulator.record();
-  EXPECT_EQ(stillHeld.x, held.x);
-  EXPECT_EQ(stillHeld.y, held.y);
+  EXPECT_EQ(rig.simulator.record().trace.size(), held.trace.size()) << "nothing moves while held";
   rig.driver.resume();
   job.join();
+  if (failed) std::rethrow_exception(failed);
   const auto record = rig.simulator.record();
-  EXPECT_FALSE(record.paused);
-  EXPECT_EQ(burns(record.trace).size(), path.strokes.size());  // a stroke held part way goes on where it stopped
+  const auto burnt = burns(record.trace);
+  ASSERT_EQ(burnt.size(), path.strokes.size());
+  for (size_t i = 0; i < burnt.size(); ++i) {
+    const auto& end = path.strokes[i].points.back();
+    EXPECT_EQ(burnt[i].back(), (std::pair{std::lround(end.x() * 1000), std::lround((path.height - end.y()) * 1000)}));
+  }
   EXPECT_TRUE(record.violations.empty()) << record.violations.front();
+}
+
+// A board that runs "I" in its turn, behind the packets it has queued: the
+// laser is called off only once the board has run it and homed.
+TEST(M2Nano, AStopTheBoardRunsInItsTurnIsConfirmedOnlyOnceRun) {
+  sim::M2NanoSimulatorOptions options;
+  options.timeScale = 5;
+  options.board.abortAtOnce = false;
+  sim::M2NanoSimulator simulator(options);
+  m2nano::M2NanoDriver driver([match = simulator.match()] { return UsbLink::open(match, 0); }, quick());
+  driver.connect();
+  CancelFlag cancel;
+  try {
+    driver.run(
+        toolpath(),
+        [&](const Progress& p) {
+          if (p.stroke >= 2) cancel.cancel();
+        },
+        cancel);
+    FAIL() << "the job ran to its end";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Cancelled);
+    EXPECT_TRUE(fault.laserOffConfirmed);
+  }
+  const auto record = simulator.record();
+  EXPECT_FALSE(record.busy) << "confirmed before the board had run its queue";
+  EXPECT_FALSE(record.laser);
+  EXPECT_EQ(record.x, 0);  // homed
+  EXPECT_EQ(record.y, 0);
+  driver.disconnect();
 }
 
 TEST(M2Nano, FramingTracesTheBoxWithTheLaserOff) {
