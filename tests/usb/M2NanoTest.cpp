@@ -56,12 +56,15 @@ m2nano::M2NanoTimeouts quick() {
 // A simulated board running `timeScale` times faster than real, and a driver connected to it.
 struct Rig {
   explicit Rig(double timeScale, m2nano::M2NanoTimeouts timeouts = quick())
-      : simulator([&] {
-          sim::M2NanoSimulatorOptions options;
-          options.timeScale = timeScale;
-          return options;
-        }()),
-        driver([match = simulator.match()] { return UsbLink::open(match, 0); }, timeouts) {
+      : Rig(
+            [&] {
+              sim::M2NanoSimulatorOptions options;
+              options.timeScale = timeScale;
+              return options;
+            }(),
+            timeouts) {}
+  explicit Rig(const sim::M2NanoSimulatorOptions& options, m2nano::M2NanoTimeouts timeouts = quick())
+      : simulator(options), driver([match = simulator.match()] { return UsbLink::open(match, 0); }, timeouts) {
     identity = driver.connect();
   }
   ~Rig() { driver.disconnect(); }  // before the device goes
@@ -215,12 +218,12 @@ Outcome runInto(Rig& rig, size_t packets, std::function<void(sim::M2NanoSimulato
   return {FaultKind::Protocol, false, "", 0};
 }
 
-TEST(M2Nano, CancelMidJobDropsTheQueueAndLeavesTheLaserOff) {
-  Rig rig(2);
+// Runs the job and cancels it once two strokes are taken: a Cancelled
+// fault, with the laser off confirmed.
+void cancelAfterTwoStrokes(m2nano::M2NanoDriver& driver, const jobs::Toolpath& path) {
   CancelFlag cancel;
-  const jobs::Toolpath path = toolpath();
   try {
-    rig.driver.run(
+    driver.run(
         path,
         [&](const Progress& p) {
           if (p.stroke >= 2) cancel.cancel();
@@ -231,6 +234,12 @@ TEST(M2Nano, CancelMidJobDropsTheQueueAndLeavesTheLaserOff) {
     EXPECT_EQ(fault.kind, FaultKind::Cancelled);
     EXPECT_TRUE(fault.laserOffConfirmed);
   }
+}
+
+TEST(M2Nano, CancelMidJobDropsTheQueueAndLeavesTheLaserOff) {
+  Rig rig(2);
+  const jobs::Toolpath path = toolpath();
+  cancelAfterTwoStrokes(rig.driver, path);
   const auto before = rig.simulator.record();
   EXPECT_FALSE(before.laser);
   EXPECT_EQ(before.mode, sim::BoardMode::Default);
@@ -341,28 +350,13 @@ TEST(M2Nano, AStopTheBoardRunsInItsTurnIsConfirmedOnlyOnceRun) {
   sim::M2NanoSimulatorOptions options;
   options.timeScale = 5;
   options.board.abortAtOnce = false;
-  sim::M2NanoSimulator simulator(options);
-  m2nano::M2NanoDriver driver([match = simulator.match()] { return UsbLink::open(match, 0); }, quick());
-  driver.connect();
-  CancelFlag cancel;
-  try {
-    driver.run(
-        toolpath(),
-        [&](const Progress& p) {
-          if (p.stroke >= 2) cancel.cancel();
-        },
-        cancel);
-    FAIL() << "the job ran to its end";
-  } catch (const DeviceFault& fault) {
-    EXPECT_EQ(fault.kind, FaultKind::Cancelled);
-    EXPECT_TRUE(fault.laserOffConfirmed);
-  }
-  const auto record = simulator.record();
+  Rig rig(options);
+  cancelAfterTwoStrokes(rig.driver, toolpath());
+  const auto record = rig.simulator.record();
   EXPECT_FALSE(record.busy) << "confirmed before the board had run its queue";
   EXPECT_FALSE(record.laser);
   EXPECT_EQ(record.x, 0);  // homed
   EXPECT_EQ(record.y, 0);
-  driver.disconnect();
 }
 
 TEST(M2Nano, FramingTracesTheBoxWithTheLaserOff) {
