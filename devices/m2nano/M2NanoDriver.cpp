@@ -78,7 +78,7 @@ std::string M2NanoDriver::connect() {
   }
   resends_ = 0;
   paused_ = false;
-  pauseRequested_ = false, resumeRequested_ = false;
+  holdWanted_ = false;
   keep.connected = true;
   return fmt::format("Lihuiyu M2 Nano on {}{}", link_->name(), chip);
 }
@@ -107,13 +107,13 @@ int M2NanoDriver::readStatus() {
   }
 }
 
-void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
+void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel, Clock::time_point deadline) {
   finishedSeen_ = false;
   for (int rejected = 0;;) {
     link_->bulkWrite(kOut, packet.data(), packet.size(), timeouts_.transfer);
     // Busy (238) means the board is still checking the packet or has no room
     // for another yet: ask again until it says OK, or that the packet arrived corrupted.
-    const auto until = Clock::now() + busy_;
+    const auto until = std::min(deadline, Clock::now() + busy_);
     int status = readStatus();
     for (int polls = 1; status != kOk && status != kCrcError; ++polls) {
       // The board can finish (FNSE, a home) before it says OK to the packet that ended the job.
@@ -131,6 +131,9 @@ void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel) {
       status = readStatus();
     }
     if (status == kOk) return;
+    if (Clock::now() > deadline) {
+      throw DeviceFault(FaultKind::Timeout, link_->name() + ": the board rejected the packet until the time ran out");
+    }
     ++resends_;
     if (++rejected >= timeouts_.crcResends) {
       throw DeviceFault(FaultKind::Protocol, fmt::format("{}: the board rejected the same packet {} times (CRC "
@@ -189,7 +192,7 @@ bool M2NanoDriver::stopSafely() noexcept {
       taken = status == kOk;
     }
     if (!taken) return false;
-    send(packet("IPP"), nullptr);
+    send(packet("IPP"), nullptr, until);
     for (;;) {
       if (std::exchange(finishedSeen_, false) || readStatus() == kFinished) return true;
       if (Clock::now() > until) return false;
@@ -226,7 +229,7 @@ void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
 void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
                        const CancelFlag& cancel) {
   if (!link_) connect();
-  pauseRequested_ = false, resumeRequested_ = false;  // requests from before the job are not for it
+  holdWanted_ = false;  // a pause from before the job is not for it
   try {
     // A packet's moves can take long at a slow speed ('z' is 255 mils): a
     // full board makes room only when it has run one.
@@ -246,9 +249,12 @@ void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(
       for (const std::string& line : job.lines) programBytes += line.size();
       const size_t base = first == 0 ? 0 : whole.strokeEnds[first - 1];
       const auto tell = [&] {
-        report.bytesAcknowledged =
+        // (Proportional within a resumed program, whose bytes differ from the
+        // whole job's; never backwards across a hold.)
+        report.bytesAcknowledged = std::max(
+            report.bytesAcknowledged,
             base + static_cast<size_t>(static_cast<double>(sent) * static_cast<double>(report.bytesTotal - base) /
-                                       static_cast<double>(std::max<size_t>(programBytes, 1)));
+                                       static_cast<double>(std::max<size_t>(programBytes, 1))));
         report.stroke =
             first + static_cast<size_t>(std::upper_bound(job.strokeEnds.begin(), job.strokeEnds.end(), sent) -
                                         job.strokeEnds.begin());
@@ -267,8 +273,7 @@ void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(
           // mode left, the job not finished), then nothing until the resume.
           // (The board's own pause, "PN", could stop it with the laser lit.)
           const auto end = std::lower_bound(job.strokeEnds.begin(), job.strokeEnds.end(), lineStart + at);
-          if (pauseRequested_ && end != job.strokeEnds.end() && *end <= lineStart + line.size()) {
-            pauseRequested_ = false;
+          if (holdWanted_ && end != job.strokeEnds.end() && *end <= lineStart + line.size()) {
             for (const Packet& p : packets(line.substr(at, *end - lineStart - at) + "@NSE")) send(p, &cancel);
             sent = *end;
             heldAfter = static_cast<size_t>(end - job.strokeEnds.begin());
@@ -287,10 +292,12 @@ void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(
         break;
       }
       paused_ = true;
-      while (!resumeRequested_.exchange(false)) {
+      while (holdWanted_) {
         if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
         std::this_thread::sleep_for(Millis(100));
-        readStatus();  // the board must still answer
+        if (readStatus() == kPowerFault) {  // the board must still answer, and well
+          throw DeviceFault(FaultKind::Alarm, link_->name() + ": the board reports a power fault (status 239)");
+        }
       }
       paused_ = false;
       first += *heldAfter + 1;

@@ -40,8 +40,11 @@ class M2NanoDriver : public Device {
   void frame(const jobs::Toolpath& toolpath) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const CancelFlag& cancel) override;
-  void pause() override { pauseRequested_ = true; }
-  void resume() override { resumeRequested_ = true; }
+  // A hold is wanted from pause() until resume(); run() holds at the next
+  // stroke's end (one the board has not been sent yet: a pause in the last
+  // few packets of a job comes too late, and the job ends).
+  void pause() override { holdWanted_ = true; }
+  void resume() override { holdWanted_ = false; }
   DeviceStatus status() override;
   void disconnect() override;
 
@@ -50,8 +53,9 @@ class M2NanoDriver : public Device {
 
  private:
   int readStatus();
-  // Sends one packet until the board takes it (status OK).
-  void send(const Packet& packet, const CancelFlag* cancel);
+  // Sends one packet until the board takes it (status OK), by `deadline` if one is given.
+  void send(const Packet& packet, const CancelFlag* cancel,
+            std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
   void sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel);
   // Polls until the board reports the job finished (236).
   void waitFinished(Millis limit, const CancelFlag* cancel);
@@ -61,7 +65,7 @@ class M2NanoDriver : public Device {
   std::function<std::unique_ptr<UsbLink>()> open_;
   M2NanoTimeouts timeouts_;
   std::unique_ptr<UsbLink> link_;
-  std::atomic<bool> pauseRequested_{false}, resumeRequested_{false};
+  std::atomic<bool> holdWanted_{false};
   bool paused_ = false;           // held at the end of a stroke
   bool finishedSeen_ = false;     // the board said "finished" after the last packet sent
   Millis busy_ = timeouts_.busy;  // this job's limit for a busy board

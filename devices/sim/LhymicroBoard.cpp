@@ -257,7 +257,15 @@ void LhymicroBoard::interpret(uint8_t byte) {
   }
   if (mode_ == BoardMode::Finished) return;  // until the next 'I'
   // "FNSE" / "@NSE" must come unbroken: padding 'F' followed by anything else was only padding.
-  if (leavingStep_ > 0 && c != "NSE"[leavingStep_ - 1]) leaving_ = 0, leavingStep_ = 0;
+  if (leavingStep_ > 0 && c != "NSE"[leavingStep_ - 1]) {
+    // Padding inside compact mode is a hazard: a real board may read its 'F'
+    // as the start of a finish (MeerK40t's parser does). Drivers pad only
+    // after "@NSE", "FNSE" or a default-mode line.
+    if (leaving_ == 'F' && c != 'F' && mode_ == BoardMode::Compact) {
+      violation(fmt::format("padding 'F' inside compact mode, before '{}', in packet {}", c, packetsExecuted_ + 1));
+    }
+    leaving_ = 0, leavingStep_ = 0;
+  }
 
   if (c >= '0' && c <= '9') {
     switch (digits_) {

@@ -31,7 +31,8 @@
 //   reverses in compact mode; a second 'G' group (unidirectional) is read and ignored.
 // - A packet accepted while full() is kept but is a violation (the host must
 //   wait for 206), as are bytes outside the language, digits left over before
-//   a letter, unreadable speed codes and the head leaving the bed.
+//   a letter, unreadable speed codes, the head leaving the bed, and 'F'
+//   padding inside compact mode (not followed by "NSE").
 
 #include <array>
 #include <cstddef>

@@ -77,6 +77,59 @@ jobs::Toolpath sampleToolpath() {
   return path;
 }
 
+// The laser-on moves of a trace, in order.
+std::vector<std::array<long, 4>> litMoves(const LhymicroBoard& board) {
+  std::vector<std::array<long, 4>> moves;
+  for (const BoardSegment& s : board.trace()) {
+    if (s.laser) moves.push_back({s.x0, s.y0, s.x1, s.y1});
+  }
+  return moves;
+}
+
+// A job held after stroke k (what the driver sends on a pause: the job up to
+// the stroke's end, then "@NSE") and resumed with jobProgram(toolpath, k + 1)
+// burns what the whole job burns, move for move, and breaks no rule.
+TEST(LhymicroBoard, AJobHeldAfterAnyStrokeAndResumedBurnsTheSame) {
+  const jobs::Toolpath path = sampleToolpath();
+  const m2nano::LhymicroJob whole = m2nano::jobProgram(path);
+  LhymicroBoard reference;
+  for (const std::string& line : whole.lines) feed(reference, line);
+  runToEnd(reference);
+  ASSERT_EQ(whole.strokeEnds.size(), path.strokes.size());
+  for (size_t k = 0; k < path.strokes.size(); ++k) {
+    std::string stream;
+    for (const std::string& line : whole.lines) stream += line;
+    LhymicroBoard board;
+    // Up to the end of stroke k, cut where the driver cuts it: "IPP" alone, then the rest with "@NSE".
+    feed(board, "IPP");
+    feed(board, stream.substr(3, whole.strokeEnds[k] - 3) + "@NSE");
+    runToEnd(board);
+    EXPECT_FALSE(board.laser());
+    EXPECT_EQ(board.mode(), BoardMode::Default);
+    const m2nano::LhymicroJob rest = m2nano::jobProgram(path, k + 1);
+    EXPECT_EQ(rest.strokeEnds.size(), path.strokes.size() - k - 1);
+    if (k + 1 == path.strokes.size()) {
+      EXPECT_TRUE(rest.lines.empty());
+    }
+    for (const std::string& line : rest.lines) feed(board, line);
+    runToEnd(board);
+    EXPECT_EQ(litMoves(board), litMoves(reference)) << "held after stroke " << k + 1;
+    EXPECT_TRUE(board.violations().empty()) << "held after stroke " << k + 1 << ": " << allViolations(board);
+  }
+}
+
+// Padding inside compact mode is a rule break the board reports.
+TEST(LhymicroBoard, PaddingInsideCompactModeIsReported) {
+  LhymicroBoard board;
+  feed(board, "ICV2502451021000015CNRBS1EDzzz");  // a full packet: no padding
+  feed(board, "B");                               // padded: "BFFF...", and the next packet goes on
+  feed(board, "aU@NSE");
+  runToEnd(board);
+  ASSERT_FALSE(board.violations().empty());
+  EXPECT_NE(board.violations().front().find("padding 'F' inside compact mode"), std::string::npos)
+      << allViolations(board);
+}
+
 TEST(LhymicroBoard, RunsJobLinesAndReproducesTheStrokes) {
   const jobs::Toolpath path = sampleToolpath();
   LhymicroBoard::Options options;
