@@ -378,14 +378,15 @@ void addRunCommand(CLI::App& app, int& status, char** argv) {
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
   run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
-  run->add_option("--out", options->out, "With --dry-run: the file for the bytes (G-code for GRBL)");
+  run->add_option("--out", options->out,
+                  "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool)");
   run->add_option("--machine", options->machine, "Machine profile (default: the first whose driver the URI names)");
   run->add_option("--material", options->material, "Material profile: power and speed overrides")
       ->capture_default_str();
   run->footer(
       "Cuts etch, then score, then inner cuts, then outer cuts, each with the machine profile's power, speed and\n"
       "passes. Ctrl-C stops the job and leaves the laser off (GRBL: feed hold, reset, M5; M2 Nano: \"I\", which\n"
-      "drops the board's queue). Exit status 3 on a device fault.\n\n"
+      "drops the board's queue, then a home). Exit status 3 on a device fault.\n\n"
       "Examples:\n"
       "  rotafab make examples/cube.obj --structure band --machine grbl-diode-400 --out cube/\n"
       "  rotafab run cube/ --device sim:grbl\n"
