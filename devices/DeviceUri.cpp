@@ -4,6 +4,9 @@
 
 #include <charconv>
 #include <stdexcept>
+#include <tuple>
+#include <type_traits>
+#include <utility>
 
 #include "devices/grbl/GrblDriver.h"
 #include "devices/m2nano/M2NanoDriver.h"
@@ -37,12 +40,33 @@ class SimulatedM2Nano : public m2nano::M2NanoDriver {
   std::unique_ptr<sim::M2NanoSimulator> simulator_;
 };
 
+// `text` as a number, all of it (nothing when anything else is there).
+template <typename Number>
+std::optional<Number> wholeNumber(const std::string& text, int base = 10) {
+  Number value{};
+  const char* last = text.data() + text.size();
+  std::from_chars_result result;
+  if constexpr (std::is_floating_point_v<Number>) {
+    result = std::from_chars(text.data(), last, value);
+  } else {
+    result = std::from_chars(text.data(), last, value, base);
+  }
+  if (text.empty() || result.ec != std::errc() || result.ptr != last) return std::nullopt;
+  return value;
+}
+
 // "1a86" as a USB vendor or product id.
 std::optional<uint16_t> hexId(const std::string& text) {
-  unsigned value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value, 16);
-  if (text.size() != 4 || error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-  return static_cast<uint16_t>(value);
+  const auto value = wholeNumber<unsigned>(text, 16);
+  if (text.size() != 4 || !value) return std::nullopt;
+  return static_cast<uint16_t>(*value);
+}
+
+// "path?query" as the path and the query (empty when there is none).
+std::pair<std::string, std::string> splitQuery(const std::string& rest) {
+  const auto query = rest.find('?');
+  if (query == std::string::npos) return {rest, ""};
+  return {rest.substr(0, query), rest.substr(query + 1)};
 }
 
 }  // namespace
@@ -56,27 +80,23 @@ DeviceUri parseDeviceUri(const std::string& uri) {
   };
   DeviceUri parsed;
   if (uri.starts_with("sim:")) {
-    std::string rest = uri.substr(4);
-    const auto query = rest.find('?');
-    if (query != std::string::npos) {
-      const std::string option = rest.substr(query + 1);
-      rest.erase(query);
-      const std::string value = option.starts_with("speed=") ? option.substr(6) : "";
-      const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), parsed.simulatedSpeed);
-      if (value.empty() || error != std::errc() || end != value.data() + value.size() || !(parsed.simulatedSpeed > 0)) {
+    const auto [rest, option] = splitQuery(uri.substr(4));
+    if (uri.find('?') != std::string::npos) {
+      const auto speed = wholeNumber<double>(option.starts_with("speed=") ? option.substr(6) : "");
+      if (!speed || !(*speed > 0)) {
         throw bad(fmt::format("\"{}\": the simulator takes speed=N, a positive number", option));
       }
+      parsed.simulatedSpeed = *speed;
     }
     if (rest != "grbl" && rest != "m2nano") throw bad("the simulators are sim:grbl and sim:m2nano");
     parsed.driver = rest, parsed.transport = "sim";
     return parsed;
   }
   if (uri.starts_with("spool:")) {
-    parsed.driver = "spool", parsed.transport = "folder", parsed.path = uri.substr(6);
-    const auto query = parsed.path.find('?');
-    if (query != std::string::npos) {
-      const std::string option = parsed.path.substr(query + 1);
-      parsed.path.erase(query);
+    parsed.driver = "spool", parsed.transport = "folder";
+    std::string option;
+    std::tie(parsed.path, option) = splitQuery(uri.substr(6));
+    if (uri.find('?') != std::string::npos) {
       if (!option.starts_with("printer=") || option.size() == 8) {
         throw bad(fmt::format("\"{}\": the spool takes printer=NAME", option));
       }
@@ -87,17 +107,13 @@ DeviceUri parseDeviceUri(const std::string& uri) {
   }
   if (uri.starts_with("grbl://")) {
     parsed.driver = "grbl", parsed.transport = "serial";
-    std::string rest = uri.substr(7);
-    const auto query = rest.find('?');
-    if (query != std::string::npos) {
-      const std::string options = rest.substr(query + 1);
-      rest.erase(query);
+    const auto [rest, options] = splitQuery(uri.substr(7));
+    if (uri.find('?') != std::string::npos) {
       if (!options.starts_with("baud=")) throw bad(fmt::format("unknown option \"{}\" (only baud=N)", options));
       const std::string baud = options.substr(5);
-      const auto [end, error] = std::from_chars(baud.data(), baud.data() + baud.size(), parsed.baud);
-      if (error != std::errc() || end != baud.data() + baud.size() || parsed.baud == 0) {
-        throw bad(fmt::format("baud={}: not a baud rate", baud));
-      }
+      const auto value = wholeNumber<unsigned>(baud);
+      if (!value || *value == 0) throw bad(fmt::format("baud={}: not a baud rate", baud));
+      parsed.baud = *value;
     }
     if (!rest.starts_with("/")) throw bad("the serial port must be an absolute path, as in grbl:///dev/ttyUSB0");
     parsed.path = rest;
@@ -115,10 +131,7 @@ DeviceUri parseDeviceUri(const std::string& uri) {
   if (uri.starts_with("m2nano://")) {
     // m2nano://usb/1a86:5512[?bus=B&address=A]
     parsed.driver = "m2nano", parsed.transport = "usb";
-    std::string rest = uri.substr(9);
-    const auto query = rest.find('?');
-    std::string options = query == std::string::npos ? "" : rest.substr(query + 1);
-    if (query != std::string::npos) rest.erase(query);
+    auto [rest, options] = splitQuery(uri.substr(9));
     const auto colon = rest.find(':');
     const bool usb = rest.starts_with("usb/") && colon != std::string::npos && colon > 4;
     const auto vendor = usb ? hexId(rest.substr(4, colon - 4)) : std::nullopt;
@@ -134,14 +147,12 @@ DeviceUri parseDeviceUri(const std::string& uri) {
       const auto equals = option.find('=');
       const std::string key = option.substr(0, equals),
                         value = equals == std::string::npos ? "" : option.substr(equals + 1);
-      int number = 0;
-      const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), number);
-      if ((key != "bus" && key != "address") || value.empty() || error != std::errc() ||
-          end != value.data() + value.size() || number <= 0) {
+      const auto number = wholeNumber<int>(value);
+      if ((key != "bus" && key != "address") || !number || *number <= 0) {
         throw bad(
             fmt::format("\"{}\": the M2 Nano takes bus=N and address=N (as `rotafab devices` shows them)", option));
       }
-      (key == "bus" ? parsed.usbBus : parsed.usbAddress) = number;
+      (key == "bus" ? parsed.usbBus : parsed.usbAddress) = *number;
     }
     return parsed;
   }

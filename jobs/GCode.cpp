@@ -13,8 +13,10 @@ std::string millimetres(double inches) { return formatDecimal(inches * kMillimet
 
 }  // namespace
 
-std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options) {
-  std::vector<std::string> lines{"G21", "G90", "G94", "M4 S0"};
+GCodeProgram gcodeProgram(const Toolpath& toolpath, const GCodeOptions& options) {
+  GCodeProgram program;
+  std::vector<std::string>& lines = program.lines;
+  lines = {"G21", "G90", "G94", "M4 S0"};
   for (const ToolpathStroke& stroke : toolpath.strokes) {
     lines.push_back(
         fmt::format("G0 X{} Y{}", millimetres(stroke.points.front().x()), millimetres(stroke.points.front().y())));
@@ -26,10 +28,15 @@ std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions
       if (i == 1) line += fmt::format(" F{} S{}", feed, power);
       lines.push_back(std::move(line));
     }
+    program.strokeEnds.push_back(lines.size());
   }
   lines.push_back("M5 S0");
   lines.push_back("G0 X0 Y0");
-  return lines;
+  return program;
+}
+
+std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options) {
+  return gcodeProgram(toolpath, options).lines;
 }
 
 }  // namespace rotafab::jobs

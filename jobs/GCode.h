@@ -20,4 +20,12 @@ struct GCodeOptions {
 // One line each, without the newline.
 std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options);
 
+// The same lines, and how many of them run through the end of each stroke
+// (for progress by strokes).
+struct GCodeProgram {
+  std::vector<std::string> lines;
+  std::vector<size_t> strokeEnds;
+};
+GCodeProgram gcodeProgram(const Toolpath& toolpath, const GCodeOptions& options);
+
 }  // namespace rotafab::jobs

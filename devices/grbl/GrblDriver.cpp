@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <regex>
@@ -23,6 +24,14 @@ int codeAfter(const std::string& line, size_t prefix) {
   } catch (const std::exception&) {
     return -1;
   }
+}
+
+// An `ALARM:N` line, and an `error:N` reply to `command`, as the faults they are.
+DeviceFault alarmFault(const std::string& device, const std::string& line) {
+  return DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", device, alarmMessage(codeAfter(line, 6))));
+}
+DeviceFault errorFault(const std::string& device, const std::string& command, const std::string& reply) {
+  return DeviceFault(FaultKind::Error, fmt::format("{}: {}: {}", device, command, errorMessage(codeAfter(reply, 6))));
 }
 
 }  // namespace
@@ -75,8 +84,7 @@ std::string GrblDriver::connect() {
   for (;;) {
     const std::string line = expectLine(timeouts_.answer, "the settings ($$)");
     if (line == "ok") break;
-    if (line.starts_with("error:"))
-      throw DeviceFault(FaultKind::Error, link_->name() + ": $$: " + errorMessage(codeAfter(line, 6)));
+    if (line.starts_with("error:")) throw errorFault(link_->name(), "$$", line);
     static const std::regex setting(R"(^\$(\d+)=(-?[0-9.]+))");
     std::smatch m;
     if (std::regex_search(line, m, setting)) settings_[std::stoi(m[1])] = std::stod(m[2]);
@@ -136,13 +144,8 @@ void GrblDriver::send(const std::string& line) {
   for (;;) {
     const std::string reply = expectLine(timeouts_.answer, line.c_str());
     if (reply == "ok") return;
-    if (reply.starts_with("error:")) {
-      throw DeviceFault(FaultKind::Error,
-                        fmt::format("{}: `{}`: {}", link_->name(), line, errorMessage(codeAfter(reply, 6))));
-    }
-    if (reply.starts_with("ALARM:")) {
-      throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6))));
-    }
+    if (reply.starts_with("error:")) throw errorFault(link_->name(), fmt::format("`{}`", line), reply);
+    if (reply.starts_with("ALARM:")) throw alarmFault(link_->name(), reply);
   }
 }
 
@@ -154,12 +157,11 @@ void GrblDriver::home() {
       const std::string reply = expectLine(timeouts_.homing, "homing ($H)");
       if (reply == "ok") return;
       if (reply.starts_with("error:")) {
-        throw DeviceFault(codeAfter(reply, 6) == 5 ? FaultKind::Refused : FaultKind::Error,
-                          fmt::format("{}: $H: {}", link_->name(), errorMessage(codeAfter(reply, 6))));
+        DeviceFault fault = errorFault(link_->name(), "$H", reply);
+        if (codeAfter(reply, 6) == 5) fault.kind = FaultKind::Refused;  // homing is off ($22=0)
+        throw fault;
       }
-      if (reply.starts_with("ALARM:")) {
-        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(reply, 6))));
-      }
+      if (reply.starts_with("ALARM:")) throw alarmFault(link_->name(), reply);
     }
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
@@ -195,9 +197,7 @@ void GrblDriver::waitIdle(Millis silence, const CancelFlag* cancel) {
         link_->write(std::string(1, kStatus), timeouts_.answer);
         continue;
       }
-      if (line->starts_with("ALARM:")) {
-        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6))));
-      }
+      if (line->starts_with("ALARM:")) throw alarmFault(link_->name(), *line);
       report = parseStatusReport(*line);
     }
     // Two Idle reports in a row: one may have been on its way from before the last lines ran.
@@ -232,19 +232,8 @@ void GrblDriver::frame(const jobs::Toolpath& toolpath) {
 void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
                      const CancelFlag& cancel) {
   if (!link_) connect();
-  const std::vector<std::string> lines = jobs::gcodeLines(toolpath, gcodeOptions());
-  // Progress by strokes: each stroke's last line.
-  std::vector<size_t> strokesDoneAt(lines.size(), 0);
-  {
-    size_t line = 4, done = 0;  // after G21, G90, G94, M4 S0
-    for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
-      line += stroke.points.size();  // G0 and the G1s
-      ++done;
-      for (size_t k = line - stroke.points.size(); k < line && k < lines.size(); ++k) strokesDoneAt[k] = done - 1;
-      if (line - 1 < lines.size()) strokesDoneAt[line - 1] = done;
-    }
-    for (size_t k = line; k < lines.size(); ++k) strokesDoneAt[k] = done;
-  }
+  const jobs::GCodeProgram program = jobs::gcodeProgram(toolpath, gcodeOptions());
+  const std::vector<std::string>& lines = program.lines;
   Progress state;
   state.sheet = toolpath.sheet;
   state.strokes = toolpath.strokes.size();
@@ -292,16 +281,17 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
         inFlightBytes -= inFlight.front();
         state.bytesAcknowledged += inFlight.front();
         inFlight.pop_front();
-        state.stroke = strokesDoneAt[acknowledged];
         ++acknowledged;
+        state.stroke =
+            static_cast<size_t>(std::upper_bound(program.strokeEnds.begin(), program.strokeEnds.end(), acknowledged) -
+                                program.strokeEnds.begin());
         state.secondsLeft = toolpath.seconds * (1.0 - static_cast<double>(state.bytesAcknowledged) /
                                                           static_cast<double>(state.bytesTotal));
         if (progress) progress(state);
       } else if (line->starts_with("error:")) {
-        throw DeviceFault(FaultKind::Error, fmt::format("{}: line {} `{}`: {}", link_->name(), acknowledged + 1,
-                                                        lines[acknowledged], errorMessage(codeAfter(*line, 6))));
+        throw errorFault(link_->name(), fmt::format("line {} `{}`", acknowledged + 1, lines[acknowledged]), *line);
       } else if (line->starts_with("ALARM:")) {
-        throw DeviceFault(FaultKind::Alarm, fmt::format("{}: {}", link_->name(), alarmMessage(codeAfter(*line, 6))));
+        throw alarmFault(link_->name(), *line);
       } else if (line->starts_with("<")) {
         const auto report = parseStatusReport(*line);
         if (!report)

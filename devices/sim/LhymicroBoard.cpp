@@ -83,7 +83,6 @@ void LhymicroBoard::advance(double seconds) {
     }
     if (queue_.empty()) return;
     const uint8_t byte = queue_.front()[readAt_++];
-    ++bytesExecuted_;
     interpret(byte);
     while (!queue_.empty() && readAt_ >= queue_.front().size()) {
       queue_.pop_front();
@@ -400,11 +399,11 @@ void LhymicroBoard::interpret(uint8_t byte) {
         sMode_ = -2;
         digits_ = Digits::Distance;
       } else if (peekInPacket() == 'P') {  // two P in one packet: home
-        ++readAt_, ++bytesExecuted_;
+        ++readAt_;
         runDefaultMove();
         home();
       } else {  // a lone P (or "PN") inside the stream
-        if (peekInPacket() == 'N') ++readAt_, ++bytesExecuted_;
+        if (peekInPacket() == 'N') ++readAt_;
         paused_ = !paused_;
       }
       break;

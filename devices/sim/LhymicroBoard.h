@@ -89,8 +89,6 @@ class LhymicroBoard {
   // The head now, in mils (part way along a move in progress).
   [[nodiscard]] long x() const;
   [[nodiscard]] long y() const;
-  // The speed compact mode runs at (mm/s, from the last speed code at S1E); 0 before any.
-  [[nodiscard]] double compactMmPerSecond() const { return compactSpeed_; }
 
   // Every move executed, in order (laser on/off, speed); a move cut short by an abort ends where it stopped.
   [[nodiscard]] const std::vector<BoardSegment>& trace() const { return trace_; }
@@ -103,7 +101,6 @@ class LhymicroBoard {
   // Packets read to their end (an abort or pause packet counts; dropped ones do not).
   [[nodiscard]] size_t packetsExecuted() const { return packetsExecuted_; }
   [[nodiscard]] size_t packetsDropped() const { return packetsDropped_; }
-  [[nodiscard]] size_t bytesExecuted() const { return bytesExecuted_; }
   [[nodiscard]] double seconds() const { return clock_; }  // machine time advanced so far
 
  private:
@@ -137,7 +134,7 @@ class LhymicroBoard {
   std::deque<Action> actions_;
   std::vector<BoardSegment> trace_;
   std::vector<std::string> violations_;
-  size_t packetsExecuted_ = 0, packetsDropped_ = 0, bytesExecuted_ = 0;
+  size_t packetsExecuted_ = 0, packetsDropped_ = 0;
   double clock_ = 0;
 
   // Machine state.

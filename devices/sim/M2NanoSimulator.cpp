@@ -393,7 +393,7 @@ M2NanoSimulatorRecord M2NanoSimulator::record() const {
   state_->advance();
   M2NanoSimulatorRecord r = state_->counts;
   const LhymicroBoard& board = state_->board;
-  r.laser = board.laser(), r.paused = board.paused(), r.busy = board.busy();
+  r.laser = board.laser(), r.busy = board.busy();
   r.mode = board.mode();
   r.x = board.x(), r.y = board.y();
   r.trace = board.trace();

@@ -33,7 +33,7 @@ struct M2NanoSimulatorRecord {
   bool initialised = false;  // the CH341's parallel-mode control transfer arrived
   size_t packetsAccepted = 0, packetsRejected = 0, statusRequests = 0;
   std::vector<std::string> payloads;  // every accepted packet's 30 bytes, in order
-  bool laser = false, paused = false, busy = false;
+  bool laser = false, busy = false;
   BoardMode mode = BoardMode::Default;
   long x = 0, y = 0;  // mils
   std::vector<BoardSegment> trace;
