@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <thread>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -103,7 +104,9 @@ void run(const std::string& name, const std::vector<NestingPart>& parts, double 
   NestingOptions options;  // the workshop bed: 31.5 x 17.5 usable, 1/16 in spacing
   options.seconds = seconds;
   const auto start = std::chrono::steady_clock::now();
-  const NestingResult result = nest(parts, options);
+  rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
+  const rotafab::core::Cancellation never;
+  const NestingResult result = nest(parts, options, rotafab::core::WorkContext(executor, never));
   const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double usable = options.width * options.height;
   std::vector<double> areaOnSheet(result.sheets, 0.0);

@@ -12,9 +12,11 @@
 #include <optional>
 #include <regex>
 #include <set>
+#include <thread>
 
 #include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
+#include "daemon/ProgressLines.h"
 #include "geometry/BandStructure.h"
 #include "geometry/FastenerHoles.h"
 #include "geometry/MeshAnalysis.h"
@@ -172,13 +174,21 @@ int runMake(const MakeOptions& options) {
       plan.window = options.window;
       plan.rows = options.layout == "rows";
       plan.title = fmt::format("{} (band)", std::filesystem::path(options.mesh).stem().string());
-      plan.progress = [&](const std::string& line) { progress("nesting: " + line); };
+      core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
+      core::Cancellation cancellation;
+      ProgressLineOptions lines;
+      lines.prefix = "make: ";
+      lines.nestingPrefix = "nesting: ";
+      lines.seconds = options.seconds;
+      lines.bed = fmt::format("{} x {} in", machine.bed.width, machine.bed.height);
+      lines.rows = plan.rows;
+      const core::WorkContext context(executor, cancellation, ProgressLines(lines));
       progress(fmt::format("{} {} panels on {} x {} in beds", plan.rows ? "laying out in rows" : "nesting",
                            structure.panels.size(), machine.bed.width, machine.bed.height));
       const std::vector<jobs::Part> parts = jobs::bandParts(structure);
       jobs::SheetPlan sheets;
       try {
-        sheets = jobs::planSheets(parts, machine, plan);
+        sheets = jobs::planSheets(parts, machine, plan, context);
       } catch (const std::invalid_argument& error) {
         throw UserError(fmt::format("{}: {}", options.mesh, error.what()));
       }

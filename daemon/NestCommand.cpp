@@ -5,10 +5,12 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
+#include <thread>
 #include <nlohmann/json.hpp>
 
 #include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
+#include "daemon/ProgressLines.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/LayoutSvg.h"
 #include "jobs/Nesting.h"
@@ -91,11 +93,21 @@ int runNest(const NestOptions& options) {
     else
       nesting.order = jobs::OrderMode::Free;
     nesting.window = options.window;
-    if (!options.json) nesting.progress = [](const std::string& line) { fmt::print(stderr, "nest: {}\n", line); };
+    core::Executor executor(std::max({1u, std::thread::hardware_concurrency(), static_cast<unsigned>(options.threads)}));
+    core::Cancellation cancellation;
+    core::ProgressSink progress;
+    if (!options.json) {
+      ProgressLineOptions lines;
+      lines.prefix = "nest: ";
+      lines.seconds = options.seconds;
+      lines.strip = options.strip;
+      progress = ProgressLines(lines);
+    }
+    const core::WorkContext context(executor, cancellation, progress);
 
     jobs::NestingResult result;
     try {
-      result = jobs::nest(parts, nesting);
+      result = jobs::nest(parts, nesting, context);
     } catch (const std::invalid_argument& error) {
       throw UserError(fmt::format("{}: {}", options.instance, error.what()));
     }

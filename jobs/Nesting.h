@@ -1,26 +1,29 @@
 #pragma once
-// True-shape nesting of parts onto beds or into a strip (issue 3): no-fit
-// polygons (unions of the Minkowski sums of convex pieces), bottom-left
-// placement on the vertices of the feasible region, each candidate confirmed
-// by an exact intersection test. Then, within a time budget, a search over
-// the sequence (swaps, fixed or freed rotations) and, with free order, a
-// compaction by guided local search that lets parts overlap and moves them
-// apart again: it shortens the strip, or on beds the last sheet, whose parts
-// move onto the earlier ones. Parts are concave and interlock; bounding boxes and
-// hulls are never used for collisions. The first layout is deterministic;
-// the searches (one per core, side by side) each follow a course fixed by
-// their seed, and the time budget decides how far along they get, so with a
-// budget the result can differ between machines (a cap on layouts,
-// `evaluations`, makes it the same everywhere for the same `threads`).
+// True-shape nesting of parts onto beds or into a strip: the facade of the
+// steps in jobs/nesting/. No-fit polygons (unions of the Minkowski sums of
+// convex pieces, NoFitPolygons.h), bottom-left placement on the vertices of
+// the feasible region, each candidate confirmed by an exact intersection
+// test (BottomLeftPacker.h). Then, within a time budget, a search over the
+// sequence (swaps, fixed or freed rotations, SequenceSearch.h) and, with free
+// order, a compaction by guided local search that lets parts overlap and
+// moves them apart again (OverlapCompaction.h): it shortens the strip, or on
+// beds the last sheet, whose parts move onto the earlier ones. Parts are
+// concave and interlock; bounding boxes and hulls are never used for
+// collisions. The first layout is deterministic; the searches (side by
+// side on the context's executor) each follow a course fixed by their seed,
+// and the time budget decides how far along they get, so with a budget the
+// result can differ between machines (a cap on layouts, `evaluations`,
+// makes it the same everywhere for the same `threads`).
 //
 // Coordinates in inches; a placement rotates the part's outline about its own
 // origin by `rotation` degrees (counter-clockwise), then translates it by
 // (x, y) in the usable area (origin at its bottom-left corner).
 
 #include <Eigen/Core>
-#include <functional>
 #include <string>
 #include <vector>
+
+#include "core/WorkContext.h"
 
 namespace rotafab::jobs {
 
@@ -51,11 +54,10 @@ struct NestingOptions {
   OrderMode order = OrderMode::Free;
   int window = 8;
   unsigned seed = 1;
-  // Searches run side by side, one per thread, with seeds seed, seed + 1, ...;
-  // the best layout wins. 0: one per core. With a cap on layouts, the result
-  // is the same on every machine for the same number of threads.
+  // Searches run side by side on the executor, with seeds seed, seed + 1,
+  // ...; the best layout wins. 0: one per thread of the executor. With a cap
+  // on layouts, the result is the same on every machine for the same number.
   int threads = 0;
-  std::function<void(const std::string&)> progress;  // one line per improvement, optional
 };
 
 struct PartPlacement {
@@ -74,8 +76,13 @@ struct NestingResult {
 };
 
 // Throws std::invalid_argument naming the part when a part cannot fit the usable
-// area (or the strip's height) in any allowed rotation.
-NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options);
+// area (or the strip's height) in any allowed rotation, and core::Cancelled
+// within 100 ms of a cancel. Progress goes to the context as phase
+// "nesting": step "first layout" (parts placed of all; when done, the
+// layout's sheets and the last one's length), "improving" and "compacting"
+// (each better layout, by sheets and length; in the strip, its length).
+NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
+                   const core::WorkContext& context);
 
 // Throws std::invalid_argument naming the first part whose outline is not a
 // polygon with area, or that has no allowed rotation.

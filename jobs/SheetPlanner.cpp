@@ -22,7 +22,7 @@ Point2 onSheet(const PlannedPart& placement, const Point2& local) {
 }
 
 SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,
-                     const PlanOptions& options) {
+                     const PlanOptions& options, const core::WorkContext& context) {
   const profiles::Bed& bed = machine.bed;
   std::vector<Part> cut;
   cut.reserve(parts.size());
@@ -38,8 +38,8 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
-  nesting.progress = options.progress;
-  const NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting);
+  const NestingResult nested =
+      options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
 
   SheetPlan plan;
   for (size_t i = 0; i < nested.placements.size(); ++i) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/WorkContext.h"
 #include "jobs/Part.h"
 #include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
@@ -24,7 +25,6 @@ struct PlanOptions {
   unsigned seed = 1;
   bool rows = false;  // rowLayout() instead of nest(): seconds for any size, more sheets
   std::string title;  // "bunny (band)"; the sheet number is appended
-  std::function<void(const std::string&)> progress;
 };
 
 struct PlannedPart {
@@ -44,9 +44,10 @@ struct SheetPlan {
 };
 
 // Throws std::invalid_argument naming the part that cannot be planned (larger
-// than the usable bed, a hole narrower than the kerf).
+// than the usable bed, a hole narrower than the kerf), core::Cancelled when
+// the context is cancelled. Progress: nest()'s.
 SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,
-                     const PlanOptions& options);
+                     const PlanOptions& options, const core::WorkContext& context);
 
 // The point of a part's frame on its sheet.
 Point2 onSheet(const PlannedPart& placement, const Point2& local);

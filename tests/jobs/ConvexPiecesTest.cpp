@@ -2,8 +2,8 @@
 // tile the polygon exactly, the linear-time sum of two convex polygons must be
 // their Minkowski sum, and a cell cover must hold every point of its region.
 
-#include "jobs/CellCover.h"
-#include "jobs/ConvexPieces.h"
+#include "jobs/nesting/CellCover.h"
+#include "jobs/nesting/ConvexPieces.h"
 
 #include <gtest/gtest.h>
 
@@ -12,7 +12,7 @@
 #include <numbers>
 #include <random>
 
-namespace rotafab::jobs {
+namespace rotafab::jobs::nesting {
 namespace {
 
 using ClipperLib::cInt;
@@ -224,4 +224,4 @@ TEST(CellCover, EmptyRegionMeetsNothing) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs
+}  // namespace rotafab::jobs::nesting

@@ -5,6 +5,8 @@
 #include "jobs/Nesting.h"
 #include "jobs/RowLayout.h"
 
+#include "TestContext.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -110,7 +112,7 @@ TEST(Nesting, RandomConcavePartsNeverOverlapAndStayInside) {
     options.spacing = 0.0625;
     options.seconds = 0.2;
     options.seed = seed;
-    expectValid(parts, nest(parts, options), options);
+    expectValid(parts, nest(parts, options, test::context()), options);
   }
 }
 
@@ -121,7 +123,7 @@ TEST(Nesting, StripModeKeepsTheHeightAndPacksTheLength) {
   options.height = 10;
   options.spacing = 0;
   options.seconds = 0.2;
-  const NestingResult result = nest(parts, options);
+  const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   EXPECT_EQ(result.sheets, 1);
   double area = 0;
@@ -130,15 +132,16 @@ TEST(Nesting, StripModeKeepsTheHeightAndPacksTheLength) {
 }
 
 // One search with a cap on layouts (the same run on any machine), 1/16 in
-// spacing; the layout is checked exactly and its progress lines are kept.
+// spacing; the layout is checked exactly and its progress is kept.
 NestingResult cappedRun(const std::vector<NestingPart>& parts, NestingOptions options, int evaluations,
-                        std::vector<std::string>& lines) {
+                        std::vector<core::Progress>& progress) {
   options.spacing = 0.0625;
   options.seconds = 600;
   options.evaluations = evaluations;
   options.threads = 1;
-  options.progress = [&](const std::string& line) { lines.push_back(line); };
-  NestingResult result = nest(parts, options);
+  test::TestContext context;
+  NestingResult result = nest(parts, options, context);
+  progress = context.progress();
   expectValid(parts, result, options);
   return result;
 }
@@ -154,12 +157,12 @@ TEST(Nesting, StripCompactionShortensTheStripAndKeepsTheSpacing) {
   NestingOptions options;
   options.strip = true;
   options.height = 10;
-  std::vector<std::string> lines;
-  const NestingResult result = cappedRun(parts, options, 1000, lines);
-  // "compacting: strip 12.34 long": the shortest strip reported is the one kept.
+  std::vector<core::Progress> progress;
+  const NestingResult result = cappedRun(parts, options, 1000, progress);
+  // Compacting, the strip's length: the shortest strip reported is the one kept.
   double shortest = std::numeric_limits<double>::max();
-  for (const std::string& line : lines) {
-    if (line.starts_with("compacting: strip ")) shortest = std::min(shortest, std::stod(line.substr(18)));
+  for (const core::Progress& p : progress) {
+    if (p.step == "compacting") shortest = std::min(shortest, p.length);
   }
   ASSERT_LT(shortest, std::numeric_limits<double>::max()) << "the compaction never found a shorter strip";
   EXPECT_NEAR(result.stripLength, shortest, 0.005);
@@ -174,20 +177,15 @@ TEST(Nesting, BedCompactionShortensTheLastSheet) {
   NestingOptions options;
   options.width = 16;
   options.height = 10;
-  std::vector<std::string> lines;
-  const NestingResult result = cappedRun(parts, options, 200, lines);
-  // "compacting: 3 sheets, last sheet 3.10 in long" (or "1 sheet, ..."):
-  // progress lines only report layouts better than the first.
+  std::vector<core::Progress> progress;
+  const NestingResult result = cappedRun(parts, options, 200, progress);
+  // Compacting: sheets and the last sheet's length; progress only reports
+  // layouts better than the first.
   std::optional<std::pair<int, double>> best;
-  for (const std::string& line : lines) {
-    if (!line.starts_with("compacting: ")) continue;
-    int sheets = 0;
-    double length = 0;
-    const auto last = line.find("last sheet ");
-    ASSERT_EQ(std::sscanf(line.c_str() + 12, "%d", &sheets), 1) << line;
-    ASSERT_NE(last, std::string::npos) << line;
-    ASSERT_EQ(std::sscanf(line.c_str() + last + 11, "%lf", &length), 1) << line;
-    best = std::min(best.value_or(std::pair{sheets, length}), std::pair{sheets, length});
+  for (const core::Progress& p : progress) {
+    if (p.step != "compacting") continue;
+    ASSERT_GT(p.sheets, 0);
+    best = std::min(best.value_or(std::pair{p.sheets, p.length}), std::pair{p.sheets, p.length});
   }
   ASSERT_TRUE(best.has_value()) << "the compaction never found a better layout";
   EXPECT_EQ(result.sheets, best->first);
@@ -208,7 +206,7 @@ TEST(Nesting, SameSeedNoBudgetSameLayout) {
   const auto parts = randomParts(11, 12);
   NestingOptions options;
   options.seconds = 0;
-  const NestingResult a = nest(parts, options), b = nest(parts, options);
+  const NestingResult a = nest(parts, options, test::context()), b = nest(parts, options, test::context());
   expectSameLayout(a, b);
 }
 
@@ -219,7 +217,7 @@ TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
   options.evaluations = 25;
   options.seed = 9;
   options.threads = 2;
-  const NestingResult a = nest(parts, options), b = nest(parts, options);
+  const NestingResult a = nest(parts, options, test::context()), b = nest(parts, options, test::context());
   EXPECT_EQ(a.evaluations, 50) << "two searches of 25 layouts";
   expectSameLayout(a, b);
 }
@@ -237,9 +235,9 @@ TEST(Nesting, SideBySideSearchesAreNeverWorseThanOne) {
     options.seconds = 600;
     options.evaluations = 30;
     options.threads = 1;
-    const NestingResult alone = nest(parts, options);
+    const NestingResult alone = nest(parts, options, test::context());
     options.threads = 3;
-    const NestingResult together = nest(parts, options);
+    const NestingResult together = nest(parts, options, test::context());
     expectValid(parts, together, options);
     EXPECT_LE(together.sheets, alone.sheets);
     if (strip) {
@@ -256,7 +254,7 @@ TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
   options.width = 15;
   options.height = 10;
   options.seconds = 0;
-  const NestingResult result = nest(parts, options);
+  const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   // In cutting order the assembly order never goes down.
   for (size_t i = 1; i < result.placements.size(); ++i) {
@@ -272,7 +270,7 @@ TEST(Nesting, WindowOrderMovesNoPartFartherThanTheWindow) {
   options.width = 15;
   options.height = 10;
   options.seconds = 0.3;
-  const NestingResult result = nest(parts, options);
+  const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   for (size_t i = 0; i < result.placements.size(); ++i) {
     EXPECT_LE(std::abs(parts[result.placements[i].part].order - static_cast<int>(i)), options.window)
@@ -286,7 +284,7 @@ TEST(Nesting, PartLargerThanTheBedIsRefusedByName) {
   parts[1].outline = {{0, 0}, {40, 0}, {40, 1}, {0, 1}};
   NestingOptions options;
   try {
-    nest(parts, options);
+    nest(parts, options, test::context());
     FAIL() << "accepted";
   } catch (const std::invalid_argument& error) {
     EXPECT_EQ(std::string(error.what()).rfind("panel 42 (40 x 1) does not fit the usable area of 31.5 x 17.5", 0), 0u)
@@ -299,7 +297,7 @@ TEST(Nesting, BedSizedPartFillsOneSheet) {
   parts[0].name = "board";
   parts[0].outline = {{0, 0}, {31.5, 0}, {31.5, 17.5}, {0, 17.5}};
   NestingOptions options;
-  const NestingResult result = nest(parts, options);
+  const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   EXPECT_EQ(result.sheets, 1);
 }
@@ -336,7 +334,7 @@ TEST(Nesting, AwkwardOutlinesAreNestedExactly) {
     options.strip = trial % 2 == 1;
     options.height = options.strip ? 8 : 17.5;
     try {
-      expectValid(parts, nest(parts, options), options);
+      expectValid(parts, nest(parts, options, test::context()), options);
     } catch (const std::invalid_argument& error) {
       const std::string message = error.what();
       const bool named = std::any_of(parts.begin(), parts.end(),

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "TestContext.h"
 #include "TestSupport.h"
 
 namespace rotafab::jobs {
@@ -72,7 +73,7 @@ TEST(SheetPlanner, KerfIsOnEveryCutAndMaterialStaysBetweenParts) {
   PlanOptions options;
   options.kerf = 0.01;
   options.seconds = 0;
-  const SheetPlan plan = planSheets(parts, workshop(), options);
+  const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   ASSERT_GE(plan.sheets.size(), 1u);
   for (const SheetDrawing& sheet : plan.sheets) {
     std::vector<const DrawnPath*> outers;
@@ -108,7 +109,7 @@ TEST(SheetPlanner, EachSheetIsEtchedThenScoredThenCutInsideOut) {
   for (int i = 0; i < 6; ++i) parts.push_back(panel(i));
   PlanOptions options;
   options.seconds = 0;
-  const SheetPlan plan = planSheets(parts, workshop(), options);
+  const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   ASSERT_EQ(plan.sheets.size(), 1u);
   const auto& paths = plan.sheets[0].paths;
   ASSERT_EQ(paths.size(), 1 + 6 * 4u);  // the material outline, then etch, score, hole, outline of each part
@@ -137,7 +138,7 @@ TEST(SheetPlanner, WindowOrderReportsHowFarEachPartMoved) {
   options.order = OrderMode::Window;
   options.window = 3;
   options.seconds = 0.5;
-  const SheetPlan plan = planSheets(parts, workshop(), options);
+  const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   ASSERT_EQ(plan.parts.size(), parts.size());
   for (const PlannedPart& p : plan.parts) {
     EXPECT_EQ(p.moved, p.cuttingIndex - parts[p.part].order);
@@ -153,7 +154,7 @@ TEST(SheetPlanner, HoleNarrowerThanTheKerfIsRefusedByName) {
   PlanOptions options;
   options.kerf = 0.01;
   try {
-    planSheets(parts, workshop(), options);
+    planSheets(parts, workshop(), options, test::context());
     FAIL() << "accepted";
   } catch (const std::invalid_argument& error) {
     EXPECT_STREQ(error.what(), "panel 1: hole 1 is narrower than the kerf (0.01 in)");
@@ -166,7 +167,7 @@ TEST(SheetPlanner, WritesEpsSvgAndDxfForEverySheet) {
   PlanOptions options;
   options.seconds = 0;
   options.title = "test";
-  const SheetPlan plan = planSheets(parts, workshop(), options);
+  const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   test::TempDir dir;
   const auto files = writeSheets(plan, dir.path());
   ASSERT_EQ(files.size(), plan.sheets.size());

@@ -11,7 +11,7 @@
 #include <array>
 #include <vector>
 
-namespace rotafab::jobs {
+namespace rotafab::jobs::nesting {
 
 using Box = std::array<ClipperLib::cInt, 4>;  // min x, min y, max x, max y (closed)
 
@@ -41,4 +41,4 @@ class CellCover {
   std::vector<Box> runs_;
 };
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::jobs::nesting

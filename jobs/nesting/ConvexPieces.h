@@ -11,7 +11,7 @@
 #include <optional>
 #include <vector>
 
-namespace rotafab::jobs {
+namespace rotafab::jobs::nesting {
 
 // Convex polygons (counter-clockwise, no three consecutive points collinear)
 // whose union is `polygon` and whose interiors are disjoint: ear-clipping
@@ -25,4 +25,4 @@ std::optional<std::vector<ClipperLib::Path>> convexPieces(const ClipperLib::Path
 // merged by angle, in time linear in their sizes. Counter-clockwise.
 ClipperLib::Path convexMinkowskiSum(const ClipperLib::Path& a, const ClipperLib::Path& b);
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::jobs::nesting

@@ -1,9 +1,9 @@
-#include "jobs/CellCover.h"
+#include "jobs/nesting/CellCover.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace rotafab::jobs {
+namespace rotafab::jobs::nesting {
 
 using ClipperLib::cInt;
 using ClipperLib::IntPoint;
@@ -97,4 +97,4 @@ bool CellCover::meets(const Box& box) const {
   return at(r1 + 1, c1 + 1) - at(r0, c1 + 1) - at(r1 + 1, c0) + at(r0, c0) > 0;
 }
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::jobs::nesting

@@ -1,10 +1,10 @@
-#include "jobs/ConvexPieces.h"
+#include "jobs/nesting/ConvexPieces.h"
 
 #include <algorithm>
 #include <map>
 #include <utility>
 
-namespace rotafab::jobs {
+namespace rotafab::jobs::nesting {
 namespace {
 
 using ClipperLib::IntPoint;
@@ -174,4 +174,4 @@ Path convexMinkowskiSum(const Path& a, const Path& b) {
   return sum;
 }
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::jobs::nesting

@@ -1,0 +1,33 @@
+#pragma once
+// Plane polygons, as the panels, parts and sheets all use them: a polygon is
+// its corners in order, not closed (the first point is not repeated).
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace rotafab::core {
+
+using Point2 = Eigen::Vector2d;
+using Polygon2 = std::vector<Point2>;
+
+// Signed area (positive counter-clockwise).
+double signedArea(const Polygon2& polygon);
+
+// The distance from `p` to the nearest side of a closed polygon.
+double distanceToOutline(const Polygon2& polygon, const Point2& p);
+
+// Whether `p` is inside a closed polygon (even-odd).
+bool insidePolygon(const Polygon2& polygon, const Point2& p);
+
+// Whether segments ab and cd cross at a point inside both (touching and
+// collinear overlaps excluded: pieces of a panel meet along shared sides and
+// at shared corners).
+bool properlyCross(const Point2& a, const Point2& b, const Point2& c, const Point2& d);
+
+// Whether a closed outline crosses itself (two sides that are not neighbours properly cross).
+bool crossesItself(const Polygon2& outline);
+
+// Whether two closed outlines cross (a side of one properly crosses a side of the other).
+bool outlinesCross(const Polygon2& a, const Polygon2& b);
+
+}  // namespace rotafab::core

@@ -1,0 +1,60 @@
+#include "daemon/ProgressLines.h"
+
+#include <fmt/format.h>
+
+namespace rotafab::cli {
+namespace {
+
+// How often a long first layout says how far it has got.
+constexpr std::chrono::seconds kCountEvery{5};
+
+const char* plural(size_t n) { return n == 1 ? "" : "s"; }
+
+}  // namespace
+
+void ProgressLines::operator()(const core::Progress& p) {
+  std::string line;
+  if (p.phase == "import" && p.step == "holes filled") {
+    line = fmt::format("filled {} hole{} with one face each", p.done, plural(p.done));
+  } else if (p.phase == "geometry") {
+    if (p.step == "band decomposition") line = fmt::format("band decomposition of {} faces", p.total);
+    if (p.step == "panels split") {
+      line = fmt::format("{} band{} cut off {} panel{} that would overlap themselves, each fastened back by a tab",
+                         p.done, plural(p.done), p.done == 1 ? "a" : "the", plural(p.done));
+    }
+    if (p.step == "fastener holes") line = fmt::format("fastener holes on {} bands", p.total);
+    if (p.step == "labels") line = fmt::format("labels on {} panels", p.total);
+  } else if (p.phase == "nesting") {
+    std::string step;
+    if (p.step.empty()) {
+      // The start of the phase: its parts are the structure's panels.
+      line = fmt::format("{} {} panels on {} beds", options_.rows ? "laying out in rows" : "nesting", p.total,
+                         options_.bed);
+    } else if (p.step == "first layout" && p.done == 0) {
+      step = fmt::format("first layout of {} parts", p.total);
+      nextCount_ = std::chrono::steady_clock::now() + kCountEvery;
+    } else if (p.step == "first layout" && p.done < p.total) {
+      const auto now = std::chrono::steady_clock::now();
+      if (now > nextCount_) {
+        step =
+            fmt::format("first layout: {} of {} parts placed, {} sheet{}", p.done, p.total, p.sheets, plural(p.sheets));
+        nextCount_ = now + kCountEvery;
+      }
+    } else if (p.step == "first layout") {
+      step = fmt::format("{} sheet{}, last sheet {:.2f} in long; improving for {} s", p.sheets, plural(p.sheets),
+                         p.length, options_.seconds);
+    } else if (p.step == "improving") {
+      step = fmt::format("{} sheet{}, last sheet {:.2f} in long", p.sheets, plural(p.sheets), p.length);
+    } else if (p.step == "compacting") {
+      step = options_.strip ? fmt::format("compacting: strip {:.2f} long", p.length)
+                            : fmt::format("compacting: {} sheet{}, last sheet {:.2f} in long", p.sheets,
+                                          plural(p.sheets), p.length);
+    }
+    if (!step.empty()) line = options_.nestingPrefix + step;
+  } else if (p.phase == "writing" && p.step.empty()) {
+    line = fmt::format("writing {} sheets to {}", p.total, options_.folder);
+  }
+  if (!line.empty()) fmt::print(stderr, "{}{}\n", options_.prefix, line);
+}
+
+}  // namespace rotafab::cli

@@ -1,0 +1,157 @@
+#include "jobs/nesting/SequenceSearch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include "jobs/nesting/BottomLeftPacker.h"
+#include "jobs/nesting/OverlapCompaction.h"
+
+namespace rotafab::jobs::nesting {
+namespace {
+
+// The share of the time budget (and of a cap on layouts) that the sequence
+// search has in free order; the compaction has the rest.
+constexpr double kSequenceShare = 0.15;
+
+}  // namespace
+
+std::pair<int, double> layoutCost(const NestingResult& result, const std::vector<NestingPart>& parts) {
+  if (result.sheets == 0) return {0, 0.0};
+  double lastExtent = 0;
+  for (const auto& p : result.placements) {
+    if (p.sheet != result.sheets) continue;
+    for (const Point2& v : placedOutline(parts[p.part], p)) lastExtent = std::max(lastExtent, v.x());
+  }
+  return {result.sheets, lastExtent};
+}
+
+void SharedProgress::remark(unsigned search, const core::Progress& progress) {
+  const std::lock_guard lock(mutex_);
+  if (search == 0) context_.report(progress);
+}
+
+void SharedProgress::improved(const std::pair<int, double>& cost, const core::Progress& progress) {
+  const std::lock_guard lock(mutex_);
+  if (best_ && cost >= *best_) return;
+  best_ = cost;
+  context_.report(progress);
+}
+
+NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProgress& progress,
+                           const core::WorkContext& context) {
+  const std::vector<NestingPart>& parts = shapes.parts();
+  const NestingOptions& options = shapes.options();
+  BottomLeftPacker packer(shapes, &context.cancellation());
+  // The first layout: assembly order, or for free order the largest parts first.
+  std::vector<int> sequence(parts.size());
+  std::iota(sequence.begin(), sequence.end(), 0);
+  std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) { return parts[a].order < parts[b].order; });
+  if (options.order == OrderMode::Free) {
+    std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) {
+      return std::abs(polygonArea(parts[a].outline)) > std::abs(polygonArea(parts[b].outline));
+    });
+  }
+  // Window: start from the strict layout (nothing moves) and accept only
+  // layouts in which no part is cut more than `window` places from its order.
+  auto withinWindow = [&](const NestingResult& result) {
+    if (options.order != OrderMode::Window) return true;
+    for (size_t i = 0; i < result.placements.size(); ++i) {
+      if (std::abs(static_cast<int>(i) - parts[result.placements[i].part].order) > options.window) return false;
+    }
+    return true;
+  };
+  std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
+  // The first layout can take many seconds (25 s for 100 long strips): say so.
+  progress.remark(search, {"nesting", "first layout", 0, parts.size()});
+  packer.onProgress = [&](size_t placed, size_t of, size_t sheets) {
+    if (placed > 0) progress.remark(search, {"nesting", "first layout", placed, of, static_cast<int>(sheets)});
+  };
+  NestingResult best = *packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
+  packer.onProgress = nullptr;
+  packer.accept();
+  auto bestCost = layoutCost(best, parts);
+  progress.improved(bestCost, {"nesting", "first layout", parts.size(), parts.size(), bestCost.first, bestCost.second});
+  int evaluations = 1;
+  // Improvement: swap two parts of the sequence (within the window when the
+  // order is bounded), or fix or free one part's rotation, and keep the
+  // change when the layout is no worse.
+  // In free order, the sequence search has the first part of the budget and
+  // the compaction the rest.
+  const bool compaction = options.order == OrderMode::Free && parts.size() > 1;
+  const double sequenceShare = compaction ? kSequenceShare : 1.0;
+  const auto start = std::chrono::steady_clock::now();
+  std::mt19937 random(options.seed + search);
+  if (options.order != OrderMode::Strict && parts.size() > 1) {
+    const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(sequenceShare * options.seconds));
+    const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
+    while (std::chrono::steady_clock::now() < deadline && (options.evaluations <= 0 || evaluations < lastEvaluation)) {
+      context.check();
+      std::vector<int> trial = sequence, trialShapes = shapeOf;
+      const size_t i = random() % trial.size();
+      size_t j = i;
+      const unsigned move = random() % 10;
+      if (move < 3) {
+        // Fix the part's rotation, or free it again.
+        const int part = trial[i];
+        const int choice = static_cast<int>(random() % (parts[part].rotations.size() + 1)) - 1;
+        if (choice == trialShapes[part]) continue;
+        trialShapes[part] = choice;
+      } else {
+        // Swap with a neighbour (small steps) or with any part.
+        const long span = options.order == OrderMode::Window ? std::max(1, options.window)
+                          : move < 6                         ? 3
+                                                             : static_cast<long>(trial.size());
+        j = std::clamp<long>(static_cast<long>(i) + static_cast<long>(random() % (2 * span + 1)) - span, 0,
+                             static_cast<long>(trial.size()) - 1);
+        if (i == j) continue;
+        std::swap(trial[i], trial[j]);
+      }
+      // The parts before the first changed one are placed as before.
+      // Without a cap on layouts, a trial that would end past the deadline is given up.
+      auto packed = packer.pack(trial, options.order, std::min(i, j), trialShapes,
+                                options.evaluations > 0 ? std::chrono::steady_clock::time_point::max() : deadline);
+      if (!packed) break;
+      NestingResult result = std::move(*packed);
+      ++evaluations;
+      const auto trialCost = layoutCost(result, parts);
+      if (trialCost <= bestCost && withinWindow(result)) {
+        if (trialCost < bestCost) {
+          progress.improved(trialCost, {"nesting", "improving", 0, 0, trialCost.first, trialCost.second});
+        }
+        best = std::move(result);
+        bestCost = trialCost;
+        sequence = std::move(trial);
+        shapeOf = std::move(trialShapes);
+        packer.accept();
+      }
+    }
+  }
+  if (compaction) {
+    const auto deadline = start + std::chrono::duration<double>(options.seconds);
+    const auto goOn = [&] {
+      return !context.cancelled() && std::chrono::steady_clock::now() < deadline &&
+             (options.evaluations <= 0 || evaluations < options.evaluations);
+    };
+    // Progress while compacting: the layout so far (its exact check comes at the end).
+    const auto shorter = [&](int sheets, double length) {
+      progress.improved({sheets, length}, {"nesting", "compacting", 0, 0, sheets, length});
+    };
+    NestingResult compacted =
+        OverlapCompaction(shapes).compact(packer.acceptedLayout(), random, goOn, evaluations, shorter);
+    context.check();
+    // The compaction lets grown shapes reach into each other by a few grid
+    // units; the layout is kept only if the true outlines keep the spacing
+    // (within layoutProblems' tolerance).
+    if (layoutCost(compacted, parts) < layoutCost(best, parts) && layoutProblems(parts, compacted, options).empty()) {
+      best = std::move(compacted);
+    }
+  }
+  best.evaluations = evaluations;
+  return best;
+}
+
+}  // namespace rotafab::jobs::nesting

@@ -1,0 +1,46 @@
+#pragma once
+// One search for a layout (jobs/Nesting.h): the first layout by bottom-left
+// placement (BottomLeftPacker.h) in assembly order (largest first in free
+// order), then a local search over the sequence and the rotations, as in
+// Jakobs 1996 and Gomes and Oliveira 2002 (swap two parts, within the
+// window when the order is bounded, or fix or free a part's rotation; keep
+// the change when the layout is no worse), and in free order the
+// compaction (OverlapCompaction.h) for the rest of the budget. Its course
+// is fixed by its seed; the time budget, or a cap on layouts, decides how
+// far along it gets. Several run side by side (nest()), and the best wins.
+
+#include <mutex>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "core/WorkContext.h"
+#include "jobs/Nesting.h"
+#include "jobs/nesting/Shapes.h"
+
+namespace rotafab::jobs::nesting {
+
+// Smaller is better: fewer sheets, then less used of the last sheet (or a shorter strip).
+std::pair<int, double> layoutCost(const NestingResult& result, const std::vector<NestingPart>& parts);
+
+// The progress of searches running side by side: the first layout's
+// progress from the first search only, and a layout only when it beats every
+// search's best so far.
+class SharedProgress {
+ public:
+  explicit SharedProgress(const core::WorkContext& context) : context_(context) {}
+  void remark(unsigned search, const core::Progress& progress);
+  void improved(const std::pair<int, double>& cost, const core::Progress& progress);
+
+ private:
+  const core::WorkContext& context_;
+  std::mutex mutex_;
+  std::optional<std::pair<int, double>> best_;
+};
+
+// Search number `search` (seed options.seed + search) on the shared shapes.
+// Throws core::Cancelled when the context is cancelled.
+NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProgress& progress,
+                           const core::WorkContext& context);
+
+}  // namespace rotafab::jobs::nesting

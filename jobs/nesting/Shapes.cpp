@@ -1,0 +1,315 @@
+#include "jobs/nesting/Shapes.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <tuple>
+
+#include "jobs/nesting/ConvexPieces.h"
+
+namespace rotafab::jobs::nesting {
+namespace {
+
+// The distance from (x, y) to the polygon's boundary.
+double distanceToBoundary(const Path& polygon, double x, double y) {
+  double best = std::numeric_limits<double>::max();
+  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const IntPoint& a = polygon[j];
+    const IntPoint& b = polygon[i];
+    const double dx = static_cast<double>(b.X - a.X), dy = static_cast<double>(b.Y - a.Y);
+    const double length2 = dx * dx + dy * dy;
+    double t = length2 > 0 ? ((x - a.X) * dx + (y - a.Y) * dy) / length2 : 0.0;
+    t = std::clamp(t, 0.0, 1.0);
+    const double ex = x - (a.X + t * dx), ey = y - (a.Y + t * dy);
+    best = std::min(best, ex * ex + ey * ey);
+  }
+  return std::sqrt(best);
+}
+
+// The points of a (steps + 1) x (steps + 1) grid over the polygon's box that
+// lie strictly inside it, with their distance to its boundary.
+std::vector<std::pair<IntPoint, double>> gridInside(const Path& polygon, int steps) {
+  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
+  std::vector<std::pair<IntPoint, double>> inside;
+  for (int i = 0; i <= steps; ++i) {
+    for (int j = 0; j <= steps; ++j) {
+      const IntPoint p{minX + (maxX - minX) * i / steps, minY + (maxY - minY) * j / steps};
+      if (ClipperLib::PointInPolygon(p, polygon) != 1) continue;
+      inside.emplace_back(p, distanceToBoundary(polygon, static_cast<double>(p.X), static_cast<double>(p.Y)));
+    }
+  }
+  return inside;
+}
+
+// Discs of one radius inside a polygon. The largest: a grid search for the
+// point farthest from the boundary, refined around the best point, its radius
+// the distance from there rounded down to `radiusStep`. Then up to
+// `maxDiscs - 1` more of that radius, each at the grid point with room for it
+// that is farthest from the centres so far, while that is at least a radius
+// away. Every radius is a true distance to the boundary, so every disc is inside.
+std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radiusStep, int maxDiscs = 5) {
+  const auto [minX, minY, maxX, maxY] = boxOf(polygon);
+  constexpr int kSteps = 24;
+  const auto inside = gridInside(polygon, kSteps);
+  IntPoint best{(minX + maxX) / 2, (minY + maxY) / 2};
+  double bestDistance = -1;
+  for (const auto& [p, d] : inside) {
+    if (d > bestDistance) bestDistance = d, best = p;
+  }
+  auto consider = [&](cInt x, cInt y) {
+    if (ClipperLib::PointInPolygon({x, y}, polygon) != 1) return;
+    const double d = distanceToBoundary(polygon, static_cast<double>(x), static_cast<double>(y));
+    if (d > bestDistance) bestDistance = d, best = {x, y};
+  };
+  for (double step = std::max(maxX - minX, maxY - minY) / (2.0 * kSteps); step >= 1; step /= 2) {
+    const IntPoint at = best;
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) consider(at.X + std::llround(dx * step), at.Y + std::llround(dy * step));
+    }
+  }
+  const cInt radius = static_cast<cInt>(std::max(0.0, bestDistance - 1)) / radiusStep * radiusStep;
+  if (radius <= 0) return {0, {}};
+  std::vector<IntPoint> centres{best};
+  while (static_cast<int>(centres.size()) < maxDiscs) {
+    double farthest = 0;
+    IntPoint next{0, 0};
+    for (const auto& [p, d] : inside) {
+      if (d < static_cast<double>(radius)) continue;
+      double nearest = std::numeric_limits<double>::max();
+      for (const IntPoint& c : centres) {
+        nearest = std::min(nearest, std::hypot(static_cast<double>(p.X - c.X), static_cast<double>(p.Y - c.Y)));
+      }
+      if (nearest > farthest) farthest = nearest, next = p;
+    }
+    if (farthest < static_cast<double>(radius)) break;
+    centres.push_back(next);
+  }
+  return {radius, centres};
+}
+
+// The poles of a polygon (see Shape::poles): on a grid of points inside
+// it, greedily the one with the largest disc clear of the boundary and of
+// the discs so far, while that is at least a tenth of the first's radius.
+std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most) {
+  // Grid points and the largest disc at each clear of the boundary and of the poles so far.
+  auto inside = gridInside(polygon, 32);
+  std::vector<Shape::Pole> poles;
+  while (poles.size() < most && !inside.empty()) {
+    const auto best = std::max_element(inside.begin(), inside.end(),
+                                       [](const auto& a, const auto& b) { return a.second < b.second; });
+    if (best->second < 1 || (!poles.empty() && best->second < 0.1 * poles.front().radius)) break;
+    const Shape::Pole pole{best->first, best->second};
+    poles.push_back(pole);
+    for (auto& [p, room] : inside) {
+      const double apart =
+          std::hypot(static_cast<double>(p.X - pole.centre.X), static_cast<double>(p.Y - pole.centre.Y)) - pole.radius;
+      room = std::min(room, apart);
+    }
+  }
+  // Too thin for the grid: one small pole at a point inside, so that
+  // containment is still found (failing that, on a vertex: never empty).
+  if (poles.empty()) {
+    for (size_t i = 0; i < polygon.size() && poles.empty(); ++i) {
+      const IntPoint& a = polygon[i];
+      const IntPoint& b = polygon[(i + 1) % polygon.size()];
+      const IntPoint& c = polygon[(i + 2) % polygon.size()];
+      const IntPoint mid{(a.X + b.X + c.X) / 3, (a.Y + b.Y + c.Y) / 3};
+      if (ClipperLib::PointInPolygon(mid, polygon) == 1) poles.push_back({mid, 1.0});
+    }
+  }
+  if (poles.empty()) poles.push_back({polygon.front(), 1.0});
+  return poles;
+}
+
+}  // namespace
+
+cInt toInt(double value) { return static_cast<cInt>(std::llround(value * kScale)); }
+
+Path toPath(const Polygon2& polygon) {
+  Path path;
+  path.reserve(polygon.size());
+  for (const Point2& p : polygon) path.push_back({toInt(p.x()), toInt(p.y())});
+  return path;
+}
+
+Polygon2 rotated(const Polygon2& polygon, double degrees) {
+  Polygon2 out;
+  out.reserve(polygon.size());
+  for (const Point2& p : polygon) out.push_back(rotatedPoint(p, degrees));
+  return out;
+}
+
+// The piece of largest area, or `otherwise` when there is none.
+Path largestOf(const Paths& pieces, const Path& otherwise) {
+  if (pieces.empty()) return otherwise;
+  return *std::max_element(pieces.begin(), pieces.end(), [](const Path& a, const Path& b) {
+    return std::abs(ClipperLib::Area(a)) < std::abs(ClipperLib::Area(b));
+  });
+}
+
+// The largest path of an offset; an outward offset of a simple polygon has one.
+// The boundary is grown too, as a line: a needle or slit in the outline (a
+// cut out and back along one line) encloses no area, and growing the polygon
+// alone would drop it, though the laser cuts it and neighbours must keep clear.
+Path grown(const Path& path, double by, ClipperLib::JoinType join) {
+  ClipperLib::ClipperOffset offset(2.0, 0.25 * kScale * 0.001);
+  offset.AddPath(path, join, ClipperLib::etClosedPolygon);
+  offset.AddPath(path, ClipperLib::jtRound, ClipperLib::etClosedLine);
+  Paths out;
+  offset.Execute(out, by * kScale);
+  return largestOf(out, path);
+}
+
+Box boxOf(const Path& path) {
+  Box box{std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::min(),
+          std::numeric_limits<cInt>::min()};
+  for (const IntPoint& p : path) {
+    box[0] = std::min(box[0], p.X), box[1] = std::min(box[1], p.Y);
+    box[2] = std::max(box[2], p.X), box[3] = std::max(box[3], p.Y);
+  }
+  return box;
+}
+
+RoomScale roomScaleFor(cInt height) {
+  const cInt h = std::max<cInt>(height, 3500);
+  return {h / 350, h / 70, static_cast<double>(h) / 17500};
+}
+
+Path translatedPath(const Path& path, IntPoint by) {
+  Path out;
+  out.reserve(path.size());
+  for (const IntPoint& p : path) out.push_back({p.X + by.X, p.Y + by.Y});
+  return out;
+}
+
+Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep) {
+  Shape shape;
+  shape.rotation = rotation;
+  Path path = toPath(rotated(outline, rotation));
+  if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
+  std::tie(shape.minX, shape.minY, shape.maxX, shape.maxY) = std::tuple_cat(boxOf(path));
+  shape.grown = grown(path, spacing / 2 + kSimplifyTolerance, ClipperLib::jtMiter);
+  ClipperLib::CleanPolygon(shape.grown, kSimplifyTolerance * kScale);
+  if (ClipperLib::Area(shape.grown) < 0) std::reverse(shape.grown.begin(), shape.grown.end());
+  for (const IntPoint& p : shape.grown) shape.negated.push_back({-p.X, -p.Y});
+  std::tie(shape.grownMinX, shape.grownMinY, shape.grownMaxX, shape.grownMaxY) = std::tuple_cat(boxOf(shape.grown));
+  std::tie(shape.radius, shape.centres) = clearDiscs(shape.grown, radiusStep);
+  shape.poles = polesOf(shape.grown, kMostPoles);
+  shape.diameter = std::hypot(static_cast<double>(shape.grownMaxX - shape.grownMinX),
+                              static_cast<double>(shape.grownMaxY - shape.grownMinY));
+  shape.size = std::sqrt(std::abs(ClipperLib::Area(shape.grown)));
+  ClipperLib::ClipperOffset shrink(2.0);
+  shrink.AddPath(shape.grown, ClipperLib::jtMiter, ClipperLib::etClosedPolygon);
+  Paths cores;
+  shrink.Execute(cores, -static_cast<double>(kCollisionSlack));
+  shape.core = largestOf(cores, shape.grown);
+  if (ClipperLib::Area(shape.core) < 0) std::reverse(shape.core.begin(), shape.core.end());
+  shape.coreBox = boxOf(shape.core);
+  if (auto pieces = convexPieces(shape.grown)) {
+    shape.pieces = std::move(*pieces);
+    for (const Path& piece : shape.pieces) {
+      Path negated;  // a half turn keeps the piece counter-clockwise
+      for (const IntPoint& p : piece) negated.push_back({-p.X, -p.Y});
+      shape.negatedPieces.push_back(std::move(negated));
+    }
+    for (const Path& piece : shape.pieces) shape.pieceBoxes.push_back(boxOf(piece));
+    for (const Path& piece : shape.negatedPieces) shape.negatedPieceBoxes.push_back(boxOf(piece));
+  }
+  return shape;
+}
+
+bool boxesApart(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) {
+  return atA.X + a.grownMaxX <= atB.X + b.grownMinX || atB.X + b.grownMaxX <= atA.X + a.grownMinX ||
+         atA.Y + a.grownMaxY <= atB.Y + b.grownMinY || atB.Y + b.grownMaxY <= atA.Y + a.grownMinY;
+}
+
+Paths intersectionOf(const Path& a, IntPoint atA, const Path& b, IntPoint atB) {
+  ClipperLib::Clipper clipper;
+  clipper.AddPath(translatedPath(a, atA), ClipperLib::ptSubject, true);
+  clipper.AddPath(translatedPath(b, atB), ClipperLib::ptClip, true);
+  Paths out;
+  clipper.Execute(ClipperLib::ctIntersection, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
+  return out;
+}
+
+PartShapes::PartShapes(const std::vector<NestingPart>& parts, const NestingOptions& options)
+    : parts_(parts), options_(options), roomScale_(roomScaleFor(toInt(options.height))) {
+  shapes_.resize(parts.size());
+  for (size_t i = 0; i < parts.size(); ++i) {
+    for (double rotation : parts[i].rotations)
+      shapes_[i].push_back(makeShape(parts[i].outline, rotation, options.spacing, roomScale_.radiusStep));
+  }
+  for (const auto& shapes : shapes_) area_.push_back(std::abs(ClipperLib::Area(shapes.front().grown)));
+  std::map<std::vector<cInt>, int> classes;
+  for (const auto& shapes : shapes_) {
+    classOf_.emplace_back();
+    for (const Shape& shape : shapes) {
+      std::vector<cInt> key;
+      for (const IntPoint& p : shape.grown) key.insert(key.end(), {p.X, p.Y});
+      const auto [it, added] = classes.emplace(std::move(key), static_cast<int>(classSize_.size()));
+      if (added) classSize_.push_back(0);
+      ++classSize_[it->second];
+      classOf_.back().push_back(it->second);
+    }
+  }
+  for (const auto& shapes : shapes_) {
+    quarterOf_.emplace_back();
+    shapeAtQuarter_.push_back({-1, -1, -1, -1});
+    for (size_t k = 0; k < shapes.size(); ++k) {
+      const double quarters = shapes[k].rotation / 90.0;
+      int quarter = -1;
+      if (std::abs(quarters - std::round(quarters)) < 1e-12) {
+        quarter = static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
+        if (shapeAtQuarter_.back()[quarter] < 0) shapeAtQuarter_.back()[quarter] = static_cast<int>(k);
+      }
+      quarterOf_.back().push_back(quarter);
+    }
+    const auto& at = shapeAtQuarter_.back();
+    firstQuarter_.push_back(
+        static_cast<int>(std::find_if(at.begin(), at.end(), [](int k) { return k >= 0; }) - at.begin()));
+  }
+  if (options.strip) {
+    // A strip long enough for every part side by side.
+    for (const auto& shapes : shapes_) {
+      cInt longest = 0;
+      for (const Shape& s : shapes) longest = std::max({longest, s.maxX - s.minX, s.maxY - s.minY});
+      width_ += longest + toInt(options_.spacing) + 1;
+    }
+  } else {
+    width_ = toInt(options.width);
+  }
+  height_ = toInt(options.height);
+  // Wider than what two grown shapes overhang their beds (spacing / 2 and
+  // the simplification each, with mitres), in any unit.
+  if (!options.strip) pitch_ = width_ + 2 * toInt(options.spacing) + toInt(1.0);
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const bool fits = std::any_of(shapes_[i].begin(), shapes_[i].end(), [&](const Shape& s) {
+      return s.maxX - s.minX <= width_ && s.maxY - s.minY <= height_;
+    });
+    if (!fits) {
+      const Shape& s = shapes_[i].front();
+      throw std::invalid_argument(fmt::format(
+          "{} ({:.4g} x {:.4g}) does not fit the usable area of {:.4g} x {:.4g} in any allowed rotation", parts[i].name,
+          (s.maxX - s.minX) / kScale, (s.maxY - s.minY) / kScale, options.strip ? 0.0 : options.width, options.height));
+    }
+  }
+}
+
+NestingResult PartShapes::resultOf(const std::vector<std::pair<int, PlacedShape>>& placed, int sheets) const {
+  NestingResult result;
+  result.sheets = sheets;
+  cInt right = 0;
+  for (const auto& [sheet, spot] : placed) {
+    const Shape& shape = of(spot);
+    result.placements.push_back({spot.part, sheet + 1, spot.at.X / kScale, spot.at.Y / kScale, shape.rotation});
+    right = std::max(right, spot.at.X + shape.maxX);
+  }
+  result.stripLength = right / kScale;
+  return result;
+}
+
+}  // namespace rotafab::jobs::nesting
