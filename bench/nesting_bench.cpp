@@ -17,12 +17,12 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
 #include <cmath>
 #include <fstream>
 #include <numbers>
 #include <random>
 #include <string>
+#include <thread>
 
 #include <clipper.hpp>
 

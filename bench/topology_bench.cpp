@@ -20,6 +20,7 @@
 #include <string>
 
 #include "geometry/BandStructure.h"
+#include "geometry/ConstructionScale.h"
 #include "geometry/FaceTracing.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
@@ -63,6 +64,9 @@ void sizes(benchmark::internal::Benchmark* b) {
 void BM_ImportAnalyzeTrace(benchmark::State& state) {
   const auto& path = meshFile(state.range(0));
   long faces = 0;
+  rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
+  const rotafab::core::Cancellation never;
+  const rotafab::core::WorkContext context(executor, never);
   for (auto _ : state) {
     geo::ImportedMesh imported = geo::importMesh(path);
     geo::requireUsable(geo::analyzeMesh(imported.mesh));
@@ -113,12 +117,15 @@ BENCHMARK(BM_RotationSystemAndTrace)->Apply(sizes)->Unit(benchmark::kMillisecond
 void BM_BandStructure(benchmark::State& state) {
   const auto& path = meshFile(state.range(0));
   long faces = 0;
+  rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
+  const rotafab::core::Cancellation never;
+  const rotafab::core::WorkContext context(executor, never);
   for (auto _ : state) {
     geo::ImportedMesh imported = geo::importMesh(path);
     geo::requireUsable(geo::analyzeMesh(imported.mesh));
     const double scale = geo::constructionScale(imported.mesh, std::nullopt, std::nullopt);
     for (geo::Point3& p : imported.mesh.positions) p *= scale;
-    const geo::BandStructure structure = geo::buildBandStructure(imported.mesh, geo::BandOptions{});
+    const geo::Structure structure = geo::buildBandStructure(imported.mesh, geo::BandOptions{}, context);
     benchmark::DoNotOptimize(structure.panels.data());
     faces = imported.mesh.faceCount();
   }

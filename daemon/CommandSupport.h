@@ -6,17 +6,17 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/UserError.h"
 #include "daemon/ExitCode.h"
+#include "geometry/Parameters.h"
+#include "jobs/Nesting.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::cli {
 
 // Bad input or a bad option value: printed as one line, exit status 1.
-class UserError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
+using core::UserError;
 
 // A length option in in, mm or cm (a bare number is inches); zero allowed
 // unless `positive`.
@@ -27,6 +27,32 @@ inline double lengthOption(const std::string& text, const char* option, bool pos
                                 positive ? "positive " : ""));
   }
   return *value;
+}
+
+// A build parameter by the flag that sets it, for messages: "--fastener".
+inline std::string flagOf(geometry::Parameter parameter) {
+  switch (parameter) {
+    case geometry::Parameter::Structure:
+      return "--structure";
+    case geometry::Parameter::Holes:
+      return "--holes";
+    case geometry::Parameter::Size:
+      return "--size";
+    case geometry::Parameter::Scale:
+      return "--scale";
+    case geometry::Parameter::Fastener:
+      return "--fastener";
+    case geometry::Parameter::Start:
+      return "--start";
+  }
+  return "--" + geometry::parameterInWords(parameter);
+}
+
+// --order strict|window|free (CLI11 has checked the word).
+inline jobs::OrderMode orderOption(const std::string& order) {
+  return order == "strict" ? jobs::OrderMode::Strict
+         : order == "free" ? jobs::OrderMode::Free
+                           : jobs::OrderMode::Window;
 }
 
 // Runs a command's body and reports the errors every command reports alike,

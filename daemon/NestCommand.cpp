@@ -5,8 +5,8 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
-#include <thread>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "daemon/CommandSupport.h"
 #include "daemon/ExitCode.h"
@@ -86,14 +86,10 @@ int runNest(const NestOptions& options) {
       nesting.height = bed.height - 2 * bed.margin;
       nesting.spacing = options.spacing.empty() ? 0.0625 : lengthOption(options.spacing, "--spacing");
     }
-    if (options.order == "strict")
-      nesting.order = jobs::OrderMode::Strict;
-    else if (options.order == "window")
-      nesting.order = jobs::OrderMode::Window;
-    else
-      nesting.order = jobs::OrderMode::Free;
+    nesting.order = orderOption(options.order);
     nesting.window = options.window;
-    core::Executor executor(std::max({1u, std::thread::hardware_concurrency(), static_cast<unsigned>(options.threads)}));
+    core::Executor executor(
+        std::max({1u, std::thread::hardware_concurrency(), static_cast<unsigned>(options.threads)}));
     core::Cancellation cancellation;
     core::ProgressSink progress;
     if (!options.json) {

@@ -8,6 +8,7 @@
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
 #include "daemon/MakeCommand.h"
+#include "daemon/ManifestCommand.h"
 #include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
 #include "daemon/RunCommand.h"
@@ -23,6 +24,7 @@ int main(int argc, char** argv) {
   int status = kSuccess;
   addInspectCommand(app, status);
   addMakeCommand(app, status);
+  addManifestCommand(app, status);
   addNestCommand(app, status);
   addProfilesCommand(app, status);
   addRunCommand(app, status, argv);

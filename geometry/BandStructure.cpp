@@ -6,7 +6,6 @@
 #include <cmath>
 #include <set>
 #include <stdexcept>
-#include <thread>
 
 #include "geometry/BandDecomposition.h"
 #include "geometry/DevelopableBands.h"
@@ -16,27 +15,6 @@
 
 namespace rotafab::geometry {
 
-double constructionScale(const PolygonMesh& mesh, std::optional<double> size, std::optional<double> scale) {
-  if (scale) return *scale;
-  if (size) {
-    Point3 low = mesh.positions.front(), high = mesh.positions.front();
-    for (const Point3& p : mesh.positions) low = low.cwiseMin(p), high = high.cwiseMax(p);
-    const double largest = (high - low).maxCoeff();
-    if (!(largest > 0)) throw std::invalid_argument("--size: the mesh has no extent to scale");
-    return *size / largest;
-  }
-  std::set<std::pair<int, int>> edges;
-  double total = 0;
-  for (const auto& face : mesh.faces) {
-    for (size_t i = 0; i < face.size(); ++i) {
-      const int a = face[i], b = face[(i + 1) % face.size()];
-      if (edges.emplace(std::min(a, b), std::max(a, b)).second) total += (mesh.positions[a] - mesh.positions[b]).norm();
-    }
-  }
-  if (edges.empty() || !(total > 0)) throw std::invalid_argument("the mesh has no edge of positive length to scale by");
-  return 2.0 / (total / static_cast<double>(edges.size()));
-}
-
 namespace {
 
 double polygonArea3(const std::vector<Point3>& polygon) {
@@ -45,25 +23,26 @@ double polygonArea3(const std::vector<Point3>& polygon) {
   return sum.norm() / 2;
 }
 
-void say(const BandOptions& options, const std::string& line) {
-  if (options.progress) options.progress(line);
-}
-
 }  // namespace
 
-BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options) {
-  if (!(options.fastener > 0)) throw std::invalid_argument("--fastener: the hole diameter must be positive");
+Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
+  const ParameterNames& names = options.names;
+  if (!(options.fastener > 0)) {
+    throw ParameterError(Parameter::Fastener, names(Parameter::Fastener) + ": the hole diameter must be positive");
+  }
   const RotationSystem rs = RotationSystem::fromMesh(mesh);
   // Faces as a user finds them in the file; a face capping a hole (--holes fill) has no number there.
   const auto faceName = [&](int f) {
     return mesh.sourceFaceIndex(f) >= 0 ? fmt::format("face {}", mesh.sourceFaceIndex(f))
                                         : std::string("the face filling a hole");
   };
-  say(options, fmt::format("band decomposition of {} faces", mesh.faceCount()));
+  context.report({"geometry", "band decomposition", 0, static_cast<size_t>(mesh.faceCount())});
   const BandDecomposition decomposition = bandDecomposition(mesh, rs, options.tension);
+  context.check();
   const std::vector<EdgeBand> bands = developableBands(rs, decomposition, options.samples);
   std::vector<FlatPanel> flat;
   for (int f = 0; f < mesh.faceCount(); ++f) {
+    context.check();
     try {
       flat.push_back(unfoldPanel(rs, decomposition, bands, f));
     } catch (const std::invalid_argument& error) {
@@ -77,8 +56,9 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
       if (mesh.sourceFaceIndex(f) == *options.start) start = f;
     }
     if (start < 0) {
-      throw std::invalid_argument(fmt::format(
-          "--start {}: the mesh has no such face (faces are numbered from 0 as in the file)", *options.start));
+      throw ParameterError(Parameter::Start,
+                           fmt::format("{} {}: the mesh has no such face (faces are numbered from 0 as in the file)",
+                                       names(Parameter::Start), *options.start));
     }
   } else {
     start = lowestFace(mesh, options.up);
@@ -95,6 +75,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   // A piece crossing itself cannot be mended so.
   int split = 0;
   for (int f = 0; f < mesh.faceCount(); ++f) {
+    context.check();
     for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
       const auto [i, j] = overlaps.front();
       const auto where = [&] { return fmt::format("panel {} ({})", order.panelOfFace[f] + 1, faceName(f)); };
@@ -140,32 +121,30 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
       };
       if (!cutOff(j) && (i < 0 || !cutOff(i))) {
         throw std::invalid_argument(fmt::format(
-            "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger --size "
-            "or a smaller --fastener makes room",
-            where(), edgeName(flat[f].bands[j].edge), why));
+            "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger {} or a "
+            "smaller {} makes room",
+            where(), edgeName(flat[f].bands[j].edge), why, names(Parameter::Size), names(Parameter::Fastener)));
       }
       ++split;
     }
   }
-  if (split > 0) {
-    say(options, fmt::format("{} band{} cut off {} panel{} that would overlap themselves, each fastened back by a tab",
-                             split, split == 1 ? "" : "s", split == 1 ? "a" : "the", split == 1 ? "" : "s"));
-  }
+  if (split > 0) context.report({"geometry", "panels split", static_cast<size_t>(split), 0});
 
   // Edge numbers in the order the flood fill meets the edges, so that the
   // numbers a builder looks for next are close to the ones in hand.
-  BandStructure result;
+  Structure result;
+  result.kind = StructureKind::Band;
   std::vector<int> edgeNumber(rs.edgeCount(), 0);
   for (int face : order.faceOfPanel) {
     Dart d = rs.faceDart(face);
     for (size_t side = 0; side < mesh.faces[face].size(); ++side, d = rs.faceNext(d)) {
       const int e = RotationSystem::edgeOf(d);
-      if (!rs.isBoundaryEdge(e) && edgeNumber[e] == 0) edgeNumber[e] = ++result.interiorEdges;
+      if (!rs.isBoundaryEdge(e) && edgeNumber[e] == 0) edgeNumber[e] = ++result.edges;
     }
   }
 
-  say(options, fmt::format("fastener holes on {} bands", result.interiorEdges));
-  const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener, edgeName);
+  context.report({"geometry", "fastener holes", 0, static_cast<size_t>(result.edges)});
+  const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener, context, edgeName, names);
   int narrow = 0, narrowest = -1;
   result.fasteners = split;  // the tabs'
   for (const BandHoles& h : holes) {
@@ -177,12 +156,12 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
   if (narrow > 0) {
     result.warnings.push_back(fmt::format(
         "{} band{} too narrow for a {:.3f} in hole {} diameters from its outlines: one hole each, down to {:.2f} "
-        "diameters (edge {}); a larger --size or a smaller --fastener gives them the full clearance",
+        "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
         narrow, narrow == 1 ? " is" : "s are", options.fastener, kClearance, holes[narrowest].clearance,
-        edgeNumber[narrowest]));
+        edgeNumber[narrowest], names(Parameter::Size), names(Parameter::Fastener)));
   }
 
-  say(options, fmt::format("labels on {} panels", mesh.faceCount()));
+  context.report({"geometry", "labels", 0, static_cast<size_t>(mesh.faceCount())});
   const HersheyFont& font = HersheyFont::simplex();
   // Each panel on its own, so the panels are shared out among the cores.
   result.panels.resize(mesh.faceCount());
@@ -193,7 +172,8 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     const FlatPanel& fp = flat[f];
     Panel panel;
     panel.id = number + 1;
-    panel.face = mesh.sourceFaceIndex(f);
+    panel.source.face = mesh.sourceFaceIndex(f);
+    panel.source.cap = panel.source.face < 0;
     panel.outline = fp.outline;
     const VertexBand& vb = decomposition.vertexBands[f];
     panel.area = polygonArea3(vb.corners);
@@ -233,8 +213,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
         bandArea += polygonArea3(panel.surface.back());
       }
       (piece ? piece->area : panel.area) += bandArea;
-      panel.neighbors.push_back(order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1);
-      panel.edges.push_back(edgeNumber[copy.edge]);
+      panel.joins.push_back({order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1, edgeNumber[copy.edge]});
     }
     // Labels: each band's edge number near its holes, reading out from the
     // vertex band (on a piece: and the piece's name on its tab); then the
@@ -265,7 +244,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
       if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, outlineHere,
                                    circlesHere, takenHere, candidates)) {
         takenHere.push_back(*box);
-        labelsHere.push_back({labelText(label), edgeNumber[copy.edge], "edge", *box,
+        labelsHere.push_back({labelText(label), edgeNumber[copy.edge], LabelRole::Edge, *box,
                               labelStrokes(font, label, box->origin, box->height, box->angle)});
       } else {
         unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
@@ -282,8 +261,8 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
         const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
         if (const auto box = fitText(font, piece->name, std::atan2(side.y(), side.x()), copy.tabOutline,
                                      copy.pieceOutline, circlesHere, takenHere, onTab)) {
-          piece->labels.push_back(
-              {piece->name, 0, "piece", *box, font.strokes(piece->name, box->origin, box->height, box->angle)});
+          piece->labels.push_back({piece->name, 0, LabelRole::Piece, *box,
+                                   font.strokes(piece->name, box->origin, box->height, box->angle)});
         } else {
           unfitted.push_back(fmt::format("piece {}", piece->name));
         }
@@ -305,8 +284,8 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
       const std::string label = std::to_string(panel.id);
       if (const auto box =
               fitText(font, labelText(label), 0.0, fp.vertexBand, fp.outline, circles, taken, candidates)) {
-        panel.labels.push_back(
-            {labelText(label), 0, "panel", *box, labelStrokes(font, label, box->origin, box->height, box->angle)});
+        panel.labels.push_back({labelText(label), 0, LabelRole::Panel, *box,
+                                labelStrokes(font, label, box->origin, box->height, box->angle)});
       } else {
         unfitted.push_back(fmt::format("panel number {}", panel.id));
       }
@@ -319,22 +298,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
     }
     result.panels[number] = std::move(panel);
   };
-  const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
-  std::vector<std::thread> threads;
-  std::vector<std::exception_ptr> errors(workers);
-  for (int w = 0; w < workers; ++w) {
-    threads.emplace_back([&, w] {
-      try {
-        for (int number = w; number < mesh.faceCount(); number += workers) makePanel(number);
-      } catch (...) {
-        errors[w] = std::current_exception();
-      }
-    });
-  }
-  for (std::thread& thread : threads) thread.join();
-  for (const auto& error : errors) {
-    if (error) std::rethrow_exception(error);
-  }
+  context.parallelFor(mesh.faceCount(), [&](size_t number) { makePanel(static_cast<int>(number)); });
   std::vector<std::string> unfitted;
   for (auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
   if (!unfitted.empty()) {
@@ -345,6 +309,7 @@ BandStructure buildBandStructure(const PolygonMesh& mesh, const BandOptions& opt
                                           unfitted.size() == 1 ? "its" : "their", kSmallestLabel, some,
                                           unfitted.size() > 3 ? ", ..." : ""));
   }
+  result.steps = stepsInPanelOrder(result.panels);
   return result;
 }
 

@@ -8,7 +8,6 @@
 #include <map>
 #include <optional>
 #include <stdexcept>
-#include <thread>
 
 namespace rotafab::geometry {
 
@@ -68,7 +67,8 @@ struct BandTooSmall {
 
 }  // namespace
 
-NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded_, double diameter)
+NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded_, double diameter,
+                                       const ParameterNames& names)
     : std::invalid_argument(""),
       bandsWithoutRoom(firstBand + (bands > 1 ? fmt::format(" (nor have {} other bands)", bands - 1) : "")),
       scaleNeeded(scaleNeeded_) {
@@ -78,11 +78,13 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
            ? fmt::format(
                  "; a fastener of {:.3f} in or less, or the mesh {:.2f} times larger, would give every band room",
                  std::floor(diameter / scaleNeeded * 1000) / 1000, scaleNeeded)
-           : "; use a smaller --fastener or a larger --size"));
+           : fmt::format("; use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size))));
 }
 
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
-                                          double diameter, const std::function<std::string(int)>& edgeName) {
+                                          double diameter, const core::WorkContext& context,
+                                          const std::function<std::string(int)>& edgeName,
+                                          const ParameterNames& names) {
   std::vector<BandHoles> result(bands.size());
   const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
   // Holes already placed, per part cut: a panel (key (face, -1)) and each
@@ -198,28 +200,15 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   // on the same panel (rare: the outline runs between two bands) is placed
   // again beside them. The result does not depend on the number of cores.
   const Placed none;
-  std::vector<std::exception_ptr> errors(bands.size());
   std::vector<std::optional<BandTooSmall>> tooSmall(bands.size());
-  const int workers = std::clamp(static_cast<int>(std::thread::hardware_concurrency()), 1, 16);
-  std::vector<std::thread> threads;
-  for (int w = 0; w < workers; ++w) {
-    threads.emplace_back([&, w] {
-      for (size_t e = w; e < bands.size(); e += workers) {
-        if (bands[e].edge < 0) continue;
-        try {
-          result[e] = placeBand(bands[e], none);
-        } catch (const BandTooSmall& small) {
-          tooSmall[e] = small;
-        } catch (...) {
-          errors[e] = std::current_exception();
-        }
-      }
-    });
-  }
-  for (std::thread& thread : threads) thread.join();
-  for (const auto& error : errors) {
-    if (error) std::rethrow_exception(error);
-  }
+  context.parallelFor(bands.size(), [&](size_t e) {
+    if (bands[e].edge < 0) return;
+    try {
+      result[e] = placeBand(bands[e], none);
+    } catch (const BandTooSmall& small) {
+      tooSmall[e] = small;
+    }
+  });
   // Every band without room, in one error: the first by edge, how many, and
   // the scale that gives the smallest of them room.
   const BandTooSmall* first = nullptr;
@@ -231,7 +220,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     ++small;
     scaleNeeded = std::max(scaleNeeded, some->scaleNeeded);
   }
-  if (first) throw NoRoomForHoleError(first->what, small, scaleNeeded, diameter);
+  if (first) throw NoRoomForHoleError(first->what, small, scaleNeeded, diameter, names);
   Placed holesOn;
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {
@@ -258,7 +247,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       try {
         result[band.edge] = placeBand(band, holesOn);
       } catch (const BandTooSmall& small) {
-        throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter);
+        throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter, names);
       }
     }
     for (int c = 0; c < 2; ++c) {

@@ -30,7 +30,9 @@
 #include <string>
 #include <vector>
 
+#include "core/WorkContext.h"
 #include "geometry/PanelUnfolding.h"
+#include "geometry/Parameters.h"
 
 namespace rotafab::geometry {
 
@@ -60,17 +62,22 @@ struct BandHoles {
 // gives every one of them room.
 class NoRoomForHoleError : public std::invalid_argument {
  public:
-  NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded, double diameter);
+  NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded, double diameter,
+                     const ParameterNames& names = parameterInWords);
   std::string bandsWithoutRoom;  // "EDGE: its band (L x W in) has no room for ... (nor have N other bands)"
   double scaleNeeded;            // > 1; infinite when a band's middle is off its panel
 };
 
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed
 // by face. Throws NoRoomForHoleError naming the first edge (by `edgeName`)
-// when some band has no room for even one hole kLeastClearance from its outlines.
+// when some band has no room for even one hole kLeastClearance from its
+// outlines, and core::Cancelled. The bands are shared out on the context's
+// executor; the result does not depend on how many threads it has.
 std::vector<BandHoles> placeFastenerHoles(
     const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels, double diameter,
-    const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); });
+    const core::WorkContext& context,
+    const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); },
+    const ParameterNames& names = parameterInWords);
 
 // The outline a copy of a band is cut with: its panel's, or its own piece's when detached.
 const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy);

@@ -18,7 +18,7 @@ int lowestFace(const PolygonMesh& mesh, int up) {
 FloodFillOrder floodFill(const PolygonMesh& mesh, const RotationSystem& rs, int start, int up) {
   if (start < 0 || start >= mesh.faceCount()) {
     throw std::invalid_argument(
-        fmt::format("--start {}: the mesh's faces are numbered 0 to {}", start, mesh.faceCount() - 1));
+        fmt::format("start face {}: the mesh's faces are numbered 0 to {}", start, mesh.faceCount() - 1));
   }
   FloodFillOrder order;
   order.panelOfFace.assign(mesh.faceCount(), -1);

@@ -27,7 +27,8 @@ bool writeAll(int fd, const std::string& bytes) {
 
 }  // namespace
 
-IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono::milliseconds timeout) {
+IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono::milliseconds timeout,
+                           const core::Cancellation* cancellation) {
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
   ::fcntl(fds[1], F_SETPIPE_SZ, 1 << 20);  // fewer round trips for a large result; best effort
@@ -56,7 +57,7 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
 
   IsolatedResult result;
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  bool timedOut = false;
+  bool timedOut = false, cancelled = false;
   std::vector<char> buffer(1 << 20);
   for (;;) {
     const auto left =
@@ -65,8 +66,12 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
       timedOut = true;
       break;
     }
+    if (cancellation && cancellation->cancelled()) {
+      cancelled = true;
+      break;
+    }
     pollfd waiting{fds[0], POLLIN, 0};
-    const int ready = ::poll(&waiting, 1, static_cast<int>(std::min<long long>(left.count(), 1000)));
+    const int ready = ::poll(&waiting, 1, static_cast<int>(std::min<long long>(left.count(), 100)));
     if (ready < 0 && errno == EINTR) continue;
     if (ready <= 0) continue;
     const ssize_t n = ::read(fds[0], buffer.data(), buffer.size());
@@ -75,10 +80,11 @@ IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono
     result.output.append(buffer.data(), static_cast<size_t>(n));
   }
   ::close(fds[0]);
-  if (timedOut) ::kill(child, SIGKILL);
+  if (timedOut || cancelled) ::kill(child, SIGKILL);
   int status = 0;
   while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
   }
+  if (cancelled) throw core::Cancelled();
   if (timedOut) {
     result.status = IsolatedResult::Status::TimedOut;
   } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {

@@ -8,6 +8,8 @@
 #include <functional>
 #include <string>
 
+#include "core/Cancellation.h"
+
 namespace rotafab::geometry {
 
 struct IsolatedResult {
@@ -19,6 +21,8 @@ struct IsolatedResult {
 
 // The child's standard error goes to /dev/null: a library's own messages must
 // not reach the user's terminal. An exception escaping `work` counts as a crash.
-IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono::milliseconds timeout);
+// A cancel (checked every 100 ms) kills the child and throws core::Cancelled.
+IsolatedResult runIsolated(const std::function<std::string()>& work, std::chrono::milliseconds timeout,
+                           const core::Cancellation* cancellation = nullptr);
 
 }  // namespace rotafab::geometry

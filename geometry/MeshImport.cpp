@@ -224,7 +224,7 @@ PolygonMesh deserialize(std::string_view bytes) {
 // some malformed files (its assertions are on) and may crash or hang on others;
 // any of that becomes one clear error here instead of taking rotafab down.
 PolygonMesh readWithAssimpIsolated(std::string_view bytes, const std::string& extension,
-                                   const std::filesystem::path* path) {
+                                   const std::filesystem::path* path, const core::Cancellation* cancellation) {
   // Generous: Assimp reads 200k faces of OBJ in about 0.15 s.
   const auto timeout = std::chrono::seconds(120 + bytes.size() / 1'000'000);
   const IsolatedResult result = runIsolated(
@@ -243,7 +243,7 @@ PolygonMesh readWithAssimpIsolated(std::string_view bytes, const std::string& ex
         }
         return reply;
       },
-      timeout);
+      timeout, cancellation);
   std::string format = extension;
   std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::toupper(c); });
   if (result.status == IsolatedResult::Status::TimedOut) {
@@ -258,11 +258,12 @@ PolygonMesh readWithAssimpIsolated(std::string_view bytes, const std::string& ex
   return deserialize(std::string_view(result.output).substr(1));
 }
 
-PolygonMesh readAny(std::string_view bytes, const std::string& extension, const std::filesystem::path* path) {
+PolygonMesh readAny(std::string_view bytes, const std::string& extension, const std::filesystem::path* path,
+                    const core::Cancellation* cancellation) {
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
   if (extension == "off") return readOff(bytes);
   if (extension == "ply") return readPly(bytes);
-  return readWithAssimpIsolated(bytes, extension, path);
+  return readWithAssimpIsolated(bytes, extension, path, cancellation);
 }
 
 ImportedMesh finishImport(PolygonMesh mesh) {
@@ -289,6 +290,8 @@ template <typename Read>
 ImportedMesh withFileName(std::string_view displayName, Read read) {
   try {
     return read();
+  } catch (const core::Cancelled&) {
+    throw;
   } catch (const InvalidMeshError& error) {
     throw InvalidMeshError(fmt::format("{}: {}", displayName, error.what()));
   } catch (const std::bad_alloc&) {
@@ -329,15 +332,16 @@ std::string extensionOf(const std::filesystem::path& path) {
 
 }  // namespace
 
-ImportedMesh importMesh(const std::filesystem::path& path) {
+ImportedMesh importMesh(const std::filesystem::path& path, const core::Cancellation* cancellation) {
   return withFileName(path.string(), [&] {
     const std::string bytes = readRegularFile(path);
-    return finishImport(readAny(bytes, extensionOf(path), &path));
+    return finishImport(readAny(bytes, extensionOf(path), &path, cancellation));
   });
 }
 
 ImportedMesh importMeshFromMemory(std::string_view bytes, std::string_view extension, std::string_view displayName) {
-  return withFileName(displayName, [&] { return finishImport(readAny(bytes, lowercase(extension), nullptr)); });
+  return withFileName(displayName,
+                      [&] { return finishImport(readAny(bytes, lowercase(extension), nullptr, nullptr)); });
 }
 
 CleaningReport cleanMesh(PolygonMesh& mesh) {

@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/Cancellation.h"
 #include "geometry/PolygonMesh.h"
 
 namespace rotafab::geometry {
@@ -26,7 +27,8 @@ struct ImportedMesh {
   std::vector<std::string> warnings;  // one line each, without the file name
 };
 
-ImportedMesh importMesh(const std::filesystem::path& path);
+// A cancel stops the import within 100 ms (core::Cancelled).
+ImportedMesh importMesh(const std::filesystem::path& path, const core::Cancellation* cancellation = nullptr);
 
 // The same from bytes in memory; `extension` picks the reader ("off", "obj",
 // ...) and `displayName` prefixes messages. Used by the fuzz target.

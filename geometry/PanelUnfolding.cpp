@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "geometry/StripUnfolding.h"
+
 namespace rotafab::geometry {
 
 Point2 FlatBand::at(double s, double t) const {
@@ -18,108 +20,23 @@ Point2 FlatBand::at(double s, double t) const {
   return (1 - t) * u + t * v;
 }
 
-double signedArea(const std::vector<Point2>& polygon) {
-  double twice = 0;
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[(i + 1) % polygon.size()];
-    twice += a.x() * b.y() - b.x() * a.y();
-  }
-  return twice / 2;
-}
-
-double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p) {
-  double nearest = std::numeric_limits<double>::max();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[(i + 1) % polygon.size()];
-    const Point2 ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    nearest = std::min(nearest, (a + t * ab - p).norm());
-  }
-  return nearest;
-}
-
-bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p) {
-  bool in = false;
-  for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[j];
-    if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x()) {
-      in = !in;
-    }
-  }
-  return in;
-}
-
 namespace {
-
-double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-// The point at distances `fromP` and `fromQ` from p and q, on the other side
-// of the line pq from `away`.
-Point2 apex(const Point2& p, const Point2& q, double fromP, double fromQ, const Point2& away) {
-  const Point2 base = q - p;
-  const double length = base.norm();
-  if (!(length > 0)) throw std::invalid_argument("a band has a side of zero length");
-  const Point2 along = base / length, normal(-along.y(), along.x());
-  const double x = (fromP * fromP - fromQ * fromQ + length * length) / (2 * length);
-  const double h = std::sqrt(std::max(0.0, fromP * fromP - x * x));
-  const double side = cross(base, away - p) > 0 ? -1.0 : 1.0;
-  return p + x * along + side * h * normal;
-}
 
 // Develops `band` from its side on the panel's vertex band (its two points
 // already placed in `points`), triangle by triangle from that end.
 void develop(const EdgeBand& band, bool fromA, std::vector<Point2>& points, const Point2& inside) {
-  const auto triangles = band.triangles();
-  const int count = static_cast<int>(triangles.size());
+  std::vector<Point3> space;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) space.push_back(band.point(i));
+  auto triangles = band.triangles();
+  if (!fromA) std::reverse(triangles.begin(), triangles.end());
   std::vector<char> placed(points.size(), 0);
   const int k = band.segments();
   placed[fromA ? 0 : k] = placed[fromA ? k + 1 : 2 * k + 1] = 1;
-  Point2 away = inside;
-  std::array<int, 3> previous{-1, -1, -1};
-  for (int step = 0; step < count; ++step) {
-    const std::array<int, 3>& t = triangles[fromA ? step : count - 1 - step];
-    int fresh = -1;
-    std::vector<int> shared;
-    for (int i : t) {
-      if (placed[i]) {
-        shared.push_back(i);
-      } else {
-        fresh = i;
-      }
-    }
-    if (previous[0] >= 0) {
-      for (int i : previous) {
-        if (i != shared[0] && i != shared[1]) away = points[i];
-      }
-    }
-    const int p = shared[0], q = shared[1];
-    points[fresh] = apex(points[p], points[q], (band.point(fresh) - band.point(p)).norm(),
-                         (band.point(fresh) - band.point(q)).norm(), away);
-    placed[fresh] = 1;
-    previous = t;
+  try {
+    unfoldStrip(space, triangles, points, placed, inside);
+  } catch (const std::invalid_argument&) {
+    throw std::invalid_argument("a band has a side of zero length");
   }
-}
-
-// Whether segments ab and cd cross at a point inside both (touching and
-// collinear overlaps excluded: pieces of a panel meet along shared sides and at shared corners).
-bool properlyCross(const Point2& a, const Point2& b, const Point2& c, const Point2& d) {
-  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
-  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-  const double scale = 1e-12 * std::max((b - a).squaredNorm(), (d - c).squaredNorm());
-  return ((d1 > scale && d2 < -scale) || (d1 < -scale && d2 > scale)) &&
-         ((d3 > scale && d4 < -scale) || (d3 < -scale && d4 > scale));
-}
-
-bool outlinesCross(const std::vector<Point2>& a, const std::vector<Point2>& b) {
-  for (size_t i = 0; i < a.size(); ++i) {
-    for (size_t j = 0; j < b.size(); ++j) {
-      if (properlyCross(a[i], a[(i + 1) % a.size()], b[j], b[(j + 1) % b.size()])) return true;
-    }
-  }
-  return false;
 }
 
 // The cut contour: the vertex band's corners, each side but those of
@@ -137,16 +54,6 @@ void rebuildOutline(FlatPanel& panel) {
 }
 
 }  // namespace
-
-bool crossesItself(const std::vector<Point2>& o) {
-  for (size_t a = 0; a < o.size(); ++a) {
-    for (size_t b = a + 2; b < o.size(); ++b) {
-      if (a == 0 && b + 1 == o.size()) continue;
-      if (properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()])) return true;
-    }
-  }
-  return false;
-}
 
 void detachBand(FlatPanel& panel, int index, double depth) {
   const int sides = static_cast<int>(panel.vertexBand.size());
@@ -179,7 +86,7 @@ void detachBand(FlatPanel& panel, int index, double depth) {
       throw std::invalid_argument(fmt::format("its vertex band has a corner where the tab would go"));
     }
   }
-  if (outlinesCross(band.tabOutline, panel.vertexBand) || crossesItself(band.pieceOutline)) {
+  if (core::outlinesCross(band.tabOutline, panel.vertexBand) || crossesItself(band.pieceOutline)) {
     throw std::invalid_argument("the tab would not lie on the vertex band");
   }
   rebuildOutline(panel);
@@ -263,7 +170,7 @@ std::vector<std::pair<int, int>> overlappingPieces(const FlatPanel& panel) {
   for (int i = -1; i < n; ++i) {
     for (int j = i + 1; j < n; ++j) {
       if (!attached(i) || !attached(j)) continue;
-      if (outlinesCross(piece(i), piece(j)) || insidePolygon(piece(i), middle(j)) ||
+      if (core::outlinesCross(piece(i), piece(j)) || insidePolygon(piece(i), middle(j)) ||
           insidePolygon(piece(j), middle(i))) {
         result.emplace_back(i, j);
       }

@@ -1,23 +1,27 @@
 #pragma once
 // Unfolding a vertex panel (dissertation V.4, with IV.3's triangle-strip
-// unfolding): the planar vertex band is laid flat in its own plane, seen
-// from outside, and each edge band is developed from the vertex band's side
-// it hangs on, triangle by triangle: each triangle keeps its three edge
-// lengths and goes on the far side of the edge it shares with the one before
-// (the first on the outside of the vertex band's side). Both copies of a band
-// are developed from the same triangles, one from each end, so they are
-// congruent: a point of the band (its triangle and barycentric coordinates)
-// lies at the same distances on both panels.
+// unfolding, StripUnfolding.h): the planar vertex band is laid flat in its
+// own plane, seen from outside, and each edge band is developed from the
+// vertex band's side it hangs on, triangle by triangle, the first on the
+// outside of the vertex band's side. Both copies of a band are developed
+// from the same triangles, one from each end, so they are congruent: a point
+// of the band (its triangle and barycentric coordinates) lies at the same
+// distances on both panels.
 
 #include <Eigen/Core>
 #include <array>
 #include <vector>
 
+#include "core/Polygon2.h"
 #include "geometry/DevelopableBands.h"
 
 namespace rotafab::geometry {
 
-using Point2 = Eigen::Vector2d;
+using core::crossesItself;
+using core::distanceToOutline;
+using core::insidePolygon;
+using core::Point2;
+using core::signedArea;
 
 struct FlatBand {
   int edge = -1;
@@ -59,18 +63,6 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
 // on the vertex band, or when the piece would cross itself; the panel is
 // then left half changed (detach a copy).
 void detachBand(FlatPanel& panel, int index, double depth);
-
-// Whether a closed outline crosses itself (two sides that are not neighbours properly cross).
-bool crossesItself(const std::vector<Point2>& outline);
-
-// The distance from `p` to the nearest side of a closed polygon.
-double distanceToOutline(const std::vector<Point2>& polygon, const Point2& p);
-
-// Whether `p` is inside a closed polygon (even-odd).
-bool insidePolygon(const std::vector<Point2>& polygon, const Point2& p);
-
-// Signed area (positive counter-clockwise).
-double signedArea(const std::vector<Point2>& polygon);
 
 // Pairs of the panel's pieces that overlap: -1 for the vertex band, else an
 // index into bands; (i, i) for a piece that crosses itself. Empty when no

@@ -6,13 +6,15 @@
 #include <fstream>
 #include <map>
 #include <numbers>
+#include <set>
 #include <stdexcept>
 
+#include "core/UserError.h"
 #include "jobs/SvgWriter.h"
 
 namespace rotafab::jobs {
 
-std::vector<Part> bandParts(const geometry::BandStructure& structure) {
+std::vector<Part> structureParts(const geometry::Structure& structure) {
   std::vector<Part> parts;
   const auto add = [&](const std::string& name, int order, const Polygon2& outline,
                        const std::vector<geometry::PanelHole>& holes, const std::vector<geometry::PanelLabel>& labels,
@@ -52,7 +54,7 @@ std::vector<Part> bandParts(const geometry::BandStructure& structure) {
   return parts;
 }
 
-std::vector<std::pair<int, int>> partOwners(const geometry::BandStructure& structure) {
+std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure) {
   std::vector<std::pair<int, int>> owners;
   for (size_t i = 0; i < structure.panels.size(); ++i) {
     owners.emplace_back(static_cast<int>(i), -1);
@@ -67,14 +69,22 @@ namespace {
 
 nlohmann::ordered_json point(const Point2& p) { return {p.x(), p.y()}; }
 
+// SPEC's `source`: a band panel's face (a cap of --holes fill has none in
+// the file), a woven panel's edge and cycle.
+nlohmann::ordered_json sourceOf(const geometry::PanelSource& source) {
+  if (source.edge >= 0) return {{"edge", source.edge}, {"cycle", source.cycle}};
+  if (source.cap) return {{"face", nullptr}, {"cap", true}};
+  return {{"face", source.face}};
+}
+
 }  // namespace
 
-nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, const MeshCounts& mesh,
-                                    const profiles::Bed& bed, const SheetPlan& plan,
-                                    const std::vector<std::vector<std::string>>& files) {
+nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const MeshCounts& mesh,
+                                         const profiles::Bed& bed, const SheetPlan& plan,
+                                         const std::vector<std::vector<std::string>>& files) {
   nlohmann::ordered_json manifest;
   manifest["version"] = 1;
-  manifest["structure"] = "band";
+  manifest["structure"] = geometry::structureName(structure.kind);
   manifest["units"] = "in";
   manifest["mesh"] = {{"vertices", mesh.vertices},
                       {"edges", mesh.edges},
@@ -82,7 +92,7 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
                       {"genus", mesh.genus ? nlohmann::ordered_json(*mesh.genus) : nlohmann::ordered_json(nullptr)}};
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
-  // Which panel (and piece) each planned part is, in bandParts()'s order.
+  // Which panel (and piece) each planned part is, in structureParts()'s order.
   const std::vector<std::pair<int, int>> owners = partOwners(structure);
   std::vector<const PlannedPart*> placement(structure.panels.size());
   std::map<std::pair<int, int>, const PlannedPart*> piecePlacement;
@@ -118,9 +128,7 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
     entry["id"] = panel.id;
     entry["order"] = placed.cuttingIndex + 1;  // its place in the cutting order
     entry["sheet"] = placed.sheet;
-    // A cap of --holes fill has no face in the file.
-    entry["source"] = panel.face >= 0 ? nlohmann::ordered_json{{"face", panel.face}}
-                                      : nlohmann::ordered_json{{"face", nullptr}, {"cap", true}};
+    entry["source"] = sourceOf(panel.source);
     entry["outline"] = nlohmann::ordered_json::array();
     for (const Point2& p : panel.outline) entry["outline"].push_back(point(p));
     entry["placement"] = {{"x", placed.x}, {"y", placed.y}, {"rotation", placed.rotation}};
@@ -130,17 +138,19 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
     }
     entry["labels"] = nlohmann::ordered_json::array();
     for (const auto& label : panel.labels) {
-      nlohmann::ordered_json l = {
-          {"text", label.role == "edge" ? std::to_string(label.edge) : std::to_string(panel.id)}};
-      if (label.role == "edge") l["edge"] = label.edge;
-      l["role"] = label.role;
+      // The number the label shows (without the mark of 6 and 9): an edge's, or the panel's own.
+      nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
+      if (label.edge > 0) l["edge"] = label.edge;
+      l["role"] = geometry::roleName(label.role);
       entry["labels"].push_back(l);
     }
-    entry["neighbors"] = panel.neighbors;
+    std::vector<int> neighbors, edges;
+    for (const geometry::PanelJoin& join : panel.joins) neighbors.push_back(join.panel), edges.push_back(join.edge);
+    entry["neighbors"] = neighbors;
     entry["area"] = panel.area;
     // Extensions: the edge number joining each neighbour (same order), and
     // how far the layout moved the panel from its assembly order.
-    entry["edges"] = panel.edges;
+    entry["edges"] = edges;
     entry["moved"] = placed.moved;
     // Extension: the bands cut off a panel that would overlap itself (V.4),
     // each a part of its own with a tab fastened to the vertex band.
@@ -172,45 +182,55 @@ nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, co
 
 namespace {
 
-// One assembly step: a panel, its sheet, and the panels placed before it
-// that it joins, with the edge and the fasteners of each.
-struct Join {
-  int panel = 0, edge = 0, fasteners = 0;
-};
+// One assembly step (geometry::stepsInPanelOrder) and where its panel and
+// pieces are cut.
 struct Step {
-  int panel = 0, sheet = 0;
-  std::vector<Join> joins;
-  std::vector<std::pair<std::string, int>> pieces;  // (name, sheet) of its bands cut off
+  geometry::AssemblyStep step;
+  int sheet = 0;
+  std::vector<int> pieceSheets;
 };
 
+// The steps of a manifest read back: its panels in id order, as far as the
+// steps need them (joins, holes' edges, pieces).
 std::vector<Step> stepsOf(const nlohmann::json& manifest) {
   std::map<int, const nlohmann::json*> byId;
   for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
+  std::vector<geometry::Panel> panels;
   std::vector<Step> steps;
   for (const auto& [id, panel] : byId) {
-    const auto& neighbors = panel->at("neighbors");
-    // A band's holes are on the panel, or on the piece it was cut off as.
-    std::map<int, int> holesOfEdge;
-    for (const auto& hole : panel->at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
-    Step step{id, panel->at("sheet").get<int>(), {}, {}};
+    geometry::Panel read;
+    read.id = id;
+    Step step;
+    step.sheet = panel->at("sheet").get<int>();
+    std::set<int> edgesHere;  // with holes on the panel or its pieces
+    for (const auto& hole : panel->at("holes")) {
+      read.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
+      edgesHere.insert(read.holes.back().edge);
+    }
     if (panel->contains("pieces")) {
       for (const auto& piece : panel->at("pieces")) {
-        for (const auto& hole : piece.at("holes")) ++holesOfEdge[hole.at("edge").get<int>()];
-        step.pieces.emplace_back(piece.at("name").get<std::string>(), piece.at("sheet").get<int>());
+        geometry::PanelPiece& p = read.pieces.emplace_back();
+        p.name = piece.at("name").get<std::string>();
+        for (const auto& hole : piece.at("holes")) {
+          p.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
+          edgesHere.insert(p.holes.back().edge);
+        }
+        step.pieceSheets.push_back(piece.at("sheet").get<int>());
       }
     }
+    const auto& neighbors = panel->at("neighbors");
     for (size_t j = 0; j < neighbors.size(); ++j) {
       const int other = neighbors[j].get<int>();
-      if (other >= id) continue;
-      // The joining edge: our extension "edges", or else the edge whose holes both panels carry.
+      // The joining edge (of a panel placed before this one): our extension
+      // "edges", or else the edge whose holes both panels carry.
       int edge = 0;
-      if (panel->contains("edges")) {
+      if (other < id && panel->contains("edges")) {
         edge = panel->at("edges").at(j).get<int>();
-      } else if (byId.count(other)) {
+      } else if (other < id && byId.count(other)) {
         const auto look = [&](const nlohmann::json& holes) {
           for (const auto& hole : holes) {
             const int e = hole.at("edge").get<int>();
-            if (e != 0 && holesOfEdge.count(e)) edge = e;  // 0: a tab's fastener, no edge
+            if (e != 0 && edgesHere.count(e)) edge = e;  // 0: a tab's fastener, no edge
           }
         };
         look(byId.at(other)->at("holes"));
@@ -218,22 +238,32 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
           for (const auto& piece : byId.at(other)->at("pieces")) look(piece.at("holes"));
         }
       }
-      step.joins.push_back({other, edge, holesOfEdge[edge]});
+      read.joins.push_back({other, edge});
     }
+    panels.push_back(std::move(read));
     steps.push_back(std::move(step));
   }
+  const std::vector<geometry::AssemblyStep> assembly = geometry::stepsInPanelOrder(panels);
+  for (size_t i = 0; i < steps.size(); ++i) steps[i].step = assembly[i];
   return steps;
+}
+
+int fastenersOf(const Step& step) {
+  int fasteners = static_cast<int>(step.step.pieces.size());  // the tabs'
+  for (const geometry::AssemblyJoin& join : step.step.joins) fasteners += join.fasteners;
+  return fasteners;
 }
 
 std::string describeJoins(const Step& step) {
   std::string text;
-  for (const auto& [name, sheet] : step.pieces) {
-    text += fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", name, sheet);
+  for (size_t k = 0; k < step.step.pieces.size(); ++k) {
+    text +=
+        fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", step.step.pieces[k], step.pieceSheets[k]);
   }
-  if (step.joins.empty()) return text + "start here, the base";
+  if (step.step.joins.empty()) return text + "start here, the base";
   text += "join to ";
-  for (size_t j = 0; j < step.joins.size(); ++j) {
-    const Join& join = step.joins[j];
+  for (size_t j = 0; j < step.step.joins.size(); ++j) {
+    const geometry::AssemblyJoin& join = step.step.joins[j];
     text += fmt::format("{}panel {} at edge {} ({} fastener{})", j ? ", " : "", join.panel, join.edge, join.fasteners,
                         join.fasteners == 1 ? "" : "s");
   }
@@ -248,6 +278,18 @@ std::string headline(const nlohmann::json& manifest) {
 
 }  // namespace
 
+nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
+  std::filesystem::path file(folderOrFile);
+  if (std::filesystem::is_directory(file)) file /= "manifest.json";
+  std::ifstream in(file);
+  if (!in) throw core::UserError(fmt::format("{}: cannot read it", file.string()));
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw core::UserError(fmt::format("{}: not JSON: {}", file.string(), error.what()));
+  }
+}
+
 std::string manifestText(const nlohmann::json& manifest) {
   try {
     std::string text = fmt::format(
@@ -257,10 +299,9 @@ std::string manifestText(const nlohmann::json& manifest) {
         headline(manifest));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
-      total += static_cast<int>(step.pieces.size());  // the tabs'
-      for (const Join& join : step.joins) total += join.fasteners;
-      text +=
-          fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.panel, step.panel, step.sheet, describeJoins(step));
+      total += fastenersOf(step);
+      text += fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.step.panel, step.step.panel, step.sheet,
+                          describeJoins(step));
     }
     text += fmt::format("\n{} fasteners in all\n", total);
     return text;
@@ -297,11 +338,10 @@ the same number on the panel named; fasten them through their holes.</p>
                                    xmlText(headline(manifest)));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
-      int fasteners = static_cast<int>(step.pieces.size());  // the tabs'
-      for (const Join& join : step.joins) fasteners += join.fasteners;
+      const int fasteners = fastenersOf(step);
       total += fasteners;
-      html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.panel, step.panel,
-                          step.sheet, xmlText(describeJoins(step)), fasteners);
+      html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.step.panel,
+                          step.step.panel, step.sheet, xmlText(describeJoins(step)), fasteners);
     }
     html += fmt::format("</table>\n<p>{} fasteners in all.</p>\n", total);
     for (const auto& sheet : manifest.at("sheets")) {

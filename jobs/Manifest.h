@@ -1,15 +1,16 @@
 #pragma once
 // The assembly manifest (SPEC "manifest.json", version 1): what the builders
-// follow, step by step in flood-fill order (dissertation V.5), and what the
-// cutter's operator needs, sheet by sheet. Built from a band structure and
-// its sheet plan; printed as text (manifest.txt, `rotafab manifest`).
+// follow, step by step in assembly order (the flood fill's, dissertation
+// V.5, for bands), and what the cutter's operator needs, sheet by sheet.
+// Built from a structure (geometry/Structure.h) and its sheet plan; printed
+// as text (manifest.txt, `rotafab manifest`) and as a page to print.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
-#include "geometry/BandStructure.h"
+#include "geometry/Structure.h"
 #include "jobs/Part.h"
 #include "jobs/SheetPlanner.h"
 #include "profiles/Profiles.h"
@@ -21,23 +22,26 @@ struct MeshCounts {
   std::optional<int> genus;
 };
 
-// The band panels as parts for the planner: outline, holes (polygons of
+// The panels as parts for the planner: outline, holes (polygons of
 // kHoleSides sides around the circle, so the fastener still passes), labels
 // to etch, folds to score. The parts' order runs over the panels in
-// flood-fill order, each panel's pieces right after it.
-// Each panel's pieces (bands cut off, see geometry::PanelPiece) follow it
+// assembly order, each panel's pieces (geometry::PanelPiece) right after it
 // as parts of their own.
 constexpr int kHoleSides = 32;
-std::vector<Part> bandParts(const geometry::BandStructure& structure);
+std::vector<Part> structureParts(const geometry::Structure& structure);
 
-// For each of bandParts()'s parts, in its order: its panel (index) and its
-// piece (index, -1 for the panel itself).
-std::vector<std::pair<int, int>> partOwners(const geometry::BandStructure& structure);
+// For each of structureParts()'s parts, in its order: its panel (index) and
+// its piece (index, -1 for the panel itself).
+std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure);
 
 // `files[s]`: the files written for sheet s + 1.
-nlohmann::ordered_json bandManifest(const geometry::BandStructure& structure, const MeshCounts& mesh,
-                                    const profiles::Bed& bed, const SheetPlan& plan,
-                                    const std::vector<std::vector<std::string>>& files);
+nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const MeshCounts& mesh,
+                                         const profiles::Bed& bed, const SheetPlan& plan,
+                                         const std::vector<std::vector<std::string>>& files);
+
+// A manifest.json, or the one in an output folder. Throws core::UserError
+// naming the file when it cannot be read or is not JSON.
+nlohmann::json readManifest(const std::filesystem::path& folderOrFile);
 
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
 // the panels already placed that it joins and the edge numbers to fasten

@@ -50,7 +50,7 @@ void checkNestingParts(const std::vector<NestingPart>& parts) {
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
                    const core::WorkContext& context) {
   checkNestingParts(parts);
-  const PartShapes shapes(parts, options);
+  const PartShapes shapes(parts, options, context);
   // Searches side by side, one per thread of the executor unless the options
   // say how many, each on its own course; the best layout wins (on a tie,
   // the lowest seed's). Strict order has nothing to search.

@@ -4,10 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <numbers>
 #include <stdexcept>
-#include <thread>
 
 #include "jobs/AtomicFile.h"
 #include "jobs/DxfWriter.h"
@@ -38,8 +36,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
-  const NestingResult nested =
-      options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
+  const NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
 
   SheetPlan plan;
   for (size_t i = 0; i < nested.placements.size(); ++i) {
@@ -87,34 +84,20 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   return plan;
 }
 
-std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder) {
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
+                                                  const core::WorkContext& context) {
   std::filesystem::create_directories(folder);
   std::vector<std::vector<std::string>> files(plan.sheets.size());
-  // The sheets shared out among the cores: the bunny's 31 sheets are 170 MB
+  // The sheets shared out among the threads: the bunny's 31 sheets are 170 MB
   // of text, and formatting them, not the disk, takes the time.
-  std::vector<std::exception_ptr> errors(plan.sheets.size());
-  const size_t workers = std::clamp<size_t>(std::thread::hardware_concurrency(), 1, 16);
-  std::vector<std::thread> threads;
-  for (size_t w = 0; w < workers && w < plan.sheets.size(); ++w) {
-    threads.emplace_back([&, w] {
-      for (size_t s = w; s < plan.sheets.size(); s += workers) {
-        try {
-          const SheetDrawing& sheet = plan.sheets[s];
-          const std::string stem = fmt::format("sheet-{:03}", sheet.index);
-          writeFileAtomically(folder / (stem + ".eps"), [&](std::ostream& out) { writeEps(sheet, out); });
-          writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
-          writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
-          files[s] = {stem + ".eps", stem + ".svg", stem + ".dxf"};
-        } catch (...) {
-          errors[s] = std::current_exception();
-        }
-      }
-    });
-  }
-  for (std::thread& thread : threads) thread.join();
-  for (const auto& error : errors) {
-    if (error) std::rethrow_exception(error);
-  }
+  context.parallelFor(plan.sheets.size(), [&](size_t s) {
+    const SheetDrawing& sheet = plan.sheets[s];
+    const std::string stem = fmt::format("sheet-{:03}", sheet.index);
+    writeFileAtomically(folder / (stem + ".eps"), [&](std::ostream& out) { writeEps(sheet, out); });
+    writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
+    writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
+    files[s] = {stem + ".eps", stem + ".svg", stem + ".dxf"};
+  });
   return files;
 }
 

@@ -52,8 +52,10 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
 // The point of a part's frame on its sheet.
 Point2 onSheet(const PlannedPart& placement, const Point2& local);
 
-// Writes sheet-001.eps, .svg and .dxf, ... into `folder` (each atomically);
-// returns the file names of each sheet, in order.
-std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder);
+// Writes sheet-001.eps, .svg and .dxf, ... into `folder` (each atomically),
+// the sheets shared out on the context's executor; returns the file names of
+// each sheet, in order. Throws core::Cancelled.
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
+                                                  const core::WorkContext& context);
 
 }  // namespace rotafab::jobs

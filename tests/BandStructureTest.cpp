@@ -10,6 +10,7 @@
 #include <set>
 
 #include "CrumpledMesh.h"
+#include "TestContext.h"
 #include "TestSupport.h"
 #include "geometry/BandDecomposition.h"
 #include "geometry/DevelopableBands.h"
@@ -49,7 +50,7 @@ TEST(BandStructure, HolesOfBothCopiesCoincideInSpace) {
     const auto bands = developableBands(rs, decomposition);
     std::vector<FlatPanel> panels;
     for (int f = 0; f < mesh.faceCount(); ++f) panels.push_back(unfoldPanel(rs, decomposition, bands, f));
-    const auto holes = placeFastenerHoles(bands, panels, 0.125);
+    const auto holes = placeFastenerHoles(bands, panels, 0.125, test::context());
     for (const EdgeBand& band : bands) {
       if (band.edge < 0) continue;
       const BandHoles& h = holes[band.edge];
@@ -85,7 +86,7 @@ TEST(BandStructure, HolesOfBothCopiesCoincideInSpace) {
 TEST(BandStructure, HolesKeepTheirClearanceAndTheBandsTheirFasteners) {
   for (auto& [name, mesh] : meshes()) {
     BandOptions options;
-    const BandStructure s = buildBandStructure(mesh, options);
+    const Structure s = buildBandStructure(mesh, options, test::context());
     ASSERT_EQ(s.panels.size(), static_cast<size_t>(mesh.faceCount())) << name;
     std::map<int, std::vector<std::pair<int, std::vector<Point2>>>> holesOfEdge;  // edge -> (panel, holes)
     int holes = 0;
@@ -101,7 +102,7 @@ TEST(BandStructure, HolesKeepTheirClearanceAndTheBandsTheirFasteners) {
       for (auto& [edge, points] : mine) holesOfEdge[edge].emplace_back(panel.id, points);
     }
     EXPECT_EQ(holes, 2 * s.fasteners) << name;
-    EXPECT_EQ(static_cast<int>(holesOfEdge.size()), s.interiorEdges) << name;
+    EXPECT_EQ(static_cast<int>(holesOfEdge.size()), s.edges) << name;
     for (const auto& [edge, copies] : holesOfEdge) {
       ASSERT_EQ(copies.size(), 2u) << name << ": edge " << edge;
       ASSERT_EQ(copies[0].second.size(), copies[1].second.size()) << name << ": edge " << edge;
@@ -120,8 +121,8 @@ TEST(BandStructure, WideBandsGetTwoHolesWithTheFullClearance) {
   for (const char* name : {"soccer ball", "torus"}) {
     const PolygonMesh mesh = meshes()[name];
     BandOptions options;
-    const BandStructure s = buildBandStructure(mesh, options);
-    EXPECT_EQ(s.fasteners, 2 * s.interiorEdges) << name;
+    const Structure s = buildBandStructure(mesh, options, test::context());
+    EXPECT_EQ(s.fasteners, 2 * s.edges) << name;
     for (const Panel& panel : s.panels) {
       for (const PanelHole& hole : panel.holes) {
         EXPECT_GE(distanceToOutline(panel.outline, hole.xy), kClearance * options.fastener - 1e-9) << name;
@@ -139,18 +140,18 @@ TEST(BandStructure, WideBandsGetTwoHolesWithTheFullClearance) {
 // A cube at 2 in edges has bands 1/3 in wide: one hole each, reported.
 TEST(BandStructure, NarrowBandsGetOneHoleAndAWarning) {
   BandOptions options;
-  const BandStructure s = buildBandStructure(atConstructionSize(cube()), options);
-  EXPECT_EQ(s.fasteners, s.interiorEdges);
+  const Structure s = buildBandStructure(atConstructionSize(cube()), options, test::context());
+  EXPECT_EQ(s.fasteners, s.edges);
   ASSERT_FALSE(s.warnings.empty());
   EXPECT_NE(s.warnings.front().find("12 bands are too narrow"), std::string::npos) << s.warnings.front();
   options.fastener = 0.5;  // no room even for one
-  EXPECT_THROW(buildBandStructure(atConstructionSize(cube()), options), std::invalid_argument);
+  EXPECT_THROW(buildBandStructure(atConstructionSize(cube()), options, test::context()), std::invalid_argument);
 }
 
 TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
   for (auto& [name, mesh] : meshes()) {
     BandOptions options;
-    const BandStructure s = buildBandStructure(mesh, options);
+    const Structure s = buildBandStructure(mesh, options, test::context());
     int missing = 0;
     for (const Panel& panel : s.panels) {
       std::set<int> edgeLabels;
@@ -164,12 +165,12 @@ TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
         for (const PanelHole& hole : panel.holes) {
           EXPECT_GE(label.box.distanceTo(hole.xy), hole.diameter / 2) << name << ": panel " << panel.id;
         }
-        if (label.role == "edge") edgeLabels.insert(label.edge);
-        if (label.role == "panel") {
+        if (label.role == LabelRole::Edge) edgeLabels.insert(label.edge);
+        if (label.role == LabelRole::Panel) {
           EXPECT_EQ(label.text, labelText(std::to_string(panel.id)));
         }
       }
-      missing += static_cast<int>(panel.edges.size() - edgeLabels.size());
+      missing += static_cast<int>(panel.joins.size() - edgeLabels.size());
     }
     // A band too small for its number even at the smallest size goes without,
     // and the warning counts every one of them.
@@ -184,7 +185,7 @@ TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
       EXPECT_EQ(missing, 0) << name;
     }
   }
-  const BandStructure ball = buildBandStructure(meshes()["soccer ball"], BandOptions{});
+  const Structure ball = buildBandStructure(meshes()["soccer ball"], BandOptions{}, test::context());
   EXPECT_EQ(ball.panels[5].labels.back().text, "6.");  // panel 6 is marked against reading as 9
 }
 
@@ -193,27 +194,30 @@ TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
 TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
   for (auto& [name, mesh] : meshes()) {
     BandOptions options;
-    const BandStructure s = buildBandStructure(mesh, options);
-    EXPECT_EQ(s.panels.front().face, mesh.sourceFaceIndex(lowestFace(mesh, 1))) << name;
+    const Structure s = buildBandStructure(mesh, options, test::context());
+    EXPECT_EQ(s.panels.front().source.face, mesh.sourceFaceIndex(lowestFace(mesh, 1))) << name;
     int previousParent = 0;
     for (const Panel& panel : s.panels) {
       if (panel.id == 1) continue;
-      const int parent = *std::min_element(panel.neighbors.begin(), panel.neighbors.end());
+      const int parent =
+          std::min_element(panel.joins.begin(), panel.joins.end(), [](const PanelJoin& a, const PanelJoin& b) {
+            return a.panel < b.panel;
+          })->panel;
       EXPECT_LT(parent, panel.id) << name << ": panel " << panel.id << " joins no panel placed before it";
       EXPECT_GE(parent, previousParent) << name << ": not breadth-first at panel " << panel.id;
       previousParent = parent;
     }
-    options.start = s.panels[3].face;
-    EXPECT_EQ(buildBandStructure(mesh, options).panels.front().face, options.start) << name;
+    options.start = s.panels[3].source.face;
+    EXPECT_EQ(buildBandStructure(mesh, options, test::context()).panels.front().source.face, options.start) << name;
   }
   BandOptions bad;
   bad.start = 100000;
-  EXPECT_THROW(buildBandStructure(meshes()["torus"], bad), std::invalid_argument);
+  EXPECT_THROW(buildBandStructure(meshes()["torus"], bad, test::context()), std::invalid_argument);
 }
 
 TEST(BandStructure, UnfoldingKeepsTheArea) {
   for (auto& [name, mesh] : meshes()) {
-    const BandStructure s = buildBandStructure(mesh, BandOptions{});
+    const Structure s = buildBandStructure(mesh, BandOptions{}, test::context());
     for (const Panel& panel : s.panels) {
       double flat = 0;
       for (size_t i = 0; i < panel.outline.size(); ++i) {
@@ -231,7 +235,7 @@ TEST(BandStructure, UnfoldingKeepsTheArea) {
 TEST(BandStructure, APanelThatWouldOverlapItselfIsSplitAtABand) {
   const PolygonMesh mesh = test::crumpledTorus();
   BandOptions options;
-  const BandStructure s = buildBandStructure(mesh, options);
+  const Structure s = buildBandStructure(mesh, options, test::context());
   int pieces = 0, holes = 0;
   for (const Panel& panel : s.panels) {
     holes += static_cast<int>(panel.holes.size());
@@ -260,7 +264,7 @@ TEST(BandStructure, APanelThatWouldOverlapItselfIsSplitAtABand) {
       EXPECT_GE(piece.holes.size(), 2u);
       for (const PanelHole& hole : panel.holes) EXPECT_NE(hole.edge, piece.edge);
       std::set<std::string> roles;
-      for (const PanelLabel& label : piece.labels) roles.insert(label.role);
+      for (const PanelLabel& label : piece.labels) roles.insert(std::string(roleName(label.role)));
       EXPECT_EQ(roles, (std::set<std::string>{"edge", "piece"}));
     }
   }

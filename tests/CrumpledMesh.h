@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "geometry/BandStructure.h"
+#include "geometry/ConstructionScale.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/Primitives.h"
 

@@ -329,5 +329,29 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   fails(mesh + " --structure pleat", 2, "--structure");
 }
 
+// Ctrl-C while the bunny is being nested (and SIGTERM, as a service manager
+// sends it): make stops at once, says so, leaves no folder, and exits as a
+// shell expects of a command a signal stopped. Started in the background by
+// a shell, where SIGINT is ignored unless a program takes it itself.
+TEST(MakeCli, InterruptStopsAtOnceAndWritesNothing) {
+  // SIGINT in the first layout, SIGTERM while the parts' shapes are made.
+  for (const auto& [signal, after] :
+       {std::pair<std::string, std::string>{"INT", "nesting: first layout"}, {"TERM", "make: nesting 3674"}}) {
+    TempDir dir;
+    const auto out = dir.path() / "bunny", err = dir.path() / "err";
+    const CommandResult r =
+        run("(" + kCli + " make " + quoted(kSource / "examples/bunny.obj") + " --structure band --out " + quoted(out) +
+            " 2> " + quoted(err) + " & pid=$!; for i in $(seq 600); do grep -q '" + after + "' " + quoted(err) +
+            " && break; sleep 0.05; done; sleep 1; start=$(date +%s%N); kill -" + signal +
+            " $pid; wait $pid; status=$?; end=$(date +%s%N); cat " + quoted(err) +
+            " >&2; echo $(( (end - start) / 1000000 )); exit $status)");
+    EXPECT_EQ(r.status, signal == "INT" ? 130 : 143) << r.err;
+    EXPECT_NE(r.err.find("make: stopped; nothing was written"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("error:"), std::string::npos) << r.err;
+    EXPECT_LT(std::stoi(r.out), 1000) << "milliseconds from the signal to the end";
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+}
+
 }  // namespace
 }  // namespace rotafab::test

@@ -11,7 +11,7 @@
 #include <random>
 #include <string>
 
-#include "geometry/BandStructure.h"
+#include "geometry/ConstructionScale.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/PolygonMesh.h"
 

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/WorkContext.h"
 #include "jobs/Nesting.h"
 #include "jobs/nesting/CellCover.h"
 
@@ -121,12 +122,13 @@ Paths intersectionOf(const Path& a, IntPoint atA, const Path& b, IntPoint atB);
 
 // The shapes of every part in every allowed rotation, which parts are
 // copies of one another, and the area they are laid out in, on the grid.
-// Built once for a nesting run; read-only after, shared by its searches.
-// Throws std::invalid_argument naming a part that fits the area in no
-// allowed rotation.
+// Built once for a nesting run, the parts shared out on the context's
+// executor; read-only after, shared by its searches. Throws
+// std::invalid_argument naming a part that fits the area in no allowed
+// rotation, core::Cancelled.
 class PartShapes {
  public:
-  PartShapes(const std::vector<NestingPart>& parts, const NestingOptions& options);
+  PartShapes(const std::vector<NestingPart>& parts, const NestingOptions& options, const core::WorkContext& context);
 
   [[nodiscard]] const std::vector<NestingPart>& parts() const { return parts_; }
   [[nodiscard]] const NestingOptions& options() const { return options_; }

@@ -169,7 +169,7 @@ TEST(SheetPlanner, WritesEpsSvgAndDxfForEverySheet) {
   options.title = "test";
   const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   test::TempDir dir;
-  const auto files = writeSheets(plan, dir.path());
+  const auto files = writeSheets(plan, dir.path(), test::context());
   ASSERT_EQ(files.size(), plan.sheets.size());
   EXPECT_EQ(files[0], (std::vector<std::string>{"sheet-001.eps", "sheet-001.svg", "sheet-001.dxf"}));
   const std::string eps = test::readFile(dir.path() / "sheet-001.eps");

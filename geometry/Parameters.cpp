@@ -1,0 +1,23 @@
+#include "geometry/Parameters.h"
+
+namespace rotafab::geometry {
+
+std::string parameterInWords(Parameter parameter) {
+  switch (parameter) {
+    case Parameter::Structure:
+      return "structure";
+    case Parameter::Holes:
+      return "holes";
+    case Parameter::Size:
+      return "structure size";
+    case Parameter::Scale:
+      return "scale";
+    case Parameter::Fastener:
+      return "fastener diameter";
+    case Parameter::Start:
+      return "start face";
+  }
+  return "parameter";
+}
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,36 @@
+#pragma once
+// The parameters of a build that messages name: geometry says which one an
+// error or a piece of advice is about, and the caller says what to call it
+// (the command line by its flag, "--fastener"; a daemon by its field).
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace rotafab::geometry {
+
+enum class Parameter {
+  Structure,  // band or weave
+  Holes,      // what to do with an open mesh's holes: keep, fill, refuse
+  Size,       // the largest side of the structure
+  Scale,      // inches per mesh unit
+  Fastener,   // the fastener hole's diameter
+  Start,      // the flood fill's first face
+};
+
+// How messages name a parameter.
+using ParameterNames = std::function<std::string(Parameter)>;
+
+// In words: "structure", "holes", "structure size", "scale", "fastener diameter", "start face".
+std::string parameterInWords(Parameter parameter);
+
+// A parameter's value that cannot be built with; the message names it as
+// the caller's ParameterNames do: "fastener diameter: the hole diameter must be positive".
+class ParameterError : public std::invalid_argument {
+ public:
+  ParameterError(Parameter parameter, const std::string& message)
+      : std::invalid_argument(message), parameter(parameter) {}
+  Parameter parameter;
+};
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,62 @@
+#include "geometry/Structure.h"
+
+#include <map>
+
+namespace rotafab::geometry {
+
+std::string_view structureName(StructureKind kind) { return kind == StructureKind::Band ? "band" : "weave"; }
+
+std::string_view roleName(LabelRole role) {
+  switch (role) {
+    case LabelRole::Edge:
+      return "edge";
+    case LabelRole::Panel:
+      return "panel";
+    case LabelRole::Neighbor:
+      return "neighbor";
+    case LabelRole::Up:
+      return "up";
+    case LabelRole::Down:
+      return "down";
+    case LabelRole::Piece:
+      return "piece";
+  }
+  return "edge";
+}
+
+std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
+  std::vector<AssemblyStep> steps;
+  for (const Panel& panel : panels) {
+    // A band's holes are on the panel, or on the piece it was cut off as.
+    std::map<int, int> holesOfEdge;
+    for (const PanelHole& hole : panel.holes) ++holesOfEdge[hole.edge];
+    AssemblyStep step{panel.id, {}, {}};
+    for (const PanelPiece& piece : panel.pieces) {
+      for (const PanelHole& hole : piece.holes) ++holesOfEdge[hole.edge];
+      step.pieces.push_back(piece.name);
+    }
+    for (const PanelJoin& join : panel.joins) {
+      if (join.panel >= panel.id) continue;
+      step.joins.push_back({join.panel, join.edge, holesOfEdge[join.edge]});
+    }
+    steps.push_back(std::move(step));
+  }
+  return steps;
+}
+
+PolygonMesh surfaceMesh(const Structure& structure) {
+  PolygonMesh surface;
+  for (const Panel& panel : structure.panels) {
+    for (const auto& polygon : panel.surface) {
+      std::vector<int> face;
+      for (const Point3& p : polygon) {
+        face.push_back(surface.vertexCount());
+        surface.positions.push_back(p);
+      }
+      surface.faces.push_back(std::move(face));
+    }
+  }
+  return surface;
+}
+
+}  // namespace rotafab::geometry

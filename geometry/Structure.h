@@ -1,0 +1,115 @@
+#pragma once
+// What a structure builder gives the planner and the manifest, whatever the
+// structure (band decomposition, dissertation ch. V; plain weave, ch. IV):
+// flat panels ready to cut, in assembly order, each with its outline, holes
+// and labels, where it comes from, the pieces cut off it and the panels it
+// joins; the assembly steps; the fasteners; warnings. Lengths in inches,
+// panel coordinates in the panel's own frame.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/Polygon2.h"
+#include "geometry/PanelLabels.h"
+#include "geometry/PolygonMesh.h"
+
+namespace rotafab::geometry {
+
+using Polyline2 = std::vector<Point2>;
+
+enum class StructureKind { Band, Weave };
+// SPEC's names in manifest.json: "band", "weave".
+std::string_view structureName(StructureKind kind);
+
+// What a label says (SPEC's `labels[].role`): an edge number, the panel's
+// number, the neighbouring edge's number (a woven panel's underlined one),
+// the edge of a woven panel's up or down crossing; and the name of a piece
+// cut off a panel (ours, on the piece's tab).
+enum class LabelRole { Edge, Panel, Neighbor, Up, Down, Piece };
+// "edge", "panel", "neighbor", "up", "down", "piece".
+std::string_view roleName(LabelRole role);
+
+struct PanelHole {
+  int edge = 0;  // the edge number it fastens (1-based); 0 for a piece's tab
+  Point2 xy;     // panel frame
+  double diameter = 0;
+};
+
+struct PanelLabel {
+  std::string text;  // as etched ("6." for 6)
+  int edge = 0;      // the edge number it names; 0 for the panel's own number and a piece's name
+  LabelRole role = LabelRole::Edge;
+  TextBox box;
+  std::vector<Polyline2> strokes;
+};
+
+// Where a panel comes from (SPEC's `source`): a band panel from an input
+// face (its index in the file) or from a face capping a hole (`cap`, no
+// face); a woven panel from the edge of its up crossing and its cycle.
+struct PanelSource {
+  int face = -1;
+  bool cap = false;
+  int edge = -1;
+  int cycle = -1;
+};
+
+// A part cut off its panel (a band that would make the panel overlap
+// itself, V.4), cut as a part of its own and fastened back to the panel.
+struct PanelPiece {
+  std::string name;   // "17a": its panel's number and a letter
+  int edge = 0;       // the edge number of its band
+  Polyline2 outline;  // in the panel's frame, where it lies on the panel; counter-clockwise
+  std::vector<PanelHole> holes;
+  std::vector<PanelLabel> labels;
+  double area = 0;  // in 3D
+};
+
+// A neighbouring panel, and the edge number along which the two are joined.
+struct PanelJoin {
+  int panel = 0;  // its id
+  int edge = 0;
+};
+
+struct Panel {
+  int id = 0;  // 1-based: the assembly order
+  PanelSource source;
+  Polyline2 outline;  // the cut contour, counter-clockwise, not closed
+  std::vector<PanelHole> holes;
+  std::vector<PanelLabel> labels;
+  std::vector<PanelPiece> pieces;
+  std::vector<Polyline2> scores;             // fold lines to score
+  std::vector<PanelJoin> joins;              // in the order of its sides
+  double area = 0;                           // the 3D surface area (its pieces' apart), square inches
+  std::vector<std::vector<Point3>> surface;  // 3D polygons, for rendering
+};
+
+// One assembly step: a panel, the pieces to fasten to it first, and the
+// panels placed before it that it joins, with the fasteners of each join.
+struct AssemblyJoin {
+  int panel = 0, edge = 0, fasteners = 0;
+};
+struct AssemblyStep {
+  int panel = 0;
+  std::vector<std::string> pieces;
+  std::vector<AssemblyJoin> joins;
+};
+
+struct Structure {
+  StructureKind kind = StructureKind::Band;
+  std::vector<Panel> panels;  // in assembly order: panels[i].id == i + 1
+  std::vector<AssemblyStep> steps;
+  int edges = 0;                      // edge numbers run 1..edges
+  int fasteners = 0;                  // one per pair of holes that meet, one per piece's tab
+  std::vector<std::string> warnings;  // one line each (labels that did not fit, ...)
+};
+
+// The steps of building panel by panel in id order (the flood fill's, V.5,
+// or a weave's cycle by cycle): each panel joined to those before it; a
+// join's fasteners are the holes of its edge on the panel and its pieces.
+std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
+
+// The panels' 3D surfaces as one mesh, polygon by polygon.
+PolygonMesh surfaceMesh(const Structure& structure);
+
+}  // namespace rotafab::geometry

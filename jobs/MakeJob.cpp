@@ -1,0 +1,205 @@
+#include "jobs/MakeJob.h"
+
+#include <fmt/format.h>
+
+#include <Eigen/Geometry>
+#include <chrono>
+#include <cmath>
+#include <regex>
+
+#include "core/UserError.h"
+#include "geometry/BandStructure.h"
+#include "geometry/ConstructionScale.h"
+#include "geometry/FastenerHoles.h"
+#include "geometry/HoleFilling.h"
+#include "geometry/MeshAnalysis.h"
+#include "geometry/MeshImport.h"
+#include "geometry/ObjWriter.h"
+#include "jobs/AtomicFile.h"
+#include "jobs/OutputFolder.h"
+
+namespace rotafab::jobs {
+namespace {
+
+using geometry::Parameter;
+
+// Seconds since the last call.
+class Lap {
+ public:
+  double operator()() {
+    const auto now = std::chrono::steady_clock::now();
+    const double elapsed = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return elapsed;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+const char* plural(int n) { return n == 1 ? "" : "s"; }
+
+// The mesh as read, checked, its holes filled if asked, at construction size.
+geometry::PolygonMesh importedMesh(const MakeRequest& request, MeshCounts& counts, const core::WorkContext& context) {
+  const std::string name = request.mesh.string();
+  context.report({"import", "", 0, 0});
+  geometry::ImportedMesh imported = geometry::importMesh(request.mesh, &context.cancellation());
+  for (const auto& warning : imported.warnings) context.warn(fmt::format("{}: {}", name, warning));
+  geometry::PolygonMesh& mesh = imported.mesh;
+  geometry::MeshAnalysis analysis = geometry::analyzeMesh(mesh);
+  for (const auto& note : analysis.notes) context.note(fmt::format("{}: {}", name, note));
+  try {
+    geometry::requireUsable(analysis);
+  } catch (const geometry::InvalidMeshError& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  }
+  if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
+    if (request.holes == HolesMode::Error) {
+      throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} keep or fill builds it", name,
+                                        loops, plural(loops), request.names(Parameter::Holes)));
+    }
+    if (request.holes == HolesMode::Fill) {
+      geometry::fillHoles(mesh);
+      analysis = geometry::analyzeMesh(mesh);
+      try {
+        geometry::requireUsable(analysis);
+      } catch (const geometry::InvalidMeshError& error) {
+        throw core::UserError(
+            fmt::format("{}: with its {} hole{} filled: {}", name, loops, plural(loops), error.what()));
+      }
+      context.report({"import", "holes filled", static_cast<size_t>(loops), 0});
+    }
+  }
+  // The mesh as built (after --holes fill): one panel per face.
+  const geometry::MeshTopology& topology = analysis.topology;
+  counts = {topology.vertices, topology.edges, topology.faces, topology.genus};
+  double scale = 0;
+  try {
+    scale = geometry::constructionScale(mesh, request.size, request.scale, request.names);
+  } catch (const std::invalid_argument& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  }
+  if (!(scale > 0) || !std::isfinite(scale)) {
+    throw core::UserError(request.names(Parameter::Scale) + ": expected a positive number");
+  }
+  for (geometry::Point3& p : mesh.positions) p *= scale;
+  return std::move(imported.mesh);
+}
+
+// The advice for bands without room for a hole: the fastener, or the size
+// (or the scale, if that is what was given), that gives every band room;
+// every length of the structure scales with the mesh.
+std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, double fastener,
+                       double scaleNeeded) {
+  const auto& names = request.names;
+  if (!std::isfinite(scaleNeeded)) {
+    return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
+  }
+  Eigen::AlignedBox3d box;
+  for (const geometry::Point3& p : mesh.positions) box.extend(p);
+  const std::string larger =
+      request.scale
+          ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
+          : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(box.sizes().maxCoeff() * scaleNeeded));
+  const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
+  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every band room",
+                                   names(Parameter::Fastener), smaller, larger)
+                     : fmt::format("{} or larger would give every band room", larger);
+}
+
+geometry::Structure builtStructure(const MakeRequest& request, const geometry::PolygonMesh& mesh,
+                                   const core::WorkContext& context) {
+  const std::string name = request.mesh.string();
+  geometry::BandOptions band;
+  band.tension = request.tension;
+  band.samples = request.samples;
+  band.fastener = request.fastener.value_or(request.material.fastenerDiameter);
+  band.start = request.start;
+  band.up = request.up;
+  band.scoreFolds = request.scoreFolds;
+  band.names = request.names;
+  try {
+    return geometry::buildBandStructure(mesh, band, context);
+  } catch (const geometry::NoRoomForHoleError& error) {
+    throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
+                                      roomAdvice(request, mesh, band.fastener, error.scaleNeeded)));
+  } catch (const std::invalid_argument& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  }
+}
+
+}  // namespace
+
+std::filesystem::path defaultOutputFolder(const MakeRequest& request) {
+  return request.mesh.stem().string() + "-" + std::string(geometry::structureName(request.structure));
+}
+
+PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context) {
+  Lap lap;
+  const std::string name = request.mesh.string();
+  if (request.structure == geometry::StructureKind::Weave) {
+    throw core::UserError(
+        fmt::format("{} weave: plain-woven structures (dissertation ch. IV) are not built yet; use band",
+                    request.names(Parameter::Structure)));
+  }
+  PlannedJob job;
+  job.title = fmt::format("{} ({})", request.mesh.stem().string(), geometry::structureName(request.structure));
+  const geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
+  job.seconds.import = lap();
+  context.check();
+
+  job.structure = builtStructure(request, mesh, context);
+  for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
+  job.seconds.geometry = lap();
+
+  PlanOptions plan;
+  plan.kerf = request.kerf.value_or(request.material.kerf);
+  plan.seconds = request.seconds;
+  plan.order = request.order;
+  plan.window = request.window;
+  plan.rows = request.rows;
+  plan.title = job.title;
+  context.report({"nesting", "", 0, job.structure.panels.size()});
+  job.parts = structureParts(job.structure);
+  try {
+    job.sheets = planSheets(job.parts, request.machine, plan, context);
+  } catch (const std::invalid_argument& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  }
+  job.seconds.nesting = lap();
+  job.folder.clear();
+  job.meshFile = request.mesh;
+  job.bed = request.machine.bed;
+  return job;
+}
+
+void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context) {
+  Lap lap;
+  context.report({"writing", "", 0, job.sheets.sheets.size()});
+  OutputFolder output(folder);
+  job.files = writeSheets(job.sheets, output.staging(), context);
+  context.check();
+  writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
+    geometry::writeObj(
+        stream, geometry::surfaceMesh(job.structure),
+        fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
+                    job.meshFile.string(), job.structure.panels.size()));
+  });
+  job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
+  writeFileAtomically(output.staging() / "manifest.json", job.manifest.dump(1) + "\n");
+  writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
+  context.check();
+  // manifest.json last: until it moves in, the folder's manifest is the old job's.
+  static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
+  output.commit("manifest.json", [](const std::string& name) { return std::regex_match(name, ours); });
+  job.folder = output.target();
+  job.seconds.writing = lap();
+}
+
+PlannedJob makeJob(const MakeRequest& request, const std::filesystem::path& folder, const core::WorkContext& context) {
+  PlannedJob job = planJob(request, context);
+  writeJob(job, folder, context);
+  return job;
+}
+
+}  // namespace rotafab::jobs

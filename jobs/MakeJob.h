@@ -1,0 +1,92 @@
+#pragma once
+// The whole of `rotafab make` (SPEC, "make") as one call, for the command
+// line and the daemon alike: a request in (a mesh file and the options), a
+// planned job out (its structure, parts, sheets, manifest and files). The
+// phases, each reported as progress: import (read, check, fill holes,
+// scale), geometry (the structure's builder), nesting (the planner), writing
+// (the output folder, by OutputFolder's rule).
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/WorkContext.h"
+#include "geometry/Parameters.h"
+#include "geometry/Structure.h"
+#include "jobs/Manifest.h"
+#include "jobs/Nesting.h"
+#include "jobs/Part.h"
+#include "jobs/SheetPlanner.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::jobs {
+
+// SPEC's --holes: leave the boundary open, fill each hole, or refuse an open mesh.
+enum class HolesMode { Keep, Fill, Error };
+
+struct MakeRequest {
+  std::filesystem::path mesh;  // messages name it as given
+  geometry::StructureKind structure = geometry::StructureKind::Band;
+  profiles::MachineProfile machine;
+  profiles::MaterialProfile material;
+  std::optional<double> size;   // the largest side, inches; or
+  std::optional<double> scale;  // inches per mesh unit; neither: the mean edge becomes 2 in
+  HolesMode holes = HolesMode::Keep;
+  // The band decomposition's options (geometry/BandStructure.h).
+  std::optional<double> tension;
+  int samples = 8;
+  std::optional<double> fastener;  // default: the material's
+  std::optional<int> start;
+  int up = 1;
+  bool scoreFolds = false;
+  // The planner's (jobs/SheetPlanner.h).
+  std::optional<double> kerf;  // default: the material's
+  double seconds = 5.0;
+  OrderMode order = OrderMode::Window;
+  int window = 8;
+  bool rows = false;
+  // How messages name the options (the command line: by their flags).
+  geometry::ParameterNames names = geometry::parameterInWords;
+};
+
+struct PhaseSeconds {
+  double import = 0, geometry = 0, nesting = 0, writing = 0;
+};
+
+struct PlannedJob {
+  std::filesystem::path meshFile;  // as the request named it
+  std::string title;               // "bunny (band)"
+  MeshCounts mesh;                 // of the mesh as built (after --holes fill)
+  profiles::Bed bed;               // the machine's
+  geometry::Structure structure;
+  std::vector<Part> parts;  // structureParts()
+  SheetPlan sheets;
+  // Once written (writeJob()):
+  std::filesystem::path folder;
+  std::vector<std::vector<std::string>> files;  // per sheet
+  nlohmann::ordered_json manifest;
+  PhaseSeconds seconds;
+};
+
+// The output folder when none is given: MESHNAME-band beside where the command runs.
+std::filesystem::path defaultOutputFolder(const MakeRequest& request);
+
+// Imports, builds and plans the job, in memory. Throws core::UserError (one
+// line naming the mesh file, or an option as `names` calls it),
+// geometry::InvalidMeshError (an unreadable mesh, named), core::Cancelled;
+// notes and warnings go to the context's logger as they come, each after
+// the mesh file's name.
+PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context);
+
+// Writes the job into `folder`: sheet-001.eps/.svg/.dxf ..., manifest.json,
+// manifest.txt, structure.obj. On any failure or a cancel the folder is left
+// as it was. Throws std::runtime_error naming a file that cannot be
+// written, core::Cancelled.
+void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
+
+// planJob() then writeJob().
+PlannedJob makeJob(const MakeRequest& request, const std::filesystem::path& folder, const core::WorkContext& context);
+
+}  // namespace rotafab::jobs

@@ -1,0 +1,55 @@
+#include "jobs/OutputFolder.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <set>
+
+namespace rotafab::jobs {
+namespace {
+
+// Two jobs of one process (a daemon's) may write into one folder at once.
+std::atomic<unsigned> stagings{0};
+
+}  // namespace
+
+OutputFolder::OutputFolder(std::filesystem::path target) : target_(std::move(target)) {
+  if (target_.filename().empty()) target_ = target_.parent_path();  // "dir/"
+  for (std::filesystem::path p = target_; !p.empty() && !std::filesystem::exists(p); p = p.parent_path()) {
+    created_ = p;
+    if (p == p.parent_path()) break;
+  }
+  std::filesystem::create_directories(target_);
+  staging_ = target_ / fmt::format(".rotafab-partial-{}-{}", ::getpid(), stagings++);
+  std::filesystem::remove_all(staging_);
+  std::filesystem::create_directories(staging_);
+}
+
+OutputFolder::~OutputFolder() {
+  std::error_code ignored;
+  std::filesystem::remove_all(staging_, ignored);
+  if (committed_ || created_.empty()) return;
+  // Up from the target to the outermost folder made for it, each only if empty.
+  for (std::filesystem::path p = target_;; p = p.parent_path()) {
+    if (!std::filesystem::remove(p, ignored) || p == created_ || p == p.parent_path()) break;
+  }
+}
+
+void OutputFolder::commit(const std::string& last, const std::function<bool(const std::string&)>& ours) {
+  std::set<std::string> written;
+  for (const auto& entry : std::filesystem::directory_iterator(staging_)) {
+    written.insert(entry.path().filename().string());
+  }
+  for (const std::string& name : written) {
+    if (name != last) std::filesystem::rename(staging_ / name, target_ / name);
+  }
+  if (written.count(last)) std::filesystem::rename(staging_ / last, target_ / last);
+  committed_ = true;
+  for (const auto& entry : std::filesystem::directory_iterator(target_)) {
+    const std::string name = entry.path().filename().string();
+    if (entry.is_regular_file() && ours(name) && !written.count(name)) std::filesystem::remove(entry.path());
+  }
+}
+
+}  // namespace rotafab::jobs
