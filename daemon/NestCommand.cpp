@@ -2,20 +2,15 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "daemon/CommandContext.h"
 #include "daemon/CommandSupport.h"
-#include "daemon/ExitCode.h"
 #include "daemon/ProgressLines.h"
-#include "jobs/AtomicFile.h"
-#include "jobs/LayoutSvg.h"
-#include "jobs/Nesting.h"
-#include "jobs/NestingInstance.h"
-#include "profiles/Length.h"
+#include "jobs/NestJob.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::cli {
@@ -38,121 +33,72 @@ struct NestOptions {
   int threads = 0;
 };
 
+// The bed: the machine profile's (SPEC's workshop bed when the profiles
+// cannot be read and none was named), with --bed and --margin over it.
+profiles::Bed bedOf(const NestOptions& options) {
+  profiles::Bed bed;
+  try {
+    bed = profiles::findMachine(profiles::loadProfiles(profiles::profileSearchPath()), options.machine).bed;
+  } catch (const profiles::ProfileError&) {
+    if (options.machine != "workshop-32x18") throw;
+  }
+  if (!options.bed.empty()) {
+    const auto x = options.bed.find('x');
+    if (x == std::string::npos)
+      throw UserError(fmt::format("--bed {}: expected WIDTHxHEIGHT, e.g. 32x18 or 812.8mmx457.2mm", options.bed));
+    bed.width = lengthOption(options.bed.substr(0, x), "--bed");
+    bed.height = lengthOption(options.bed.substr(x + 1), "--bed");
+  }
+  if (!options.margin.empty()) bed.margin = lengthOption(options.margin, "--margin");
+  if (2 * bed.margin >= std::min(bed.width, bed.height)) {
+    throw UserError(
+        fmt::format("--margin {}: leaves no usable area on a {} x {} bed", bed.margin, bed.width, bed.height));
+  }
+  return bed;
+}
+
 int runNest(const NestOptions& options) {
   return reportingErrors(options.instance, [&]() -> int {
-    const auto start = std::chrono::steady_clock::now();
-    jobs::NestingInstance instance;
+    jobs::NestRequest request;
+    request.instance = options.instance;
+    request.strip = options.strip;
+    if (!options.strip) request.bed = bedOf(options);
+    if (!options.spacing.empty()) request.spacing = lengthOption(options.spacing, "--spacing");
+    request.search.seconds = options.seconds;
+    request.search.seed = options.seed;
+    request.search.evaluations = options.evaluations;
+    request.search.threads = options.threads;
+    request.search.order = orderOption(options.order);
+    request.search.window = options.window;
+    ProgressLineOptions lines;
+    lines.prefix = "nest: ";
+    lines.seconds = options.seconds;
+    lines.strip = options.strip;
+    // As many threads as searches asked for, at least one per core.
+    CommandContext command(options.json ? core::ProgressSink() : ProgressLines(lines),
+                           std::max(std::thread::hardware_concurrency(), static_cast<unsigned>(options.threads)));
+    jobs::NestedInstance nested;
     try {
-      instance = jobs::readNestingInstance(options.instance);
-    } catch (const std::invalid_argument& error) {
-      throw UserError(error.what());
+      nested = jobs::nestInstance(request, command.context());
+    } catch (const core::Cancelled&) {
+      fmt::print(stderr, "nest: stopped\n");
+      return command.interruptedStatus();
     }
-    const std::vector<jobs::NestingPart>& parts = instance.parts;
-    const double stripHeight = instance.stripHeight;
-
-    jobs::NestingOptions nesting;
-    nesting.strip = options.strip;
-    nesting.seconds = options.seconds;
-    nesting.seed = options.seed;
-    nesting.evaluations = options.evaluations;
-    nesting.threads = options.threads;
-    double margin = 0;
-    if (options.strip) {
-      if (!(stripHeight > 0))
-        throw UserError(fmt::format("{}: strip_height: expected a positive number", options.instance));
-      nesting.height = stripHeight;
-      nesting.spacing = options.spacing.empty() ? 0.0 : lengthOption(options.spacing, "--spacing");
-    } else {
-      profiles::Bed bed;
-      try {
-        bed = profiles::findMachine(profiles::loadProfiles(profiles::profileSearchPath()), options.machine).bed;
-      } catch (const profiles::ProfileError&) {
-        if (options.machine != "workshop-32x18") throw;  // the default bed of SPEC otherwise
-      }
-      if (!options.bed.empty()) {
-        const auto x = options.bed.find('x');
-        if (x == std::string::npos)
-          throw UserError(fmt::format("--bed {}: expected WIDTHxHEIGHT, e.g. 32x18 or 812.8mmx457.2mm", options.bed));
-        bed.width = lengthOption(options.bed.substr(0, x), "--bed");
-        bed.height = lengthOption(options.bed.substr(x + 1), "--bed");
-      }
-      if (!options.margin.empty()) bed.margin = lengthOption(options.margin, "--margin");
-      if (2 * bed.margin >= std::min(bed.width, bed.height)) {
-        throw UserError(
-            fmt::format("--margin {}: leaves no usable area on a {} x {} bed", bed.margin, bed.width, bed.height));
-      }
-      margin = bed.margin;
-      nesting.width = bed.width - 2 * bed.margin;
-      nesting.height = bed.height - 2 * bed.margin;
-      nesting.spacing = options.spacing.empty() ? 0.0625 : lengthOption(options.spacing, "--spacing");
-    }
-    nesting.order = orderOption(options.order);
-    nesting.window = options.window;
-    core::Executor executor(
-        std::max({1u, std::thread::hardware_concurrency(), static_cast<unsigned>(options.threads)}));
-    core::Cancellation cancellation;
-    core::ProgressSink progress;
-    if (!options.json) {
-      ProgressLineOptions lines;
-      lines.prefix = "nest: ";
-      lines.seconds = options.seconds;
-      lines.strip = options.strip;
-      progress = ProgressLines(lines);
-    }
-    const core::WorkContext context(executor, cancellation, progress);
-
-    jobs::NestingResult result;
-    try {
-      result = jobs::nest(parts, nesting, context);
-    } catch (const std::invalid_argument& error) {
-      throw UserError(fmt::format("{}: {}", options.instance, error.what()));
-    }
-    const auto problems = jobs::layoutProblems(parts, result, nesting);
-    if (!problems.empty()) {
-      fmt::print(stderr, "error: internal: the layout failed its own check: {}\n", problems.front());
-      return kUserError;
-    }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    nlohmann::ordered_json summary;
-    summary["sheets"] = result.sheets;
-    summary["utilization"] =
-        options.strip ? nlohmann::ordered_json(nullptr)
-                      : nlohmann::ordered_json(result.partArea / (result.sheets * nesting.width * nesting.height));
-    summary["strip_length"] =
-        options.strip ? nlohmann::ordered_json(result.stripLength) : nlohmann::ordered_json(nullptr);
-    summary["density"] = options.strip ? nlohmann::ordered_json(result.partArea / (nesting.height * result.stripLength))
-                                       : nlohmann::ordered_json(nullptr);
-    summary["seconds"] = seconds;
-    summary["layouts"] = result.evaluations;  // an extension of SPEC's summary: how far the search got
-
-    if (!options.out.empty()) {
-      std::filesystem::create_directories(options.out);
-      nlohmann::ordered_json layout = {{"placements", nlohmann::ordered_json::array()}};
-      for (size_t cut = 0; cut < result.placements.size(); ++cut) {
-        const auto& p = result.placements[cut];
-        layout["placements"].push_back({{"item", instance.itemOfPart[p.part]},
-                                        {"copy", instance.copyOfPart[p.part]},
-                                        {"sheet", p.sheet},
-                                        {"x", p.x + margin},
-                                        {"y", p.y + margin},
-                                        {"rotation", p.rotation},
-                                        // Extension: how far the layout moved the part from its order in the file.
-                                        {"moved", static_cast<int>(cut) - parts[p.part].order}});
-      }
-      jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.json", layout.dump(1) + "\n");
-      jobs::writeFileAtomically(std::filesystem::path(options.out) / "layout.svg",
-                                jobs::layoutSvg(parts, result, nesting, margin));
-    }
+    if (!options.out.empty()) jobs::writeNestOutput(nested, options.out);
+    const auto& summary = nested.summary;
+    const jobs::NestingResult& result = nested.result;
+    const size_t parts = nested.instance.parts.size();
+    const double seconds = summary["seconds"].get<double>();
     if (options.json) {
       std::cout << summary.dump() << '\n';
     } else if (options.strip) {
       fmt::print("{} parts in a strip {:.4g} long and {:.4g} high: density {:.1f}% ({} layouts tried in {:.1f} s)\n",
-                 parts.size(), result.stripLength, nesting.height, 100.0 * summary["density"].get<double>(),
+                 parts, result.stripLength, nested.options.height, 100.0 * summary["density"].get<double>(),
                  result.evaluations, seconds);
     } else {
-      fmt::print("{} parts on {} sheet{}: utilization {:.1f}% ({} layouts tried in {:.1f} s)\n", parts.size(),
-                 result.sheets, result.sheets == 1 ? "" : "s", 100.0 * summary["utilization"].get<double>(),
-                 result.evaluations, seconds);
+      fmt::print("{} parts on {} sheet{}: utilization {:.1f}% ({} layouts tried in {:.1f} s)\n", parts, result.sheets,
+                 result.sheets == 1 ? "" : "s", 100.0 * summary["utilization"].get<double>(), result.evaluations,
+                 seconds);
     }
     return kSuccess;
   });

@@ -82,4 +82,19 @@ NestingInstance readNestingInstance(const std::string& file) {
   return result;
 }
 
+nlohmann::ordered_json layoutJson(const NestingInstance& instance, const NestingResult& result, double margin) {
+  nlohmann::ordered_json layout = {{"placements", nlohmann::ordered_json::array()}};
+  for (size_t cut = 0; cut < result.placements.size(); ++cut) {
+    const auto& p = result.placements[cut];
+    layout["placements"].push_back({{"item", instance.itemOfPart[p.part]},
+                                    {"copy", instance.copyOfPart[p.part]},
+                                    {"sheet", p.sheet},
+                                    {"x", p.x + margin},
+                                    {"y", p.y + margin},
+                                    {"rotation", p.rotation},
+                                    {"moved", static_cast<int>(cut) - instance.parts[p.part].order}});
+  }
+  return layout;
+}
+
 }  // namespace rotafab::jobs

@@ -4,6 +4,7 @@
 // "shape": {"type": "simple_polygon", "data": [[x, y], ...]}}]}. One part per
 // copy of each item, numbered in file order.
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -25,5 +26,11 @@ struct NestingInstance {
 
 // Throws std::invalid_argument "FILE: items[3].shape.data: what is wrong".
 NestingInstance readNestingInstance(const std::string& file);
+
+// SPEC's layout.json: {"placements": [{"item", "copy", "sheet", "x", "y",
+// "rotation"}]}, one per part copy in cutting order, on the bed (the usable
+// area's placements moved by `margin`), with our extension "moved": how
+// far the layout moved the part from its order in the file.
+nlohmann::ordered_json layoutJson(const NestingInstance& instance, const NestingResult& result, double margin);
 
 }  // namespace rotafab::jobs
