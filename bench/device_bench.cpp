@@ -46,7 +46,7 @@ void BM_GrblStreaming(benchmark::State& state) {
     devices::grbl::GrblDriver driver([&] { return devices::openSerialLink(simulator.path(), baud); });
     driver.connect();
     driver.setCharacterCounting(counting);
-    devices::CancelFlag cancel;
+    rotafab::core::Cancellation cancel;
     size_t acknowledged = 0;
     const auto started = std::chrono::steady_clock::now();
     auto lastAcknowledged = started;  // the rate counts to the last `ok`, not to the machine's stop

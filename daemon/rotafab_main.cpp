@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 
+#include "daemon/DevicesCommand.h"
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
 #include "daemon/MakeCommand.h"
@@ -27,7 +28,8 @@ int main(int argc, char** argv) {
   addManifestCommand(app, status);
   addNestCommand(app, status);
   addProfilesCommand(app, status);
-  addRunCommand(app, status, argv);
+  addDevicesCommand(app, status);
+  addRunCommand(app, status);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {

@@ -7,13 +7,13 @@
 // turned the laser off (as far as the controller still answers) before it
 // throws.
 
-#include <atomic>
 #include <functional>
 #include <memory>
 #include <ostream>
 #include <stdexcept>
 #include <string>
 
+#include "core/Cancellation.h"
 #include "jobs/Toolpath.h"
 
 namespace rotafab::devices {
@@ -50,16 +50,6 @@ struct DeviceStatus {
   double x = 0, y = 0;  // inches, machine position
 };
 
-// Set from another thread (a signal handler's watcher, the daemon) to stop a job.
-class CancelFlag {
- public:
-  void cancel() { cancelled_ = true; }
-  [[nodiscard]] bool cancelled() const { return cancelled_; }
-
- private:
-  std::atomic<bool> cancelled_{false};
-};
-
 // In a catch block: runs `stopSafely` (the driver's way to leave the laser
 // off; it returns whether the controller confirmed it, and never throws),
 // then rethrows, a DeviceFault marked with that answer.
@@ -75,12 +65,20 @@ class Device {
   virtual void frame(const jobs::Toolpath& toolpath) = 0;
   // Runs the job to its end; `progress` is called as the device acknowledges it.
   virtual void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-                   const CancelFlag& cancel) = 0;
+                   const core::Cancellation& cancel) = 0;
   // From another thread while run() streams: hold and resume motion.
   virtual void pause() = 0;
   virtual void resume() = 0;
   virtual DeviceStatus status() = 0;
   virtual void disconnect() = 0;
+  // What the machine can do, for planning its toolpaths (once connected, as
+  // the controller reports it).
+  [[nodiscard]] virtual jobs::MotionLimits motionLimits() const { return {}; }
+  // The bytes run() would send for these toolpaths, one after another, as a
+  // dry run writes them (SPEC, "Devices"), and what they are, for people:
+  // "G-code for 1 sheet (108 strokes), as the driver would send it".
+  [[nodiscard]] virtual std::string program(const std::vector<jobs::Toolpath>& toolpaths) const = 0;
+  [[nodiscard]] virtual std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const = 0;
 };
 
 }  // namespace rotafab::devices

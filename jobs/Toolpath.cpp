@@ -8,7 +8,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include "geometry/PanelUnfolding.h"
+#include "core/Polygon2.h"
 
 namespace rotafab::jobs {
 namespace {
@@ -153,7 +153,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
       if (cuts[k] == &path) continue;
       const auto& b = boxes[k];
       if (p.x() < b[0] || p.x() > b[2] || p.y() < b[1] || p.y() > b[3]) continue;
-      depth += geometry::insidePolygon(cuts[k]->points, p);
+      depth += core::insidePolygon(cuts[k]->points, p);
     }
     return depth;
   };

@@ -120,10 +120,25 @@ std::string GrblDriver::connect() {
   return fmt::format("{} (receive buffer {} bytes, laser mode on)", banner, receiveBuffer_);
 }
 
-jobs::GCodeOptions GrblDriver::gcodeOptions() const {
-  jobs::GCodeOptions options;
+GCodeOptions GrblDriver::gcodeOptions() const {
+  GCodeOptions options;
   if (const auto it = settings_.find(30); it != settings_.end() && it->second > 0) options.maxSpindle = it->second;
   return options;
+}
+
+std::string GrblDriver::program(const std::vector<jobs::Toolpath>& toolpaths) const {
+  std::string bytes;
+  for (const jobs::Toolpath& toolpath : toolpaths) {
+    for (const std::string& line : gcodeLines(toolpath, gcodeOptions())) bytes.append(line).append("\n");
+  }
+  return bytes;
+}
+
+std::string GrblDriver::describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const {
+  size_t strokes = 0;
+  for (const jobs::Toolpath& toolpath : toolpaths) strokes += toolpath.strokes.size();
+  return fmt::format("G-code for {} sheet{} ({} strokes), as the driver would send it", toolpaths.size(),
+                     toolpaths.size() == 1 ? "" : "s", strokes);
 }
 
 jobs::MotionLimits GrblDriver::motionLimits() const {
@@ -177,7 +192,7 @@ DeviceStatus GrblDriver::status() {
   }
 }
 
-void GrblDriver::waitIdle(Millis silence, const CancelFlag* cancel) {
+void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel) {
   // As long as status reports come, the machine is working (or held).
   bool idleBefore = false;
   for (;;) {
@@ -230,9 +245,9 @@ void GrblDriver::frame(const jobs::Toolpath& toolpath) {
 }
 
 void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-                     const CancelFlag& cancel) {
+                     const core::Cancellation& cancel) {
   if (!link_) connect();
-  const jobs::GCodeProgram program = jobs::gcodeProgram(toolpath, gcodeOptions());
+  const GCodeProgram program = gcodeProgram(toolpath, gcodeOptions());
   const std::vector<std::string>& lines = program.lines;
   Progress state;
   state.sheet = toolpath.sheet;

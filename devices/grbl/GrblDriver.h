@@ -13,8 +13,9 @@
 #include <memory>
 
 #include "devices/Device.h"
+#include "devices/DriverEntry.h"
+#include "devices/grbl/GCode.h"
 #include "devices/transport/SerialLink.h"
-#include "jobs/GCode.h"
 
 namespace rotafab::devices::grbl {
 
@@ -35,7 +36,7 @@ class GrblDriver : public Device {
   void home() override;
   void frame(const jobs::Toolpath& toolpath) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-           const CancelFlag& cancel) override;
+           const core::Cancellation& cancel) override;
   // Send-and-wait instead of character counting: one line at a time, each
   // after the last one's `ok` (for comparison: the benchmark).
   void setCharacterCounting(bool on) { characterCounting_ = on; }
@@ -47,15 +48,19 @@ class GrblDriver : public Device {
   // What the controller reported at connect().
   [[nodiscard]] const std::map<int, double>& settings() const { return settings_; }
   [[nodiscard]] size_t receiveBuffer() const { return receiveBuffer_; }
-  // The G-code options (S scale) and motion limits ($110, $120) of the controller.
-  [[nodiscard]] jobs::GCodeOptions gcodeOptions() const;
-  [[nodiscard]] jobs::MotionLimits motionLimits() const;
+  // The G-code options (S scale) and motion limits ($110, $120) of the
+  // controller; GRBL's defaults before connect().
+  [[nodiscard]] GCodeOptions gcodeOptions() const;
+  [[nodiscard]] jobs::MotionLimits motionLimits() const override;
+  // The G-code, each line ended by a newline.
+  [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override;
+  [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override;
 
  private:
   void send(const std::string& line);  // a command and its `ok`
   std::string expectLine(Millis timeout, const char* waitingFor);
   // Polls until the controller is Idle; throws on silence, an alarm or a cancel.
-  void waitIdle(Millis silence, const CancelFlag* cancel);
+  void waitIdle(Millis silence, const core::Cancellation* cancel);
   // Feed hold; once the machine has stopped (Hold:0), soft reset, which
   // turns the laser off without the alarm a reset in motion raises; then
   // M5 S0. Returns whether the controller answered it all. Never throws.
@@ -69,6 +74,10 @@ class GrblDriver : public Device {
   bool characterCounting_ = true;
   std::atomic<bool> holdRequested_{false}, resumeRequested_{false};
 };
+
+// The registry's entry (DriverEntry.h): grbl:///dev/PORT[?baud=N] and
+// grbl+tcp://HOST[:PORT]; CH340, FTDI, CP210x and Arduino USB serial adapters.
+const DriverEntry& entry();
 
 // A status report "<Run|MPos:1.000,2.000,0.000|FS:500,0>" as a DeviceStatus (MPos in mm -> inches).
 std::optional<DeviceStatus> parseStatusReport(const std::string& line);

@@ -215,4 +215,18 @@ std::string egvFile(const std::vector<std::string>& lines) {
   return out;
 }
 
+std::string egvProgram(const std::vector<jobs::Toolpath>& toolpaths) {
+  std::vector<std::string> lines;
+  for (const jobs::Toolpath& toolpath : toolpaths) {
+    const auto sheet = jobLines(toolpath);
+    lines.insert(lines.end(), sheet.begin(), sheet.end());
+  }
+  return egvFile(lines);
+}
+
+std::string describeEgvProgram(const std::vector<jobs::Toolpath>& toolpaths) {
+  return fmt::format("LHYMICRO-GL for {} sheet{} (an .egv file K40 Whisperer and MeerK40t open)", toolpaths.size(),
+                     toolpaths.size() == 1 ? "" : "s");
+}
+
 }  // namespace rotafab::devices::m2nano

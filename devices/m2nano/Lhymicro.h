@@ -72,6 +72,11 @@ std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPer
 // The .egv file K40 Whisperer and MeerK40t open (SPEC, "Devices").
 std::string egvFile(const std::vector<std::string>& lines);
 
+// The .egv file of the sheets' jobs one after another, as a dry run writes
+// it, and what it is, for people.
+std::string egvProgram(const std::vector<jobs::Toolpath>& toolpaths);
+std::string describeEgvProgram(const std::vector<jobs::Toolpath>& toolpaths);
+
 // The M2's motion limits for the toolpath: a profile's 100% speed is 100 mm/s.
 jobs::MotionLimits motionLimits();
 

@@ -107,7 +107,7 @@ int M2NanoDriver::readStatus() {
   }
 }
 
-void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel, Clock::time_point deadline) {
+void M2NanoDriver::send(const Packet& packet, const core::Cancellation* cancel, Clock::time_point deadline) {
   finishedSeen_ = false;
   for (int rejected = 0;;) {
     link_->bulkWrite(kOut, packet.data(), packet.size(), timeouts_.transfer);
@@ -143,13 +143,13 @@ void M2NanoDriver::send(const Packet& packet, const CancelFlag* cancel, Clock::t
   }
 }
 
-void M2NanoDriver::sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel) {
+void M2NanoDriver::sendLines(const std::vector<std::string>& lines, const core::Cancellation* cancel) {
   for (const std::string& line : lines) {
     for (const Packet& p : packets(line)) send(p, cancel);
   }
 }
 
-void M2NanoDriver::waitFinished(Millis limit, const CancelFlag* cancel) {
+void M2NanoDriver::waitFinished(Millis limit, const core::Cancellation* cancel) {
   const auto until = Clock::now() + limit;
   for (;;) {
     if (std::exchange(finishedSeen_, false)) return;
@@ -227,7 +227,7 @@ void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
 }
 
 void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-                       const CancelFlag& cancel) {
+                       const core::Cancellation& cancel) {
   if (!link_) connect();
   holdWanted_ = false;  // a pause from before the job is not for it
   try {
@@ -330,5 +330,11 @@ DeviceStatus M2NanoDriver::status() {
 }
 
 void M2NanoDriver::disconnect() { link_.reset(); }
+
+std::string M2NanoDriver::program(const std::vector<jobs::Toolpath>& toolpaths) const { return egvProgram(toolpaths); }
+
+std::string M2NanoDriver::describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const {
+  return describeEgvProgram(toolpaths);
+}
 
 }  // namespace rotafab::devices::m2nano

@@ -17,6 +17,7 @@
 #include <memory>
 
 #include "devices/Device.h"
+#include "devices/DriverEntry.h"
 #include "devices/m2nano/Lhymicro.h"
 #include "devices/transport/UsbLink.h"
 
@@ -39,7 +40,7 @@ class M2NanoDriver : public Device {
   void home() override;
   void frame(const jobs::Toolpath& toolpath) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-           const CancelFlag& cancel) override;
+           const core::Cancellation& cancel) override;
   // A hold is wanted from pause() until resume(); run() holds at the next
   // stroke's end (one the board has not been sent yet: a pause in the last
   // few packets of a job comes too late, and the job ends).
@@ -48,17 +49,23 @@ class M2NanoDriver : public Device {
   DeviceStatus status() override;
   void disconnect() override;
 
+  // The M2's limits (a profile's 100% speed is 100 mm/s), its LHYMICRO-GL
+  // as an .egv file.
+  [[nodiscard]] jobs::MotionLimits motionLimits() const override { return m2nano::motionLimits(); }
+  [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override;
+  [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override;
+
   // Packets the board asked for again (CRC errors), since connect().
   [[nodiscard]] size_t resends() const { return resends_; }
 
  private:
   int readStatus();
   // Sends one packet until the board takes it (status OK), by `deadline` if one is given.
-  void send(const Packet& packet, const CancelFlag* cancel,
+  void send(const Packet& packet, const core::Cancellation* cancel,
             std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
-  void sendLines(const std::vector<std::string>& lines, const CancelFlag* cancel);
+  void sendLines(const std::vector<std::string>& lines, const core::Cancellation* cancel);
   // Polls until the board reports the job finished (236).
-  void waitFinished(Millis limit, const CancelFlag* cancel);
+  void waitFinished(Millis limit, const core::Cancellation* cancel);
   // "I", then a home; whether the board confirmed both. Never throws.
   bool stopSafely() noexcept;
 
@@ -71,5 +78,8 @@ class M2NanoDriver : public Device {
   Millis busy_ = timeouts_.busy;  // this job's limit for a busy board
   size_t resends_ = 0;
 };
+
+// The registry's entry (DriverEntry.h): m2nano://usb/VENDOR:PRODUCT[?bus=B&address=A]; the CH341 in parallel mode.
+const DriverEntry& entry();
 
 }  // namespace rotafab::devices::m2nano

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <fstream>
+#include <sstream>
 
 #include "jobs/AtomicFile.h"
 #include "jobs/EpsWriter.h"
@@ -48,7 +49,7 @@ std::string SpoolDevice::connect() {
 }
 
 void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-                      const CancelFlag& cancel) {
+                      const core::Cancellation& cancel) {
   if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, "spool: cancelled");
   const jobs::SheetDrawing sheet = drawingOf(toolpath, colours_);
   const std::filesystem::path eps = folder_ / fmt::format("sheet-{:03}.eps", toolpath.sheet);
@@ -85,6 +86,17 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     done.bytesAcknowledged = done.bytesTotal = std::filesystem::file_size(eps);
     progress(done);
   }
+}
+
+std::string SpoolDevice::program(const std::vector<jobs::Toolpath>& toolpaths) const {
+  std::ostringstream out;
+  for (const jobs::Toolpath& toolpath : toolpaths) jobs::writeEps(drawingOf(toolpath, colours_), out);
+  return out.str();
+}
+
+std::string SpoolDevice::describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const {
+  return fmt::format("EPS for {} sheet{}, as the spool would write it", toolpaths.size(),
+                     toolpaths.size() == 1 ? "" : "s");
 }
 
 }  // namespace rotafab::devices::spool

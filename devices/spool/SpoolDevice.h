@@ -11,6 +11,7 @@
 #include <string>
 
 #include "devices/Device.h"
+#include "devices/DriverEntry.h"
 
 namespace rotafab::devices::spool {
 
@@ -26,16 +27,22 @@ class SpoolDevice : public Device {
   void home() override {}
   void frame(const jobs::Toolpath&) override {}
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
-           const CancelFlag& cancel) override;
+           const core::Cancellation& cancel) override;
   void pause() override {}
   void resume() override {}
   DeviceStatus status() override { return {"Idle", 0, 0}; }
   void disconnect() override {}
+  // Each sheet's EPS, one after another.
+  [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override;
+  [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override;
 
  private:
   std::filesystem::path folder_;
   std::string printer_;
   std::map<jobs::Operation, jobs::Rgb> colours_;
 };
+
+// The registry's entry (DriverEntry.h): spool:DIR[?printer=NAME].
+const DriverEntry& entry();
 
 }  // namespace rotafab::devices::spool

@@ -21,9 +21,9 @@
 
 #include "jobs/SheetDrawing.h"
 
+#include "devices/grbl/GCode.h"
 #include "devices/grbl/GrblDriver.h"
 #include "devices/sim/GrblSimulator.h"
-#include "jobs/GCode.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::devices {
@@ -115,9 +115,9 @@ TEST(Grbl, RefusesToCutWithLaserModeOff) {
 TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
   Rig rig(40);
   auto& [simulator, driver, path] = rig;
-  const auto lines = jobs::gcodeLines(path, driver->gcodeOptions());
+  const auto lines = grbl::gcodeLines(path, driver->gcodeOptions());
   std::vector<Progress> seen;
-  CancelFlag cancel;
+  core::Cancellation cancel;
   driver->run(
       path, [&](const Progress& p) { seen.push_back(p); }, cancel);
   const auto record = simulator.record();
@@ -145,7 +145,7 @@ void expectFault(FaultKind kind, const std::function<void(sim::GrblSimulator&)>&
                  bool cancelIt = false) {
   Rig rig(2);
   auto& [simulator, driver, path] = rig;
-  CancelFlag cancel;
+  core::Cancellation cancel;
   simulator.afterLines(12, [&](sim::GrblSimulator& s) {
     if (cancelIt) cancel.cancel();
     if (inject) inject(s);
@@ -199,7 +199,7 @@ TEST(Grbl, ALostReplyIsFoundAndTheLaserTurnedOff) {
   Rig rig(40);
   auto& [simulator, driver, path] = rig;
   simulator.afterLines(20, [](sim::GrblSimulator& s) { s.loseNextOk(); });
-  CancelFlag cancel;
+  core::Cancellation cancel;
   try {
     driver->run(path, nullptr, cancel);
     FAIL() << "the job ran to its end";
@@ -237,7 +237,7 @@ TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
 TEST(Grbl, PauseHoldsAndResumeFinishes) {
   Rig rig(40);
   auto& [simulator, driver, path] = rig;
-  CancelFlag cancel;
+  core::Cancellation cancel;
   std::exception_ptr failed;
   std::thread job([&] {
     try {
@@ -339,10 +339,10 @@ TEST(Grbl, StreamsOverTcpAsOverSerial) {
                           quick());
   EXPECT_NE(driver.connect().find("Grbl 1.1h"), std::string::npos);
   const jobs::Toolpath path = toolpath(driver.motionLimits());
-  CancelFlag cancel;
+  core::Cancellation cancel;
   driver.run(path, nullptr, cancel);
   const auto record = simulator.record();
-  const auto lines = jobs::gcodeLines(path, driver.gcodeOptions());
+  const auto lines = grbl::gcodeLines(path, driver.gcodeOptions());
   ASSERT_GE(record.lines.size(), lines.size());
   EXPECT_EQ(record.lines.back(), "G0X0Y0");
   EXPECT_FALSE(record.overflowed);
@@ -361,7 +361,7 @@ TEST(Grbl, ADroppedTcpConnectionIsADisconnectNotAHang) {
   const size_t before = simulator.record().linesExecuted;
   simulator.afterLines(before + 12, [&](sim::GrblSimulator&) { bridge.drop(); });
   const auto started = std::chrono::steady_clock::now();
-  CancelFlag cancel;
+  core::Cancellation cancel;
   try {
     driver.run(toolpath(driver.motionLimits()), nullptr, cancel);
     FAIL() << "the job ran to its end";

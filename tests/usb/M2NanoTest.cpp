@@ -117,7 +117,7 @@ TEST(M2Nano, CutsTheSheetAsDrawnAndHomes) {
   Rig rig(200);
   const jobs::Toolpath path = toolpath();
   std::vector<Progress> reports;
-  CancelFlag cancel;
+  core::Cancellation cancel;
   rig.driver.run(
       path, [&](const Progress& p) { reports.push_back(p); }, cancel);
   const auto record = rig.simulator.record();
@@ -168,7 +168,7 @@ TEST(M2Nano, ResendsPacketsThatArriveCorrupted) {
   Rig rig(200);
   rig.simulator.afterPackets(2, [](sim::M2NanoSimulator& s) { s.corruptPackets(3); });
   const jobs::Toolpath path = toolpath();
-  CancelFlag cancel;
+  core::Cancellation cancel;
   rig.driver.run(path, {}, cancel);
   const auto record = rig.simulator.record();
   EXPECT_EQ(record.packetsRejected, 3u);
@@ -181,7 +181,7 @@ TEST(M2Nano, TooManyCrcErrorsIsAFaultWithTheLaserOff) {
   Rig rig(200);
   // 50 rejects of one packet make the fault; the stop ("I") gets through on its third try.
   rig.simulator.afterPackets(2, [](sim::M2NanoSimulator& s) { s.corruptPackets(52); });
-  CancelFlag cancel;
+  core::Cancellation cancel;
   try {
     rig.driver.run(toolpath(), {}, cancel);
     FAIL() << "the job ran through a broken cable";
@@ -206,7 +206,7 @@ struct Outcome {
 };
 Outcome runInto(Rig& rig, size_t packets, std::function<void(sim::M2NanoSimulator&)> fault) {
   rig.simulator.afterPackets(packets, std::move(fault));
-  CancelFlag cancel;
+  core::Cancellation cancel;
   const auto started = Clock::now();
   try {
     rig.driver.run(toolpath(), {}, cancel);
@@ -221,7 +221,7 @@ Outcome runInto(Rig& rig, size_t packets, std::function<void(sim::M2NanoSimulato
 // Runs the job and cancels it once two strokes are taken: a Cancelled
 // fault, with the laser off confirmed.
 void cancelAfterTwoStrokes(m2nano::M2NanoDriver& driver, const jobs::Toolpath& path) {
-  CancelFlag cancel;
+  core::Cancellation cancel;
   try {
     driver.run(
         path,
@@ -299,7 +299,7 @@ TEST(M2Nano, APowerFaultIsAnAlarm) {
 TEST(M2Nano, PauseHoldsAtAStrokesEndWithTheLaserOffAndResumeFinishes) {
   Rig rig(20);
   const jobs::Toolpath path = toolpath();
-  CancelFlag cancel;
+  core::Cancellation cancel;
   std::exception_ptr failed;
   std::thread job([&] {
     try {

@@ -1,10 +1,13 @@
-#include "jobs/GCode.h"
+#include "devices/grbl/GCode.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
 
-namespace rotafab::jobs {
+namespace rotafab::devices::grbl {
+
+using namespace jobs;
+
 namespace {
 
 constexpr double kMillimetresPerInch = 25.4;
@@ -13,7 +16,7 @@ std::string millimetres(double inches) { return formatDecimal(inches * kMillimet
 
 }  // namespace
 
-GCodeProgram gcodeProgram(const Toolpath& toolpath, const GCodeOptions& options) {
+GCodeProgram gcodeProgram(const jobs::Toolpath& toolpath, const GCodeOptions& options) {
   GCodeProgram program;
   std::vector<std::string>& lines = program.lines;
   lines = {"G21", "G90", "G94", "M4 S0"};
@@ -35,8 +38,8 @@ GCodeProgram gcodeProgram(const Toolpath& toolpath, const GCodeOptions& options)
   return program;
 }
 
-std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options) {
+std::vector<std::string> gcodeLines(const jobs::Toolpath& toolpath, const GCodeOptions& options) {
   return gcodeProgram(toolpath, options).lines;
 }
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::devices::grbl

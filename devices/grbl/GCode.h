@@ -11,14 +11,14 @@
 
 #include "jobs/Toolpath.h"
 
-namespace rotafab::jobs {
+namespace rotafab::devices::grbl {
 
 struct GCodeOptions {
   double maxSpindle = 1000;  // $30: S for full power
 };
 
 // One line each, without the newline.
-std::vector<std::string> gcodeLines(const Toolpath& toolpath, const GCodeOptions& options);
+std::vector<std::string> gcodeLines(const jobs::Toolpath& toolpath, const GCodeOptions& options);
 
 // The same lines, and how many of them run through the end of each stroke
 // (for progress by strokes).
@@ -26,6 +26,6 @@ struct GCodeProgram {
   std::vector<std::string> lines;
   std::vector<size_t> strokeEnds;
 };
-GCodeProgram gcodeProgram(const Toolpath& toolpath, const GCodeOptions& options);
+GCodeProgram gcodeProgram(const jobs::Toolpath& toolpath, const GCodeOptions& options);
 
-}  // namespace rotafab::jobs
+}  // namespace rotafab::devices::grbl

@@ -1,0 +1,59 @@
+#include "daemon/DevicesCommand.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "daemon/ExitCode.h"
+#include "devices/Discovery.h"
+
+namespace rotafab::cli {
+namespace {
+
+int runDevices(bool json) {
+  const auto found = devices::findDevices();
+  if (json) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const auto& d : found) {
+      nlohmann::ordered_json entry = {{"port", d.port}, {"description", d.description}};
+      if (d.vendor >= 0) {
+        entry["usb"] = {{"vendor", fmt::format("{:04x}", d.vendor)}, {"product", fmt::format("{:04x}", d.product)}};
+        if (!d.serial.empty()) entry["usb"]["serial"] = d.serial;
+      }
+      entry["driver"] = d.driver.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(d.driver);
+      entry["uri"] = d.uri.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(d.uri);
+      list.push_back(entry);
+    }
+    std::cout << list.dump() << '\n';
+    return kSuccess;
+  }
+  if (found.empty()) {
+    fmt::print(
+        "no serial port or cutter found (a GRBL board shows as /dev/ttyUSB* or /dev/ttyACM*; check the cable, "
+        "and that you may open it: the dialout group)\n");
+    return kSuccess;
+  }
+  for (const auto& d : found) {
+    fmt::print("{}  {}", d.port, d.description.empty() ? "(no description)" : d.description);
+    if (d.vendor >= 0) fmt::print("  usb {:04x}:{:04x}", d.vendor, d.product);
+    if (!d.serial.empty()) fmt::print(" serial {}", d.serial);
+    if (!d.uri.empty()) fmt::print("\n    {} driver: --device {}", d.driver, d.uri);
+    fmt::print("\n");
+  }
+  return kSuccess;
+}
+
+}  // namespace
+
+void addDevicesCommand(CLI::App& app, int& status) {
+  auto json = std::make_shared<bool>(false);
+  CLI::App* devicesCommand =
+      app.add_subcommand("devices", "List the serial ports and cutters plugged in, and the driver for each");
+  devicesCommand->add_flag("--json", *json,
+                           "Print one JSON array: port, description, usb {vendor, product, serial}, driver, uri");
+  devicesCommand->callback([json, &status] { status = runDevices(*json); });
+}
+
+}  // namespace rotafab::cli

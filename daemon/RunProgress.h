@@ -1,0 +1,35 @@
+#pragma once
+// How `rotafab run` shows a cut at the terminal: the progress bar, times in
+// minutes, and the question before each sheet after the first.
+
+#include <chrono>
+#include <string>
+
+#include "core/Cancellation.h"
+#include "devices/Device.h"
+
+namespace rotafab::cli {
+
+// "4m 37s", "12s".
+std::string minutes(double seconds);
+
+// A bar redrawn in place on a terminal (at most every 200 ms), a line every
+// 10% otherwise.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool terminal) : terminal_(terminal) {}
+  void operator()(const devices::Progress& progress);
+  // After a sheet, or a fault: the bar's line ended.
+  void end() const;
+
+ private:
+  bool terminal_;
+  std::chrono::steady_clock::time_point lastShown_{};
+  int lastPercent_ = -1;
+};
+
+// Waits for a line on standard input while watching for a cancel (a read
+// restarted after a signal would not see it). False on a cancel or the end of input.
+bool waitForEnter(const core::Cancellation& cancel);
+
+}  // namespace rotafab::cli

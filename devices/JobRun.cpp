@@ -1,0 +1,59 @@
+#include "devices/JobRun.h"
+
+#include "jobs/AtomicFile.h"
+
+namespace rotafab::devices {
+
+JobRun::JobRun(JobRunSetup setup) : setup_(std::move(setup)) {
+  const DriverEntry& driver = *setup_.device.driver;
+  DeviceSetup deviceSetup;
+  for (profiles::Operation operation : profiles::kAllOperations) {
+    deviceSetup.colours[operation] = setup_.machine.settingFor(operation).rgb;
+  }
+  device_ = driver.open(*setup_.device.address, deviceSetup);
+  if (!setup_.dryRun || driver.connectsForDryRun(*setup_.device.address)) {
+    const std::string identity = device_->connect();
+    connected_ = true;
+    if (setup_.connected) setup_.connected(identity);
+  }
+  const jobs::MotionLimits limits = device_->motionLimits();
+  for (const jobs::SheetDrawing& sheet : setup_.sheets) {
+    toolpaths_.push_back(jobs::planToolpath(sheet, setup_.machine, setup_.material, limits));
+  }
+}
+
+JobRun::~JobRun() {
+  if (device_) device_->disconnect();
+}
+
+std::string JobRun::writeDryRun(const std::filesystem::path& file) const {
+  jobs::writeFileAtomically(file, device_->program(toolpaths_));
+  return device_->describeProgram(toolpaths_);
+}
+
+RunSummary JobRun::run(bool frame, const RunEvents& events, const core::Cancellation& cancel) {
+  RunSummary summary;
+  for (size_t s = 0; s < toolpaths_.size(); ++s) {
+    const jobs::Toolpath& toolpath = toolpaths_[s];
+    // Stop, do not cut blind, unless the next sheet is known to be loaded.
+    const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
+    if (!loaded || cancel.cancelled()) {
+      throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
+    }
+    if (events.sheetStarted) events.sheetStarted(s, toolpath);
+    if (frame) {
+      if (events.framing) events.framing();
+      device_->frame(toolpath);
+    }
+    device_->run(
+        toolpath, events.progress ? events.progress : [](const Progress&) {}, cancel);
+    if (events.sheetFinished) events.sheetFinished();
+    ++summary.sheets;
+    summary.burnt += toolpath.burnLength, summary.estimated += toolpath.seconds;
+    summary.strokes += toolpath.strokes.size();
+  }
+  device_->disconnect();
+  return summary;
+}
+
+}  // namespace rotafab::devices

@@ -1,0 +1,85 @@
+#pragma once
+// A job's sheets run on a device, as `rotafab run` and the daemon run them:
+// the device opened through the registry (DriverEntry.h) and connected
+// (unless a dry run need not), each sheet's toolpath planned with the
+// machine and material profiles and the device's own limits; then either
+// the bytes of a dry run written, or the sheets cut one after another:
+// progress, pause and resume from another thread, a stop before each sheet
+// after the first (for the next to be loaded), and a cancel that leaves the
+// laser off (the driver's safe stop) and says where the job had got to.
+
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/Cancellation.h"
+#include "devices/Device.h"
+#include "devices/DriverEntry.h"
+#include "jobs/SheetDrawing.h"
+#include "jobs/Toolpath.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::devices {
+
+struct JobRunSetup {
+  ParsedUri device;  // parseDeviceUri()
+  profiles::MachineProfile machine;
+  profiles::MaterialProfile material;
+  std::vector<jobs::SheetDrawing> sheets;  // in the order to cut
+  bool dryRun = false;
+  // Told what the controller says it is, once connected.
+  std::function<void(const std::string& identity)> connected;
+};
+
+struct RunEvents {
+  // Before each sheet but the first: whether the next sheet is loaded (if
+  // not, the job stops as cancelled). The command line asks at the
+  // terminal, a daemon waits for its client. Not set: go on.
+  std::function<bool(const jobs::Toolpath& next)> beforeSheet;
+  std::function<void(size_t index, const jobs::Toolpath& toolpath)> sheetStarted;  // index of all, from 0
+  std::function<void()> framing;
+  std::function<void(const Progress&)> progress;
+  std::function<void()> sheetFinished;
+};
+
+struct RunSummary {
+  size_t sheets = 0, strokes = 0;
+  double burnt = 0;      // inches
+  double estimated = 0;  // seconds
+};
+
+class JobRun {
+ public:
+  // Throws std::invalid_argument (an operation with no usable setting) and
+  // DeviceFault (the device cannot be opened or is not one the driver drives).
+  explicit JobRun(JobRunSetup setup);
+  ~JobRun();  // disconnects
+  JobRun(const JobRun&) = delete;
+  JobRun& operator=(const JobRun&) = delete;
+
+  [[nodiscard]] const std::vector<jobs::Toolpath>& toolpaths() const { return toolpaths_; }
+  [[nodiscard]] const DriverEntry& driver() const { return *setup_.device.driver; }
+
+  // Writes exactly the bytes the device would be sent, atomically; returns
+  // what they are ("G-code for 1 sheet (108 strokes), as the driver would send it").
+  std::string writeDryRun(const std::filesystem::path& file) const;
+
+  // Runs every sheet, each framed first if asked. Throws DeviceFault: the
+  // driver has stopped the machine and says whether the controller
+  // confirmed the laser off; a cancel is FaultKind::Cancelled.
+  RunSummary run(bool frame, const RunEvents& events, const core::Cancellation& cancel);
+
+  // From another thread while run() goes on.
+  void pause() { device_->pause(); }
+  void resume() { device_->resume(); }
+
+ private:
+  JobRunSetup setup_;
+  std::unique_ptr<Device> device_;
+  bool connected_ = false;
+  std::vector<jobs::Toolpath> toolpaths_;
+};
+
+}  // namespace rotafab::devices

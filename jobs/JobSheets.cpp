@@ -1,0 +1,87 @@
+#include "jobs/JobSheets.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/UserError.h"
+#include "jobs/SheetReader.h"
+
+namespace rotafab::jobs {
+namespace {
+
+// The sheets to read: (number, SVG file).
+std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesystem::path& target,
+                                                              std::optional<int> only) {
+  std::vector<std::pair<int, std::filesystem::path>> sheets;
+  if (std::filesystem::is_directory(target)) {
+    const auto manifestFile = target / "manifest.json";
+    std::ifstream in(manifestFile);
+    if (!in) {
+      throw core::UserError(
+          fmt::format("{}: no manifest.json (is it an output folder of `rotafab make`?)", target.string()));
+    }
+    nlohmann::json manifest;
+    try {
+      manifest = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& error) {
+      throw core::UserError(fmt::format("{}: not JSON: {}", manifestFile.string(), error.what()));
+    }
+    try {
+      for (const auto& sheet : manifest.at("sheets")) {
+        const int index = sheet.at("index");
+        for (const auto& file : sheet.at("files")) {
+          const std::string name = file;
+          if (name.ends_with(".svg")) sheets.emplace_back(index, target / name);
+        }
+      }
+    } catch (const nlohmann::json::exception& error) {
+      throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), error.what()));
+    }
+    if (sheets.empty()) throw core::UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
+  } else {
+    if (target.extension() != ".svg") {
+      throw core::UserError(
+          fmt::format("{}: give the sheet's .svg (or the output folder of `rotafab make`)", target.string()));
+    }
+    sheets.emplace_back(1, target);
+  }
+  if (only) {
+    const auto it = std::find_if(sheets.begin(), sheets.end(), [&](const auto& s) { return s.first == *only; });
+    if (it == sheets.end()) {
+      throw core::UserError(fmt::format("--sheet {}: {} has sheets 1 to {}", *only, target.string(), sheets.size()));
+    }
+    sheets = {*it};
+  }
+  return sheets;
+}
+
+}  // namespace
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only) {
+  std::vector<JobSheet> sheets;
+  for (const auto& [index, file] : sheetFiles(target, only)) {
+    try {
+      sheets.push_back({index, file, readSheetSvg(file)});
+    } catch (const std::invalid_argument& error) {
+      throw core::UserError(error.what());
+    }
+  }
+  return sheets;
+}
+
+void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {
+  for (const JobSheet& sheet : sheets) {
+    if (sheet.drawing.width > machine.bed.width + 1e-6 || sheet.drawing.height > machine.bed.height + 1e-6) {
+      throw core::UserError(
+          fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
+                      "make it for this machine (`rotafab make ... --machine {}`)",
+                      sheet.file.string(), sheet.drawing.width, sheet.drawing.height, machine.name, machine.bed.width,
+                      machine.bed.height, machine.name));
+    }
+  }
+}
+
+}  // namespace rotafab::jobs

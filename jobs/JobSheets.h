@@ -1,0 +1,28 @@
+#pragma once
+// The sheets of a planned job as a cutter runs them: a `make` output folder
+// (its manifest's SVG sheets, in order) or one sheet's SVG, read back
+// (SheetReader.h), and checked against the bed they are to be cut on.
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "jobs/SheetDrawing.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::jobs {
+
+struct JobSheet {
+  int index = 1;  // the sheet's number in the job
+  std::filesystem::path file;
+  SheetDrawing drawing;
+};
+
+// All the sheets, or only sheet `only`. Throws core::UserError naming the
+// folder, the manifest or the sheet file and what is wrong.
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only);
+
+// Throws core::UserError naming the first sheet larger than the machine's bed.
+void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);
+
+}  // namespace rotafab::jobs
