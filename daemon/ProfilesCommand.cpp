@@ -85,7 +85,8 @@ void addProfilesCommand(CLI::App& app, int& status) {
   command->add_flag("--json", options->json, "Print one JSON object: {\"machines\": [...], \"materials\": [...]}");
   command->footer(
       "Profiles are YAML files in machines/ and materials/ under each folder of the search path, first match wins:\n"
-      "  ./profiles, $XDG_CONFIG_HOME/rotafab/profiles (~/.config/rotafab/profiles), /usr/share/rotafab/profiles.\n"
+      "  ./profiles, $XDG_CONFIG_HOME/rotafab/profiles (~/.config/rotafab/profiles), PREFIX/share/rotafab/profiles\n"
+      "  (beside an installed PREFIX/bin/rotafab), /usr/share/rotafab/profiles.\n"
       "An invalid profile is reported as FILE:LINE:COL: key: what is wrong, and the exit status is 1.\n\n"
       "Examples:\n"
       "  rotafab profiles\n"

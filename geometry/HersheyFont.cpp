@@ -6,6 +6,8 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "core/ProgramFolders.h"
+
 namespace rotafab::geometry {
 namespace {
 
@@ -93,7 +95,13 @@ HersheyFont HersheyFont::load(const std::filesystem::path& file) {
 }
 
 const HersheyFont& HersheyFont::simplex() {
-  static const HersheyFont font = load(std::filesystem::path(kDefaultFontFolder) / "rowmans.jhf");
+  static const HersheyFont font = [] {
+    const auto installed = core::installedDataFolder() / "fonts" / "rowmans.jhf";
+    std::error_code missing;
+    return load(std::filesystem::exists(installed, missing)
+                    ? installed
+                    : std::filesystem::path(kDefaultFontFolder) / "rowmans.jhf");
+  }();
   return font;
 }
 

@@ -48,7 +48,9 @@ class HersheyFont {
   // "FILE:LINE: what is wrong".
   static HersheyFont load(const std::filesystem::path& file);
 
-  // Simplex Roman (rowmans.jhf), read once from kDefaultFontFolder.
+  // Simplex Roman (rowmans.jhf), read once: from the fonts installed beside
+  // the program (PREFIX/share/rotafab/fonts), else from kDefaultFontFolder,
+  // where Debian's hershey-fonts-data puts them.
   static const HersheyFont& simplex();
   static constexpr const char* kDefaultFontFolder = "/usr/share/hershey-fonts";
 

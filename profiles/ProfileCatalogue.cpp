@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 
+#include "core/ProgramFolders.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::profiles {
@@ -44,9 +45,15 @@ std::vector<std::filesystem::path> profileSearchPath() {
   } else if (const char* home = std::getenv("HOME"); home && *home) {
     path.push_back(std::filesystem::path(home) / ".config" / "rotafab" / "profiles");
   }
+  // Installed (cmake --install): beside the program, wherever its prefix is; then the system's.
+  const auto installed = core::installedDataFolder() / "profiles";
+  if (installed != "/usr/share/rotafab/profiles") path.push_back(installed);
   path.push_back("/usr/share/rotafab/profiles");
-#ifdef ROTAFAB_PROFILES_DIR
-  path.push_back(ROTAFAB_PROFILES_DIR);  // the shipped profiles, when run from a build tree
+#if defined(ROTAFAB_PROFILES_DIR) && defined(ROTAFAB_BUILD_DIR)
+  // The shipped profiles of the source tree, for a program run from its build tree (not once installed).
+  std::error_code error;
+  if (std::filesystem::equivalent(core::programFolder(), ROTAFAB_BUILD_DIR, error))
+    path.push_back(ROTAFAB_PROFILES_DIR);
 #endif
   return path;
 }

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 
+#include "core/ProgramFolders.h"
 #include "devices/UriParts.h"
 #include "devices/grbl/GrblDriver.h"
 #include "devices/m2nano/Lhymicro.h"

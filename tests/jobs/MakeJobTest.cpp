@@ -12,8 +12,8 @@
 #include <mutex>
 #include <thread>
 
-#include "TestContext.h"
-#include "TestSupport.h"
+#include "support/TestContext.h"
+#include "support/TestSupport.h"
 #include "core/UserError.h"
 
 namespace rotafab::jobs {

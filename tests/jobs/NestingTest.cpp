@@ -5,7 +5,7 @@
 #include "jobs/Nesting.h"
 #include "jobs/RowLayout.h"
 
-#include "TestContext.h"
+#include "support/TestContext.h"
 
 #include <gtest/gtest.h>
 

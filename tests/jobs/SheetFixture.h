@@ -18,7 +18,7 @@
 #include <string>
 #include <vector>
 
-#include "TestSupport.h"
+#include "support/TestSupport.h"
 #include "geometry/HersheyFont.h"
 #include "jobs/SheetDrawing.h"
 

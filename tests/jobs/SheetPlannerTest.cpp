@@ -9,8 +9,8 @@
 #include <numbers>
 #include <sstream>
 
-#include "TestContext.h"
-#include "TestSupport.h"
+#include "support/TestContext.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::jobs {
 namespace {

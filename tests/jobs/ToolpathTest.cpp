@@ -10,7 +10,7 @@
 #include <fstream>
 #include <regex>
 
-#include "TestSupport.h"
+#include "support/TestSupport.h"
 #include "jobs/SheetReader.h"
 #include "jobs/SvgWriter.h"
 #include "profiles/Profiles.h"

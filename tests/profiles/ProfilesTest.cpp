@@ -3,12 +3,16 @@
 
 #include <gtest/gtest.h>
 
-#include "TestSupport.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
+#include "support/ProfileSamples.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::profiles {
 namespace {
+
+using test::kGoodMachine;
+using test::replaced;
 
 const std::filesystem::path kShipped = std::filesystem::path(ROTAFAB_SOURCE_DIR) / "profiles";
 
@@ -59,19 +63,6 @@ TEST(Profiles, EarlierFolderShadowsLater) {
   EXPECT_EQ(findMachine(catalogue, "workshop-32x18").bed.margin, 0.5);
 }
 
-constexpr const char* kGoodMachine =
-    "kind: machine\n"                                                       // 1
-    "name: test\n"                                                          // 2
-    "bed: {width: 32in, height: 18in, margin: 0.25in}\n"                    // 3
-    "driver: spool\n"                                                       // 4
-    "connection: spool:out\n"                                               // 5
-    "colours:\n"                                                            // 6
-    "  blue: {rgb: [0, 0, 255], power: 50}\n"                               // 7
-    "  red: {rgb: [255, 0, 0]}\n"                                           // 8
-    "  yellow: {rgb: '#ffff00'}\n"                                          // 9
-    "  green: {rgb: [0, 255, 0]}\n"                                         // 10
-    "operations: {cut: blue, score: red, etch: yellow, outline: green}\n";  // 11
-
 // Loads `text` as a machine (or material) profile file and returns the error.
 std::string refusal(const std::string& text, bool material = false) {
   test::TempDir dir;
@@ -88,12 +79,6 @@ std::string refusal(const std::string& text, bool material = false) {
     return message.starts_with(prefix) ? "p.yaml" + message.substr(prefix.size()) : message;
   }
   return "(accepted)";
-}
-
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
-  const size_t at = text.find(from);
-  EXPECT_NE(at, std::string::npos) << from;
-  return text.replace(at, from.size(), to);
 }
 
 TEST(Profiles, GoodMachineLoads) { EXPECT_EQ(refusal(kGoodMachine), "(accepted)"); }
@@ -169,32 +154,6 @@ TEST(Profiles, EveryInvalidMaterialIsRefusedWithItsPlace) {
   EXPECT_EQ(refusal(replaced(good, "speed: 40", "speed: 0"), true),
             "p.yaml:6:44: machines.workshop-32x18.cut.speed: must be between 0.1 and 100, not 0");
   EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", ""), true), "p.yaml:1:1: kerf: missing");
-}
-
-}  // namespace
-}  // namespace rotafab::profiles
-
-namespace rotafab::profiles {
-namespace {
-
-TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
-  test::TempDir dir;
-  const auto bad = dir.write("bad.yaml", replaced(kGoodMachine, "driver: spool", "drivr: spool"));
-  const auto good = dir.write("good.yaml", kGoodMachine);
-  const test::CommandResult refused = test::run(std::string(ROTAFAB_CLI) + " profiles " + bad.string());
-  EXPECT_EQ(refused.status, 1);
-  EXPECT_EQ(refused.err, "error: " + bad.string() +
-                             ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
-                             "connection, colours, operations)\n");
-  const test::CommandResult accepted = test::run(std::string(ROTAFAB_CLI) + " profiles --json " + good.string());
-  EXPECT_EQ(accepted.status, 0) << accepted.err;
-  EXPECT_NE(accepted.out.find(R"("name":"test")"), std::string::npos) << accepted.out;
-  // From the source tree, the shipped profiles are on the search path.
-  const test::CommandResult listed =
-      test::run("cd " + std::string(ROTAFAB_SOURCE_DIR) + " && " + ROTAFAB_CLI + " profiles");
-  EXPECT_EQ(listed.status, 0) << listed.err;
-  EXPECT_NE(listed.out.find("workshop-32x18"), std::string::npos);
-  EXPECT_NE(listed.out.find("posterboard"), std::string::npos);
 }
 
 }  // namespace

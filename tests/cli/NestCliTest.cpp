@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "TestSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {

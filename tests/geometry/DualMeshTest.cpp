@@ -4,8 +4,9 @@
 
 #include <gtest/gtest.h>
 
-#include "TestSupport.h"
 #include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

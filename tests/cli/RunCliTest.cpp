@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
-#include "TestSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {

@@ -1,6 +1,7 @@
 #pragma once
 // Small helpers shared by the test suites: temporary folders and files,
-// running the built `rotafab` program, and topology in one call.
+// running a program, and the meshes other people made that Debian packages
+// install.
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
@@ -10,10 +11,6 @@
 #include <fstream>
 #include <random>
 #include <string>
-
-#include "geometry/ConstructionScale.h"
-#include "geometry/MeshAnalysis.h"
-#include "geometry/PolygonMesh.h"
 
 namespace rotafab::test {
 
@@ -101,15 +98,5 @@ inline std::filesystem::path publicMesh(const std::string& where) {
 inline std::string cgalMesh(const std::string& name) {
   return "/usr/share/doc/libcgal-dev/data.tar.gz:data/meshes/" + name;
 }
-
-// A mesh scaled as `make` scales it by default (mean edge 2 in).
-inline geometry::PolygonMesh atConstructionSize(geometry::PolygonMesh mesh) {
-  geometry::analyzeMesh(mesh);
-  const double scale = geometry::constructionScale(mesh, std::nullopt, std::nullopt);
-  for (geometry::Point3& p : mesh.positions) p *= scale;
-  return mesh;
-}
-
-inline geometry::MeshTopology topologyOf(geometry::PolygonMesh mesh) { return geometry::analyzeMesh(mesh).topology; }
 
 }  // namespace rotafab::test

@@ -8,8 +8,9 @@
 #include <map>
 #include <random>
 
-#include "TestSupport.h"
+#include "geometry/MeshAnalysis.h"
 #include "geometry/Primitives.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

@@ -15,9 +15,10 @@
 
 #include <cstring>
 
-#include "TestSupport.h"
 #include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

@@ -7,8 +7,9 @@
 #include <Eigen/Eigenvalues>
 #include <numbers>
 
-#include "TestSupport.h"
 #include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

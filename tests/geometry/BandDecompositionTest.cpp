@@ -13,13 +13,14 @@
 #include <map>
 #include <string>
 
-#include "TestSupport.h"
 #include "geometry/Curvature.h"
 #include "geometry/DevelopableBands.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
 #include "geometry/PanelUnfolding.h"
 #include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

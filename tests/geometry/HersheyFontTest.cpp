@@ -6,14 +6,27 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
 #include <numbers>
 
-#include "SheetFixture.h"
+#include "support/TestSupport.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::geometry {
 namespace {
 
-using namespace rotafab::geometry;  // the font is geometry's (SPEC: single-stroke labels)
+using test::TempDir;
+
+// The box of some points.
+struct Box {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+  void add(const Point2& p) {
+    x0 = std::min(x0, p.x()), y0 = std::min(y0, p.y());
+    x1 = std::max(x1, p.x()), y1 = std::max(y1, p.y());
+  }
+};
 
 const HersheyFont& font() { return HersheyFont::simplex(); }
 
@@ -189,4 +202,4 @@ TEST(HersheyFont, LabelMarkIsAPeriodAfterTheNumberOnTheBaseline) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::geometry

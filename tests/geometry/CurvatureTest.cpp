@@ -7,9 +7,10 @@
 #include <numbers>
 #include <random>
 
-#include "TestSupport.h"
 #include "geometry/CornerCutting.h"
 #include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

@@ -9,9 +9,6 @@
 #include <regex>
 #include <set>
 
-#include "CrumpledMesh.h"
-#include "TestContext.h"
-#include "TestSupport.h"
 #include "geometry/BandDecomposition.h"
 #include "geometry/DevelopableBands.h"
 #include "geometry/FastenerHoles.h"
@@ -20,6 +17,10 @@
 #include "geometry/MeshImport.h"
 #include "geometry/PanelUnfolding.h"
 #include "geometry/Primitives.h"
+#include "support/CrumpledMesh.h"
+#include "support/MeshSupport.h"
+#include "support/TestContext.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

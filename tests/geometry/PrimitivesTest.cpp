@@ -5,8 +5,9 @@
 
 #include <gtest/gtest.h>
 
-#include "TestSupport.h"
 #include "geometry/ObjWriter.h"
+#include "support/MeshSupport.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::geometry {
 namespace {

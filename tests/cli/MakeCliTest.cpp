@@ -11,9 +11,9 @@
 #include <set>
 #include <sstream>
 
-#include "CrumpledMesh.h"
-#include "TestSupport.h"
 #include "geometry/ObjWriter.h"
+#include "support/CrumpledMesh.h"
+#include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {

@@ -1,0 +1,20 @@
+#pragma once
+// Where the running program's own files are: its folder, and its data
+// folder as `cmake --install` lays it out (PREFIX/bin/rotafab beside
+// PREFIX/share/rotafab and PREFIX/libexec/rotafab), wherever PREFIX is.
+
+#include <filesystem>
+
+namespace rotafab::core {
+
+// The folder of the running program (empty when it cannot be told).
+std::filesystem::path programFolder();
+
+// PREFIX/share/rotafab for a program in PREFIX/bin: the shipped profiles
+// (profiles/) and fonts (fonts/).
+std::filesystem::path installedDataFolder();
+
+// PREFIX/libexec/rotafab: the helper programs.
+std::filesystem::path installedHelperFolder();
+
+}  // namespace rotafab::core
