@@ -18,18 +18,12 @@ namespace {
 
 struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
-  bool json = false;
-  std::string size, fastener, kerf;
+  std::string size, fastener, kerf, holes = "keep", up = "y", order = "window", layout = "nest";
   std::optional<double> scale, tension;
-  std::string holes = "keep";
-  int samples = 8;
   std::optional<int> start;
-  std::string up = "y";
-  bool scoreFolds = false;
+  int samples = 8, window = 8;
   double seconds = 5.0;
-  std::string order = "window";
-  int window = 8;
-  std::string layout = "nest";
+  bool json = false, scoreFolds = false;
 };
 
 jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalogue& catalogue) {
@@ -61,13 +55,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
 void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
   const auto& s = job.seconds;
   if (options.json) {
-    const nlohmann::ordered_json summary = {
-        {"panels", job.structure.panels.size()},
-        {"sheets", job.sheets.sheets.size()},
-        {"fasteners", job.structure.fasteners},
-        {"utilization", job.sheets.utilization},
-        {"seconds", {{"import", s.import}, {"geometry", s.geometry}, {"nesting", s.nesting}, {"writing", s.writing}}}};
-    std::cout << summary.dump() << '\n';
+    std::cout << jobs::summaryJson(job).dump() << '\n';
     return;
   }
   const size_t sheets = job.sheets.sheets.size();

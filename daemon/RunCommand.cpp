@@ -25,11 +25,8 @@ struct RunOptions {
 profiles::MachineProfile machineFor(const RunOptions& options, const profiles::ProfileCatalogue& catalogue,
                                     std::string_view driver) {
   if (options.machine.empty()) {
-    const auto it = std::find_if(catalogue.machines.begin(), catalogue.machines.end(),
-                                 [&](const auto& m) { return m.driver == driver; });
-    if (it == catalogue.machines.end())
-      throw UserError(fmt::format("no machine profile for the {} driver; give --machine", driver));
-    return *it;
+    if (auto machine = profiles::firstMachineFor(catalogue, driver)) return *machine;
+    throw UserError(fmt::format("no machine profile for the {} driver; give --machine", driver));
   }
   profiles::MachineProfile machine = profiles::findMachine(catalogue, options.machine);
   if (machine.driver != driver) {
@@ -47,27 +44,11 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
                     "run them one at a time with --sheet N",
                     options.target, toolpaths.size()));
   }
-  const bool terminal = ::isatty(STDERR_FILENO) != 0;
-  ProgressBar bar(terminal);
-  devices::RunEvents events;
-  events.beforeSheet = [&](const jobs::Toolpath& next) {
-    fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", next.sheet);
-    return waitForEnter(command.cancellation());  // Ctrl-C or the end of input: stop, do not cut blind
-  };
-  events.sheetStarted = [&](size_t s, const jobs::Toolpath& toolpath) {
-    fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}\n", toolpath.sheet, s + 1,
-               toolpaths.size(), toolpath.strokes.size(), toolpath.burnLength, minutes(toolpath.seconds));
-    bar = ProgressBar(terminal);
-  };
-  events.framing = [] { fmt::print(stderr, "run: framing (laser off)\n"); };
-  events.progress = [&](const devices::Progress& p) { bar(p); };
-  events.sheetFinished = [&] { bar.end(); };
   const auto started = std::chrono::steady_clock::now();
   devices::RunSummary done;
   try {
-    done = job.run(options.frame, events, command.cancellation());
+    done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation()), command.cancellation());
   } catch (const devices::DeviceFault& fault) {
-    bar.end();
     fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
                fault.laserOffConfirmed ? "the laser is off"
                                        : "the controller did not confirm the laser off: switch it off at the machine");

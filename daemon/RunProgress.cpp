@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 namespace rotafab::cli {
 
@@ -44,6 +45,26 @@ bool waitForEnter(const core::Cancellation& cancel) {
       return false;
     }
   }
+}
+
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel) {
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  auto bar = std::make_shared<ProgressBar>(terminal);
+  devices::RunEvents events;
+  events.beforeSheet = [&cancel](const jobs::Toolpath& next) {
+    fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", next.sheet);
+    return waitForEnter(cancel);  // Ctrl-C or the end of input: stop, do not cut blind
+  };
+  events.sheetStarted = [bar, sheets, terminal](size_t s, const jobs::Toolpath& toolpath) {
+    fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}\n", toolpath.sheet, s + 1,
+               sheets, toolpath.strokes.size(), toolpath.burnLength, minutes(toolpath.seconds));
+    *bar = ProgressBar(terminal);
+  };
+  events.framing = [] { fmt::print(stderr, "run: framing (laser off)\n"); };
+  events.progress = [bar](const devices::Progress& p) { (*bar)(p); };
+  events.sheetFinished = [bar] { bar->end(); };
+  events.stopped = [bar] { bar->end(); };
+  return events;
 }
 
 }  // namespace rotafab::cli

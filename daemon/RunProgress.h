@@ -7,6 +7,7 @@
 
 #include "core/Cancellation.h"
 #include "devices/Device.h"
+#include "devices/JobRun.h"
 
 namespace rotafab::cli {
 
@@ -31,5 +32,10 @@ class ProgressBar {
 // Waits for a line on standard input while watching for a cancel (a read
 // restarted after a signal would not see it). False on a cancel or the end of input.
 bool waitForEnter(const core::Cancellation& cancel);
+
+// The events of a run of `sheets` sheets shown on standard error: a line as
+// each sheet starts, its progress bar, the question before each sheet after
+// the first (answered at the terminal), the framing.
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel);
 
 }  // namespace rotafab::cli

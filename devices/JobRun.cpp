@@ -32,6 +32,15 @@ std::string JobRun::writeDryRun(const std::filesystem::path& file) const {
 }
 
 RunSummary JobRun::run(bool frame, const RunEvents& events, const core::Cancellation& cancel) {
+  try {
+    return runSheets(frame, events, cancel);
+  } catch (const DeviceFault&) {
+    if (events.stopped) events.stopped();
+    throw;
+  }
+}
+
+RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Cancellation& cancel) {
   RunSummary summary;
   for (size_t s = 0; s < toolpaths_.size(); ++s) {
     const jobs::Toolpath& toolpath = toolpaths_[s];

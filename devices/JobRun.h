@@ -42,6 +42,7 @@ struct RunEvents {
   std::function<void()> framing;
   std::function<void(const Progress&)> progress;
   std::function<void()> sheetFinished;
+  std::function<void()> stopped;  // by a fault or a cancel, before the fault is thrown
 };
 
 struct RunSummary {
@@ -76,6 +77,8 @@ class JobRun {
   void resume() { device_->resume(); }
 
  private:
+  RunSummary runSheets(bool frame, const RunEvents& events, const core::Cancellation& cancel);
+
   JobRunSetup setup_;
   std::unique_ptr<Device> device_;
   bool connected_ = false;

@@ -196,6 +196,16 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   job.seconds.writing = lap();
 }
 
+nlohmann::ordered_json summaryJson(const PlannedJob& job) {
+  const PhaseSeconds& s = job.seconds;
+  return {
+      {"panels", job.structure.panels.size()},
+      {"sheets", job.sheets.sheets.size()},
+      {"fasteners", job.structure.fasteners},
+      {"utilization", job.sheets.utilization},
+      {"seconds", {{"import", s.import}, {"geometry", s.geometry}, {"nesting", s.nesting}, {"writing", s.writing}}}};
+}
+
 PlannedJob makeJob(const MakeRequest& request, const std::filesystem::path& folder, const core::WorkContext& context) {
   PlannedJob job = planJob(request, context);
   writeJob(job, folder, context);

@@ -86,6 +86,10 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 // written, core::Cancelled.
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
+// SPEC's summary of a written job (`make --json`): {"panels", "sheets",
+// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "writing"}}.
+nlohmann::ordered_json summaryJson(const PlannedJob& job);
+
 // planJob() then writeJob().
 PlannedJob makeJob(const MakeRequest& request, const std::filesystem::path& folder, const core::WorkContext& context);
 

@@ -91,6 +91,12 @@ MachineProfile findMachine(const ProfileCatalogue& catalogue, const std::string&
                                  namesOf(catalogue.machines)));
 }
 
+std::optional<MachineProfile> firstMachineFor(const ProfileCatalogue& catalogue, std::string_view driver) {
+  for (const auto& machine : catalogue.machines)
+    if (machine.driver == driver) return machine;
+  return std::nullopt;
+}
+
 MaterialProfile findMaterial(const ProfileCatalogue& catalogue, const std::string& name) {
   for (const auto& material : catalogue.materials)
     if (material.name == name) return material;

@@ -94,4 +94,7 @@ ProfileCatalogue loadProfiles(const std::vector<std::filesystem::path>& searchPa
 MachineProfile findMachine(const ProfileCatalogue& catalogue, const std::string& name);
 MaterialProfile findMaterial(const ProfileCatalogue& catalogue, const std::string& name);
 
+// The first machine on the search path that the driver drives ("grbl", ...), or nothing.
+std::optional<MachineProfile> firstMachineFor(const ProfileCatalogue& catalogue, std::string_view driver);
+
 }  // namespace rotafab::profiles
