@@ -1,5 +1,5 @@
 #pragma once
-// A baseline for the bin-mode nesting benchmark (issue 3, item 8): the same
+// A baseline for the bin-mode nesting benchmark: the same
 // parts through Debian's libnest2d 5.0 (no-fit-polygon placer, first-fit
 // selection), so that our nester's sheet counts can be read against a public
 // library's. libnest2d's no-fit polygons are only correct for convex shapes,

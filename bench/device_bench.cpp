@@ -1,4 +1,4 @@
-// Issue 5, item 9: streaming G-code to the simulated GRBL over a pseudo-
+// Streaming G-code to the simulated GRBL over a pseudo-
 // terminal paced at 115200 baud (10 bits a byte: 11 520 bytes/s), each
 // reply reaching the driver `latency` after GRBL sends it (a USB serial
 // adapter's round trip), with the simulated machine far faster than the

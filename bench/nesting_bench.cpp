@@ -1,4 +1,4 @@
-// Bin-mode nesting benchmark (issue 3, item 8): 200 star-shaped vertex panels
+// Bin-mode nesting benchmark: 200 star-shaped vertex panels
 // and 100 wavy strips on the workshop bed (32 x 18 in, 1/4 in margins, 1/16 in
 // spacing). The vertex panels are shaped as the dissertation's vertex
 // components (V.1-V.2): a vertex band, a polygon with one side per edge of

@@ -1,5 +1,5 @@
 // Import + analysis + rotation system + face tracing on meshes from 1k to 200k
-// faces (issue 2's target: linear growth, 2x faces at most 2.2x time).
+// faces (the target: linear growth, 2x faces at most 2.2x time).
 //
 //   build/rotafab_bench                         run the benchmarks
 //   build/rotafab_bench write-mesh FACES FILE   write the benchmark's mesh of
@@ -110,7 +110,7 @@ void BM_RotationSystemAndTrace(benchmark::State& state) {
 }
 BENCHMARK(BM_RotationSystemAndTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
 
-// Issue 4, item 8: `make --structure band` up to the planner, import to
+// `make --structure band` up to the planner, import to
 // labelled panels: import, analysis, scale (mean edge 2 in), vertex bands,
 // developable bands, unfolding, holes, labels, flood fill. Target: linear,
 // under 5 s for 50k faces. (Nesting is measured by rotafab_nest_bench.)
@@ -140,7 +140,7 @@ BENCHMARK(BM_BandStructure)
     ->Unit(benchmark::kMillisecond)
     ->Complexity(benchmark::oN);
 
-// Issue 4, item 8, the whole pipeline: `rotafab make MESH --structure band
+// The whole pipeline: `rotafab make MESH --structure band
 // --layout rows --json`, the program itself, import to written sheets
 // (EPS, SVG, DXF), manifest.json, manifest.txt and structure.obj. The time
 // is import + geometry + writing as make reports them; the layout is left

@@ -16,11 +16,6 @@ struct Executor::Loop {
   std::mutex errorMutex;
   std::exception_ptr error;  // of failedAt
   int helpers = 0;           // pool threads working on it (guarded by the executor's mutex)
-
-  [[nodiscard]] bool exhausted() const {
-    const size_t n = next.load(std::memory_order_relaxed);
-    return n >= count || n > failedAt.load(std::memory_order_relaxed);
-  }
 };
 
 Executor::Executor(unsigned concurrency) {

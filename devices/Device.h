@@ -1,5 +1,5 @@
 #pragma once
-// The device abstraction (issue 5): one interface for every cutter, whatever
+// The device abstraction: one interface for every cutter, whatever
 // its wire protocol, as libsigrok has one for every logic analyser. A device
 // knows toolpaths (jobs/Toolpath.h), never meshes. Every call that waits on
 // the device has a timeout; a timeout, a disconnect, an error or alarm the

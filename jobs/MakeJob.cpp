@@ -167,7 +167,6 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   }
   job.seconds.nesting = lap();
-  job.folder.clear();
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;
   return job;

@@ -37,7 +37,7 @@ struct NestingPart {
   int order = 0;                                           // assembly order, 0-based
 };
 
-// How far the layout may move parts from their assembly order (issue 3, item 3).
+// How far the layout may move parts from their assembly order.
 enum class OrderMode {
   Strict,  // sheet k holds a contiguous run of the order
   Window,  // no part is cut more than `window` places before or after its order

@@ -1,5 +1,5 @@
 #pragma once
-// A flat part to be cut (issue 3, item 1): its outer contour, its inner cut
+// A flat part to be cut: its outer contour, its inner cut
 // contours (fastener holes), the open strokes to score and to etch (labels,
 // already single-stroke polylines), an assembly order, and the rotations the
 // nester may use. Design size, inches, in the part's own frame.

@@ -1,5 +1,5 @@
 #pragma once
-// The job planner (issue 3): from parts to laser-ready sheets. Kerf
+// The job planner: from parts to laser-ready sheets. Kerf
 // compensation, true-shape nesting on the machine's bed within its margins,
 // the cutting order on each sheet (etch, then score, then inner cuts, then
 // outer cuts: a part is cut free last, so nothing moves while it is worked

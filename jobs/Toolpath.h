@@ -1,5 +1,5 @@
 #pragma once
-// What a laser does with one sheet (issue 5): the strokes it burns, in order,
+// What a laser does with one sheet: the strokes it burns, in order,
 // each with its power, speed and pass, and the travel between them. Built from
 // the planner's sheet and the machine and material profiles:
 // - power, speed and passes per operation from the machine's colour table

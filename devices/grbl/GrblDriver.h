@@ -1,5 +1,5 @@
 #pragma once
-// GRBL 1.1 (and grblHAL) laser controllers, over serial or TCP (issue 5).
+// GRBL 1.1 (and grblHAL) laser controllers, over serial or TCP.
 // Connect: wait for the banner, read `$$` and `$I` (the receive buffer from
 // [OPT:...]), refuse to cut unless laser mode is on ($32=1). Run: the job's
 // G-code (jobs/GCode.h) streamed by character counting against the receive

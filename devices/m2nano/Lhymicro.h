@@ -1,7 +1,7 @@
 #pragma once
 // LHYMICRO-GL, the command language of the Lihuiyu M2 Nano board (K40
 // lasers), as MeerK40t, K40 Whisperer and LibLaserCut speak it (learnt from
-// them, written anew; issue 5): distances in mils (1/1000 in) as letters and
+// them, written anew): distances in mils (1/1000 in) as letters and
 // digits, direction letters, laser on (D) and off (U), speed codes, and the
 // 30-byte packets with their CRC-8 that go over USB. The board has no power
 // control (the machine's dial sets it): speed and passes are what it varies.

@@ -1,5 +1,5 @@
 #pragma once
-// The Lihuiyu M2 Nano board (K40 lasers) over USB (issue 5). The board sits
+// The Lihuiyu M2 Nano board (K40 lasers) over USB. The board sits
 // behind a CH341 bridge in parallel mode (1a86:5512): the driver initialises
 // it with one control transfer, sends each 30-byte LHYMICRO-GL packet
 // (Lhymicro.h) as a 34-byte bulk transfer, and after each one asks for the

@@ -1,5 +1,5 @@
 #pragma once
-// A simulated GRBL 1.1 laser controller on a pseudo-terminal (issue 5): the
+// A simulated GRBL 1.1 laser controller on a pseudo-terminal: the
 // driver opens its /dev/pts/N as it would /dev/ttyUSB0, so the real serial
 // code runs. It behaves as GRBL does where a driver can tell: the banner,
 // `$$`, `$I` ([OPT:V,15,128]), a 127-byte receive buffer that loses what

@@ -1,5 +1,5 @@
 #pragma once
-// A simulated Lihuiyu M2 Nano (K40) on USB (issue 5), plugged into libusb
+// A simulated Lihuiyu M2 Nano (K40) on USB, plugged into libusb
 // through umockdev: a testbed device 1a86:5512 (the CH341 bridge in
 // parallel mode) whose usbfs requests (claim, control and bulk transfers,
 // reaping, discarding) this simulator answers, so that the real libusb code

@@ -1,5 +1,5 @@
 #pragma once
-// The spool "driver" (`spool:DIR[?printer=NAME]`, issue 5): for cutters
+// The spool "driver" (`spool:DIR[?printer=NAME]`): for cutters
 // driven through a print driver, as the dissertation's workshop cutter was.
 // Each sheet's toolpath becomes an EPS file in DIR, drawn in the machine's
 // colours (the print driver maps colours to power, speed and passes, fig. 65),

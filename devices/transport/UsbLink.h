@@ -1,5 +1,5 @@
 #pragma once
-// A USB device on libusb-1.0 (issue 5): the M2 Nano's CH341 bridge, or
+// A USB device on libusb-1.0: the M2 Nano's CH341 bridge, or
 // anything else that talks in control and bulk transfers. Every transfer has
 // a timeout. Errors become DeviceFaults: the device gone (unplugged) is
 // Disconnected, a transfer that does not finish in time is Timeout, no

@@ -4,7 +4,7 @@
 // them: the no-fit polygon of two concave shapes is the union of the sums of
 // their convex pieces, and each such sum takes time linear in the pieces'
 // sizes, where Clipper's MinkowskiSum unions one quadrilateral per pair of
-// edges (issue 3: 200 star panels took minutes that way).
+// edges (200 star panels took minutes that way).
 
 #include <clipper.hpp>
 
