@@ -3,7 +3,8 @@
 // test. The one who may stop the work holds a Cancellation and calls cancel()
 // from any thread; the work is handed it by reference (WorkContext) and
 // checks it in every long loop, often enough to stop within 100 ms. Checking
-// costs one relaxed atomic load.
+// costs one atomic load; what was written before the cancel (why it was
+// cancelled) is seen by the one who sees the cancel.
 
 #include <atomic>
 #include <stdexcept>
@@ -23,8 +24,8 @@ class Cancellation {
   Cancellation(const Cancellation&) = delete;
   Cancellation& operator=(const Cancellation&) = delete;
 
-  void cancel() noexcept { cancelled_.store(true, std::memory_order_relaxed); }
-  [[nodiscard]] bool cancelled() const noexcept { return cancelled_.load(std::memory_order_relaxed); }
+  void cancel() noexcept { cancelled_.store(true, std::memory_order_release); }
+  [[nodiscard]] bool cancelled() const noexcept { return cancelled_.load(std::memory_order_acquire); }
   // Throws Cancelled once cancel() has been called.
   void check() const {
     if (cancelled()) throw Cancelled();

@@ -19,17 +19,26 @@ struct Executor::Loop {
 };
 
 Executor::Executor(unsigned concurrency) {
-  for (unsigned i = 1; i < std::max(1u, concurrency); ++i) threads_.emplace_back([this] { work(); });
+  try {
+    for (unsigned i = 1; i < std::max(1u, concurrency); ++i) threads_.emplace_back([this] { work(); });
+  } catch (...) {
+    // No more threads to be had: let the ones started go, and say so.
+    stopAll();
+    throw;
+  }
 }
 
-Executor::~Executor() {
+void Executor::stopAll() noexcept {
   {
     const std::lock_guard lock(mutex_);
     stopping_ = true;
   }
   wake_.notify_all();
   for (std::thread& thread : threads_) thread.join();
+  threads_.clear();
 }
+
+Executor::~Executor() { stopAll(); }
 
 void Executor::runIndices(Loop& loop) {
   for (;;) {

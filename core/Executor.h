@@ -20,7 +20,8 @@ namespace rotafab::core {
 class Executor {
  public:
   // `concurrency`: how many indices run at once, the calling thread's
-  // included (at least 1); the pool starts concurrency - 1 threads.
+  // included (at least 1); the pool starts concurrency - 1 threads (throws
+  // std::system_error when the system has no more to give).
   explicit Executor(unsigned concurrency);
   ~Executor();  // waits for the threads; no loop may be running
   Executor(const Executor&) = delete;
@@ -39,6 +40,7 @@ class Executor {
  private:
   struct Loop;
   void work();
+  void stopAll() noexcept;
   static void runIndices(Loop& loop);
 
   std::vector<std::thread> threads_;

@@ -25,7 +25,7 @@ class MessageLines : public spdlog::sinks::base_sink<std::mutex> {
 
 }  // namespace
 
-CommandContext::CommandContext(core::ProgressSink progress, unsigned threads) {
+CommandContext::CommandContext(core::ProgressSink progress, unsigned threads, SecondSignal second) : second_(second) {
   sigemptyset(&blocked_);
   sigaddset(&blocked_, SIGINT);
   sigaddset(&blocked_, SIGTERM);
@@ -35,10 +35,15 @@ CommandContext::CommandContext(core::ProgressSink progress, unsigned threads) {
     const timespec tick{0, 50'000'000};  // how soon a stopping context is noticed
     while (!stopping_) {
       const int got = sigtimedwait(&blocked_, nullptr, &tick);
-      if (got == SIGINT || got == SIGTERM) {
-        signal_ = got;
-        cancellation_.cancel();
+      if (got != SIGINT && got != SIGTERM) continue;
+      if (signal_ != 0 && second_ == SecondSignal::Ends) {
+        // Asked twice: go now, as the signal would have ended it.
+        std::signal(got, SIG_DFL);
+        pthread_sigmask(SIG_UNBLOCK, &blocked_, nullptr);
+        std::raise(got);
       }
+      if (signal_ == 0) signal_ = got;
+      cancellation_.cancel();
     }
   });
   executor_ =
@@ -53,6 +58,11 @@ CommandContext::~CommandContext() {
   executor_.reset();
   stopping_ = true;
   watcher_.join();
+  // A signal that came once the watcher was done is the command's, not a
+  // reason to end the program now that it is done.
+  const timespec none{0, 0};
+  while (sigtimedwait(&blocked_, nullptr, &none) > 0) {
+  }
   pthread_sigmask(SIG_SETMASK, &previous_, nullptr);
 }
 

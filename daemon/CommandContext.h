@@ -6,7 +6,9 @@
 // thread of the program from the moment this is made, and one thread of its
 // own waits for them, so no handler and no global flag is involved, and a
 // signal reaches the command even when the shell started it in the
-// background (where SIGINT would be ignored).
+// background (where SIGINT would be ignored). A second signal ends a
+// command that allows it at once (`make`, `nest`: nothing is cut there);
+// `run` never, as it must wait for the machine to stop.
 
 #include <atomic>
 #include <csignal>
@@ -20,7 +22,9 @@ namespace rotafab::cli {
 class CommandContext {
  public:
   // `threads`: the executor's size; 0: one per core.
-  explicit CommandContext(core::ProgressSink progress = {}, unsigned threads = 0);
+  enum class SecondSignal { Ends, Waits };
+  explicit CommandContext(core::ProgressSink progress = {}, unsigned threads = 0,
+                          SecondSignal second = SecondSignal::Ends);
   ~CommandContext();
   CommandContext(const CommandContext&) = delete;
   CommandContext& operator=(const CommandContext&) = delete;
@@ -34,6 +38,7 @@ class CommandContext {
 
  private:
   sigset_t blocked_{}, previous_{};
+  SecondSignal second_;
   core::Cancellation cancellation_;
   std::atomic<int> signal_{0};
   std::atomic<bool> stopping_{false};

@@ -65,7 +65,7 @@ int runRun(const RunOptions& options) {
   return reportingErrors(options.target, [&]() -> int {
     try {
       // Ctrl-C and SIGTERM cancel the job from here on (before any device, a simulator's thread, starts).
-      CommandContext command;
+      CommandContext command({}, 0, CommandContext::SecondSignal::Waits);
       devices::JobRunSetup setup;
       try {
         setup.device = devices::parseDeviceUri(options.device);
@@ -80,6 +80,7 @@ int runRun(const RunOptions& options) {
       jobs::checkSheetsFitBed(sheets, setup.machine);
       for (const jobs::JobSheet& sheet : sheets) setup.sheets.push_back(sheet.drawing);
       setup.dryRun = options.dryRun;
+      setup.cancellation = &command.cancellation();
       setup.connected = [&](const std::string& identity) {
         fmt::print(stderr, "run: {}: {}\n", options.device, identity);
       };
@@ -100,6 +101,10 @@ int runRun(const RunOptions& options) {
         // One file of several sheets would be cut back to back, onto one sheet.
         throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
                                     job->toolpaths().size()));
+      }
+      if (command.cancellation().cancelled()) {
+        fmt::print(stderr, "run: stopped; nothing was written\n");
+        return command.interruptedStatus();
       }
       fmt::print("{}: {}\n", options.out, job->writeDryRun(options.out));
       return kSuccess;

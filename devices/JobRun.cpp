@@ -18,7 +18,15 @@ JobRun::JobRun(JobRunSetup setup) : setup_(std::move(setup)) {
   }
   const jobs::MotionLimits limits = device_->motionLimits();
   for (const jobs::SheetDrawing& sheet : setup_.sheets) {
+    throwIfCancelled(setup_.cancellation);
     toolpaths_.push_back(jobs::planToolpath(sheet, setup_.machine, setup_.material, limits));
+  }
+  throwIfCancelled(setup_.cancellation);
+}
+
+void JobRun::throwIfCancelled(const core::Cancellation* cancel) const {
+  if (cancel && cancel->cancelled()) {
+    throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
   }
 }
 
@@ -46,13 +54,13 @@ RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Ca
     const jobs::Toolpath& toolpath = toolpaths_[s];
     // Stop, do not cut blind, unless the next sheet is known to be loaded.
     const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
-    if (!loaded || cancel.cancelled()) {
-      throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
-    }
+    if (!loaded) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
+    throwIfCancelled(&cancel);
     if (events.sheetStarted) events.sheetStarted(s, toolpath);
     if (frame) {
       if (events.framing) events.framing();
       device_->frame(toolpath);
+      throwIfCancelled(&cancel);  // a cancel while framing: the laser was never lit
     }
     device_->run(
         toolpath, events.progress ? events.progress : [](const Progress&) {}, cancel);

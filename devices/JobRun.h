@@ -31,6 +31,9 @@ struct JobRunSetup {
   bool dryRun = false;
   // Told what the controller says it is, once connected.
   std::function<void(const std::string& identity)> connected;
+  // Checked once connected and for each sheet planned: JobRun() then throws
+  // DeviceFault Cancelled (the device is disconnected; nothing was sent).
+  const core::Cancellation* cancellation = nullptr;
 };
 
 struct RunEvents {
@@ -78,6 +81,7 @@ class JobRun {
 
  private:
   RunSummary runSheets(bool frame, const RunEvents& events, const core::Cancellation& cancel);
+  void throwIfCancelled(const core::Cancellation* cancel) const;
 
   JobRunSetup setup_;
   std::unique_ptr<Device> device_;

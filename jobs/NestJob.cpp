@@ -41,7 +41,7 @@ NestedInstance nestInstance(const NestRequest& request, const core::WorkContext&
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   }
-  const auto problems = layoutProblems(parts, nested.result, options);
+  const auto problems = layoutProblems(parts, nested.result, options, 1e-3, &context.cancellation());
   // Never seen: every placement is checked as it is made; said as the command line has always said it.
   if (!problems.empty()) throw core::UserError("internal: the layout failed its own check: " + problems.front());
   const NestingResult& result = nested.result;

@@ -75,9 +75,15 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
 }
 
 std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,
-                                        const NestingOptions& options, double tolerance) {
+                                        const NestingOptions& options, double tolerance,
+                                        const core::Cancellation* cancellation) {
   std::vector<std::string> problems;
-  std::map<int, std::vector<std::pair<int, Path>>> bySheet;
+  struct Checked {
+    int part;
+    Path path;
+    Box box;
+  };
+  std::map<int, std::vector<Checked>> bySheet;
   const double reach = std::max(0.0, (options.spacing - tolerance) / 2);
   for (const auto& placement : result.placements) {
     const Polygon2 outline = placedOutline(parts[placement.part], placement);
@@ -92,22 +98,28 @@ std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, c
     }
     Path path = toPath(outline);
     if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
-    bySheet[placement.sheet].emplace_back(placement.part, reach > 0 ? grown(path, reach, ClipperLib::jtRound) : path);
+    if (reach > 0) path = grown(path, reach, ClipperLib::jtRound);
+    const Box box = boxOf(path);
+    bySheet[placement.sheet].push_back({placement.part, std::move(path), box});
   }
   for (const auto& [sheet, shapes] : bySheet) {
     for (size_t a = 0; a < shapes.size(); ++a) {
+      if (cancellation) cancellation->check();
       for (size_t b = a + 1; b < shapes.size(); ++b) {
+        // Shapes whose boxes are apart have nothing in common.
+        const Box &boxA = shapes[a].box, &boxB = shapes[b].box;
+        if (boxA[2] <= boxB[0] || boxB[2] <= boxA[0] || boxA[3] <= boxB[1] || boxB[3] <= boxA[1]) continue;
         ClipperLib::Clipper clipper;
-        clipper.AddPath(shapes[a].second, ClipperLib::ptSubject, true);
-        clipper.AddPath(shapes[b].second, ClipperLib::ptClip, true);
+        clipper.AddPath(shapes[a].path, ClipperLib::ptSubject, true);
+        clipper.AddPath(shapes[b].path, ClipperLib::ptClip, true);
         Paths common;
         clipper.Execute(ClipperLib::ctIntersection, common, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
         double area = 0;
         for (const Path& p : common) area += std::abs(ClipperLib::Area(p));
         if (area > 1.0) {  // more than 1e-8 square inches
           problems.push_back(fmt::format("sheet {}: {} and {} overlap or are nearer than {} ({:.3g} sq in in common)",
-                                         sheet, parts[shapes[a].first].name, parts[shapes[b].first].name,
-                                         options.spacing, area / (kScale * kScale)));
+                                         sheet, parts[shapes[a].part].name, parts[shapes[b].part].name, options.spacing,
+                                         area / (kScale * kScale)));
         }
       }
     }

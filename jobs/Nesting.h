@@ -92,9 +92,11 @@ void checkNestingParts(const std::vector<NestingPart>& parts);
 Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement);
 
 // Exact check of a layout: every outline inside the area, no two outlines on a
-// sheet overlapping or nearer than `spacing - tolerance`. One line per problem.
+// sheet overlapping or nearer than `spacing - tolerance`. One line per
+// problem. Throws core::Cancelled when `cancellation` is given and set.
 std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,
-                                        const NestingOptions& options, double tolerance = 1e-3);
+                                        const NestingOptions& options, double tolerance = 1e-3,
+                                        const core::Cancellation* cancellation = nullptr);
 
 double polygonArea(const Polygon2& polygon);
 

@@ -16,24 +16,36 @@ std::atomic<unsigned> stagings{0};
 
 OutputFolder::OutputFolder(std::filesystem::path target) : target_(std::move(target)) {
   if (target_.filename().empty()) target_ = target_.parent_path();  // "dir/"
-  for (std::filesystem::path p = target_; !p.empty() && !std::filesystem::exists(p); p = p.parent_path()) {
+  // The folders to make, outermost last, on the path as it really runs ("a/../b" is b).
+  const auto full = std::filesystem::absolute(target_).lexically_normal();
+  for (std::filesystem::path p = full; !p.empty() && !std::filesystem::exists(p); p = p.parent_path()) {
     created_ = p;
     if (p == p.parent_path()) break;
   }
-  std::filesystem::create_directories(target_);
-  staging_ = target_ / fmt::format(".rotafab-partial-{}-{}", ::getpid(), stagings++);
-  std::filesystem::remove_all(staging_);
-  std::filesystem::create_directories(staging_);
+  try {
+    std::filesystem::create_directories(target_);
+    staging_ = target_ / fmt::format(".rotafab-partial-{}-{}", ::getpid(), stagings++);
+    std::filesystem::remove_all(staging_);
+    std::filesystem::create_directories(staging_);
+  } catch (...) {
+    removeCreated();
+    throw;
+  }
+}
+
+void OutputFolder::removeCreated() noexcept {
+  if (created_.empty()) return;
+  // Up from the target to the outermost folder made for it, each only if empty.
+  std::error_code ignored;
+  for (auto p = std::filesystem::absolute(target_, ignored).lexically_normal();; p = p.parent_path()) {
+    if (!std::filesystem::remove(p, ignored) || p == created_ || p == p.parent_path()) break;
+  }
 }
 
 OutputFolder::~OutputFolder() {
   std::error_code ignored;
-  std::filesystem::remove_all(staging_, ignored);
-  if (committed_ || created_.empty()) return;
-  // Up from the target to the outermost folder made for it, each only if empty.
-  for (std::filesystem::path p = target_;; p = p.parent_path()) {
-    if (!std::filesystem::remove(p, ignored) || p == created_ || p == p.parent_path()) break;
-  }
+  if (!staging_.empty()) std::filesystem::remove_all(staging_, ignored);
+  if (!committed_) removeCreated();
 }
 
 void OutputFolder::commit(const std::string& last, const std::function<bool(const std::string&)>& ours) {

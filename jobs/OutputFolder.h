@@ -36,6 +36,8 @@ class OutputFolder {
   void commit(const std::string& last, const std::function<bool(const std::string&)>& ours);
 
  private:
+  void removeCreated() noexcept;
+
   std::filesystem::path target_, staging_;
   std::filesystem::path created_;  // the outermost folder this made, or empty
   bool committed_ = false;

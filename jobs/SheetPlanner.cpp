@@ -24,7 +24,10 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   const profiles::Bed& bed = machine.bed;
   std::vector<Part> cut;
   cut.reserve(parts.size());
-  for (const Part& part : parts) cut.push_back(compensateKerf(part, options.kerf));
+  for (const Part& part : parts) {
+    context.check();
+    cut.push_back(compensateKerf(part, options.kerf));
+  }
 
   std::vector<NestingPart> nestingParts;
   for (const Part& part : cut) nestingParts.push_back({part.name, part.outline, part.rotations, part.order});
@@ -94,7 +97,9 @@ std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const s
     const SheetDrawing& sheet = plan.sheets[s];
     const std::string stem = fmt::format("sheet-{:03}", sheet.index);
     writeFileAtomically(folder / (stem + ".eps"), [&](std::ostream& out) { writeEps(sheet, out); });
+    context.check();
     writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
+    context.check();
     writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
     files[s] = {stem + ".eps", stem + ".svg", stem + ".dxf"};
   });

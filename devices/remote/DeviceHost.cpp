@@ -1,5 +1,6 @@
 #include "devices/remote/DeviceHost.h"
 
+#include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <memory>
@@ -12,6 +13,8 @@
 namespace rotafab::devices::remote {
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
 // What the reader hands the worker: the requests in order, and the end of the input.
 struct Requests {
   std::mutex mutex;
@@ -20,10 +23,43 @@ struct Requests {
   bool ended = false;
 };
 
-std::string reply(const nlohmann::json& fields) {
-  nlohmann::json out = fields;
-  out["ok"] = true;
-  return out.dump();
+// The runs: the one going on (its id and cancellation), and the highest id
+// cancelled so far, so that a cancel that comes before its run has started
+// (or while it waits its turn) still stops it.
+struct Runs {
+  std::mutex mutex;
+  long current = -1;
+  std::shared_ptr<core::Cancellation> cancel;
+  long cancelledUpTo = -1;
+  bool inputEnded = false;
+
+  void cancelRun(long id) {
+    const std::lock_guard lock(mutex);
+    cancelledUpTo = std::max(cancelledUpTo, id);
+    if (cancel && current <= cancelledUpTo) cancel->cancel();
+  }
+  void endInput() {
+    const std::lock_guard lock(mutex);
+    inputEnded = true;
+    if (cancel) cancel->cancel();
+  }
+  std::shared_ptr<core::Cancellation> start(long id) {
+    const std::lock_guard lock(mutex);
+    current = id;
+    cancel = std::make_shared<core::Cancellation>();
+    if (inputEnded || id <= cancelledUpTo) cancel->cancel();
+    return cancel;
+  }
+  void finish() {
+    const std::lock_guard lock(mutex);
+    cancel.reset();
+  }
+};
+
+nlohmann::json reply(long id, nlohmann::json fields = nlohmann::json::object()) {
+  fields["ok"] = true;
+  fields["id"] = id;
+  return fields;
 }
 
 }  // namespace
@@ -31,26 +67,29 @@ std::string reply(const nlohmann::json& fields) {
 void serveDevice(Device& device, int input, int output) {
   LinePipe pipe(input, output, false);
   Requests requests;
-  // The cancellation of the run going on, each run its own.
-  std::mutex runMutex;
-  std::shared_ptr<core::Cancellation> running;
-  bool inputEnded = false;
-  const auto cancelRun = [&] {
-    const std::lock_guard lock(runMutex);
-    if (running) running->cancel();
-  };
+  Runs runs;
+  std::atomic<long> busy{-1};  // the request being served, for the heartbeat
   // The reader: pause, resume and cancel act at once (the driver takes them
-  // between its reads); everything else waits its turn.
+  // between its reads); everything else waits its turn. While a request is
+  // served it says so every second, so that a hung helper is told from a
+  // slow job.
   std::thread reader([&] {
     std::string line;
+    auto lastWord = Clock::now();
     for (;;) {
-      const LinePipe::Read read = pipe.readLine(line, std::chrono::milliseconds(1000));
-      if (read == LinePipe::Read::Timeout) continue;
+      const LinePipe::Read read = pipe.readLine(line, std::chrono::milliseconds(250));
       if (read == LinePipe::Read::End) break;
+      if (const long id = busy; id >= 0 && Clock::now() - lastWord > std::chrono::seconds(1)) {
+        pipe.writeLine(nlohmann::json{{"alive", true}, {"id", id}}.dump());
+        lastWord = Clock::now();
+      }
+      if (read == LinePipe::Read::Timeout) continue;
       nlohmann::json request;
       try {
         request = nlohmann::json::parse(line);
       } catch (const nlohmann::json::exception&) {
+      }
+      if (!request.is_object() || !request.contains("id") || !request.at("id").is_number_integer()) {
         pipe.writeLine(nlohmann::json{{"error", "not a request: " + line}}.dump());
         continue;
       }
@@ -60,19 +99,14 @@ void serveDevice(Device& device, int input, int output) {
       } else if (op == "resume") {
         device.resume();
       } else if (op == "cancel") {
-        cancelRun();
+        runs.cancelRun(request.at("id").get<long>());
       } else {
         const std::lock_guard lock(requests.mutex);
         requests.queue.push_back(std::move(request));
         requests.arrived.notify_one();
       }
     }
-    {
-      // Nobody is left to see the job: stop it safely.
-      const std::lock_guard lock(runMutex);
-      inputEnded = true;
-      if (running) running->cancel();
-    }
+    runs.endInput();  // nobody is left to see the job: stop it safely
     const std::lock_guard lock(requests.mutex);
     requests.ended = true;
     requests.arrived.notify_one();
@@ -87,52 +121,46 @@ void serveDevice(Device& device, int input, int output) {
       requests.queue.pop_front();
     }
     const std::string op = request.value("op", "");
+    const long id = request.at("id").get<long>();
+    busy = id;
     try {
       if (op == "connect") {
-        pipe.writeLine(reply({{"identity", device.connect()}}));
+        pipe.writeLine(reply(id, {{"identity", device.connect()}}).dump());
       } else if (op == "home") {
         device.home();
-        pipe.writeLine(reply({}));
+        pipe.writeLine(reply(id).dump());
       } else if (op == "frame") {
         device.frame(toolpathOf(request.at("toolpath")));
-        pipe.writeLine(reply({}));
+        pipe.writeLine(reply(id).dump());
       } else if (op == "run") {
         const jobs::Toolpath toolpath = toolpathOf(request.at("toolpath"));
-        const auto cancel = std::make_shared<core::Cancellation>();
-        {
-          const std::lock_guard lock(runMutex);
-          running = cancel;
-          if (inputEnded) cancel->cancel();
-        }
+        const auto cancel = runs.start(id);
         struct Finished {
-          std::mutex& mutex;
-          std::shared_ptr<core::Cancellation>& running;
-          ~Finished() {
-            const std::lock_guard lock(mutex);
-            running.reset();
-          }
-        } finished{runMutex, running};
+          Runs& runs;
+          ~Finished() { runs.finish(); }
+        } finished{runs};
         device.run(
             toolpath,
             [&](const Progress& p) {
-              pipe.writeLine(nlohmann::json{{"progress", toJson(p)}}.dump());
+              pipe.writeLine(nlohmann::json{{"progress", toJson(p)}, {"id", id}}.dump());
             },
             *cancel);
-        pipe.writeLine(reply({}));
+        pipe.writeLine(reply(id).dump());
       } else if (op == "status") {
         const DeviceStatus status = device.status();
-        pipe.writeLine(reply({{"status", {{"state", status.state}, {"x", status.x}, {"y", status.y}}}}));
+        pipe.writeLine(reply(id, {{"status", {{"state", status.state}, {"x", status.x}, {"y", status.y}}}}).dump());
       } else if (op == "disconnect") {
         device.disconnect();
-        pipe.writeLine(reply({}));
+        pipe.writeLine(reply(id).dump());
       } else {
-        pipe.writeLine(nlohmann::json{{"error", "no such request: " + op}}.dump());
+        pipe.writeLine(nlohmann::json{{"error", "no such request: " + op}, {"id", id}}.dump());
       }
     } catch (const DeviceFault& fault) {
-      pipe.writeLine(nlohmann::json{{"fault", toJson(fault)}}.dump());
+      pipe.writeLine(nlohmann::json{{"fault", toJson(fault)}, {"id", id}}.dump());
     } catch (const std::exception& error) {
-      pipe.writeLine(nlohmann::json{{"error", error.what()}}.dump());
+      pipe.writeLine(nlohmann::json{{"error", error.what()}, {"id", id}}.dump());
     }
+    busy = -1;
   }
   reader.join();
   device.disconnect();
@@ -144,7 +172,14 @@ void serveError(const std::string& error, int input, int output) {
   for (;;) {
     const LinePipe::Read read = pipe.readLine(line, std::chrono::milliseconds(1000));
     if (read == LinePipe::Read::End) return;
-    if (read == LinePipe::Read::Line) pipe.writeLine(nlohmann::json{{"error", error}}.dump());
+    if (read != LinePipe::Read::Line) continue;
+    nlohmann::json answer{{"error", error}};
+    try {
+      const auto request = nlohmann::json::parse(line);
+      if (request.is_object() && request.contains("id")) answer["id"] = request.at("id");
+    } catch (const nlohmann::json::exception&) {
+    }
+    pipe.writeLine(answer.dump());
   }
 }
 

@@ -46,8 +46,7 @@ bool LinePipe::writeLine(const std::string& line) {
   size_t written = 0;
   while (written < bytes.size()) {
     // A socket (as the helper's is): no SIGPIPE when the other side is gone.
-    ssize_t n = ::send(write_, bytes.data() + written, bytes.size() - written, MSG_NOSIGNAL);
-    if (n < 0 && errno == ENOTSOCK) n = ::write(write_, bytes.data() + written, bytes.size() - written);
+    const ssize_t n = ::send(write_, bytes.data() + written, bytes.size() - written, MSG_NOSIGNAL);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) return false;
     written += static_cast<size_t>(n);

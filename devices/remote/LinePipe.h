@@ -1,7 +1,7 @@
 #pragma once
-// Lines over a socket or a pair of pipes (a helper process's standard input
-// and output): reads with a timeout, writes whole lines from any thread,
-// never a SIGPIPE on a socket whose other side is gone.
+// Lines over a socket (a helper process's standard input and output): reads
+// with a timeout, writes whole lines from any thread, never a SIGPIPE when
+// the other side is gone.
 
 #include <chrono>
 #include <mutex>
@@ -12,7 +12,8 @@ namespace rotafab::devices::remote {
 
 class LinePipe {
  public:
-  // Takes the two descriptors (closed by the destructor unless `own` is false).
+  // Takes the two descriptors of a socket, to read from and to write to
+  // (closed by the destructor unless `own` is false).
   LinePipe(int readFd, int writeFd, bool own = true);
   ~LinePipe();
   LinePipe(const LinePipe&) = delete;

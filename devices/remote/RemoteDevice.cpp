@@ -7,6 +7,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fcntl.h>
+
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -41,7 +43,7 @@ void RemoteDevice::start() {
   std::vector<char*> args;
   for (std::string& arg : argv_) args.push_back(arg.data());
   args.push_back(nullptr);
-  const int spawned = ::posix_spawn(&child_, argv_[0].c_str(), &actions, nullptr, args.data(), environ);
+  const int spawned = ::posix_spawnp(&child_, argv_[0].c_str(), &actions, nullptr, args.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   ::close(sockets[1]);
   if (spawned != 0) {
@@ -50,12 +52,15 @@ void RemoteDevice::start() {
     throw DeviceFault(FaultKind::Disconnected,
                       fmt::format("{}: cannot start it: {}", argv_[0], std::strerror(spawned)));
   }
-  pipe_ = std::make_unique<LinePipe>(sockets[0], ::dup(sockets[0]));
+  // Both ends close-on-exec: a later child (another helper, lp) must not
+  // hold the socket open, or this helper would never see its input end.
+  pipe_ = std::make_unique<LinePipe>(sockets[0], ::fcntl(sockets[0], F_DUPFD_CLOEXEC, 0));
+  heardFromHelper_ = false;
 }
 
 void RemoteDevice::stop() noexcept {
   if (child_ < 0) return;
-  pipe_.reset();  // the helper's input ends: it disconnects and goes
+  pipe_.reset();  // the helper's input ends: it stops a run safely, disconnects and goes
   const auto deadline = Clock::now() + timeouts_.exit;
   int status = 0;
   while (::waitpid(child_, &status, WNOHANG) == 0) {
@@ -69,37 +74,54 @@ void RemoteDevice::stop() noexcept {
   child_ = -1;
 }
 
-nlohmann::json RemoteDevice::call(const nlohmann::json& request, std::chrono::milliseconds timeout,
+nlohmann::json RemoteDevice::call(nlohmann::json request, std::chrono::milliseconds timeout,
                                   const std::function<void(const Progress&)>& progress,
                                   const core::Cancellation* cancel) {
-  const std::string name = argv_[0];
-  const auto gone = [&] {
-    DeviceFault fault(FaultKind::Disconnected, fmt::format("{}: the helper ended", name));
-    fault.laserOffConfirmed = false;
-    return fault;
+  const std::string name = argv_[0], op = request.value("op", "a request");
+  const long id = ++nextId_;
+  request["id"] = id;
+  // Something went wrong on this side: the helper is ended (a run in it
+  // stops), and nobody can say the laser is off.
+  const auto abandon = [&](FaultKind kind, const std::string& what) {
+    stop();
+    return DeviceFault(kind, fmt::format("{}: {}", name, what));
   };
-  if (!pipe_ || !pipe_->writeLine(request.dump())) throw gone();
+  if (!pipe_ || !pipe_->writeLine(request.dump())) throw abandon(FaultKind::Disconnected, "the helper ended");
   auto deadline = Clock::now() + timeout;
+  auto heard = Clock::now();
   bool cancelSent = false;
   std::string line;
   for (;;) {
     if (cancel && cancel->cancelled() && !cancelSent) {
       // The helper's driver stops the machine and answers with its fault.
-      pipe_->writeLine(nlohmann::json{{"op", "cancel"}}.dump());
+      pipe_->writeLine(nlohmann::json{{"op", "cancel"}, {"id", id}}.dump());
       cancelSent = true;
       deadline = Clock::now() + timeouts_.stop;
+      timeout = timeouts_.stop;
     }
-    if (Clock::now() > deadline) {
-      throw DeviceFault(FaultKind::Timeout,
-                        fmt::format("{}: no answer to {} within {} ms", name, request.value("op", "a request"),
-                                    std::chrono::duration_cast<std::chrono::milliseconds>(timeout).count()));
+    const auto now = Clock::now();
+    if (now > deadline) {
+      throw abandon(FaultKind::Timeout, fmt::format("no answer to {} within {} ms", op, timeout.count()));
+    }
+    // (Until the helper has said a word, it may still be starting: the request's timeout alone counts.)
+    if (heardFromHelper_ && now - heard > timeouts_.silence) {
+      throw abandon(FaultKind::Timeout, fmt::format("no word from the helper for {} ms", timeouts_.silence.count()));
     }
     const LinePipe::Read read = pipe_->readLine(line, kTick);
     if (read == LinePipe::Read::Timeout) continue;
-    if (read == LinePipe::Read::End) throw gone();
+    if (read == LinePipe::Read::End) throw abandon(FaultKind::Disconnected, "the helper ended");
+    heard = Clock::now();
+    heardFromHelper_ = true;
     nlohmann::json answer;
     try {
       answer = nlohmann::json::parse(line);
+    } catch (const nlohmann::json::exception&) {
+    }
+    if (!answer.is_object() || !answer.contains("id")) {
+      throw abandon(FaultKind::Protocol, "an answer no helper gives: " + line);
+    }
+    if (answer.at("id") != id || answer.contains("alive")) continue;  // a late word for an earlier request
+    try {
       if (answer.contains("progress")) {
         if (progress) progress(progressOf(answer.at("progress")));
         continue;
@@ -110,8 +132,12 @@ nlohmann::json RemoteDevice::call(const nlohmann::json& request, std::chrono::mi
       }
       if (answer.value("ok", false)) return answer;
     } catch (const nlohmann::json::exception&) {
+    } catch (const DeviceFault&) {
+      throw;  // the helper's own word: its driver has done what it could
+    } catch (const std::exception& error) {
+      throw abandon(FaultKind::Protocol, error.what());  // the progress callback
     }
-    throw DeviceFault(FaultKind::Protocol, fmt::format("{}: an answer no helper gives: {}", name, line));
+    throw abandon(FaultKind::Protocol, "an answer no helper gives: " + line);
   }
 }
 

@@ -25,6 +25,9 @@ struct RemoteTimeouts {
   std::chrono::milliseconds request{30000};  // for the reply to a request
   std::chrono::milliseconds home{180000};    // to home or frame
   std::chrono::milliseconds stop{60000};     // after a cancel, for the run to end
+  // With no word at all from the helper this long (it says it is alive every
+  // second while it serves a request), it is taken for hung.
+  std::chrono::milliseconds silence{10000};
   // After its input ends, for the helper to end (it stops a run safely
   // first, which can take a board's home); then it is killed.
   std::chrono::milliseconds exit{60000};
@@ -48,10 +51,15 @@ class RemoteDevice : public Device {
 
  private:
   void start();
+  // Ends the helper: its input closed (it stops a run safely and goes), then
+  // killed if it lingers past the exit timeout. Never throws.
   void stop() noexcept;
   // Sends a request and waits for its reply (progress goes to `progress`);
-  // a fault is thrown as the DeviceFault it was, anything else as one.
-  nlohmann::json call(const nlohmann::json& request, std::chrono::milliseconds timeout,
+  // a fault the helper reports is thrown as the DeviceFault it was. Anything
+  // else that goes wrong here (no answer, a garbled one, a progress callback
+  // that throws) ends the helper first, so that a job in it stops, and is
+  // thrown as a DeviceFault whose laser-off is not confirmed.
+  nlohmann::json call(nlohmann::json request, std::chrono::milliseconds timeout,
                       const std::function<void(const Progress&)>& progress = {},
                       const core::Cancellation* cancel = nullptr);
 
@@ -59,6 +67,8 @@ class RemoteDevice : public Device {
   RemoteTimeouts timeouts_;
   pid_t child_ = -1;
   std::unique_ptr<LinePipe> pipe_;
+  long nextId_ = 0;               // each request's, echoed by its replies
+  bool heardFromHelper_ = false;  // since it started
 };
 
 }  // namespace rotafab::devices::remote

@@ -35,12 +35,14 @@ class SimulatedM2Nano : public m2nano::M2NanoDriver {
 
 int main(int argc, char** argv) {
   // The program that started this one decides when a job stops (it sends a
-  // cancel); Ctrl-C at the terminal reaches it, not this.
+  // cancel, or goes, and the input ends): Ctrl-C at the terminal, the
+  // terminal closing, reach it, not this; nor does a write to a closed pipe
+  // end this mid-job.
   sigset_t signals;
   sigemptyset(&signals);
-  sigaddset(&signals, SIGINT);
-  sigaddset(&signals, SIGTERM);
+  for (int s : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) sigaddset(&signals, s);
   pthread_sigmask(SIG_BLOCK, &signals, nullptr);
+  std::signal(SIGPIPE, SIG_IGN);
   double speed = 1;
   if (argc == 3 && std::string(argv[1]) == "--speed") speed = std::atof(argv[2]);
   if (argc != 1 && argc != 3) {

@@ -1,6 +1,7 @@
 #include "devices/spool/SpoolDevice.h"
 
 #include <fmt/format.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 
@@ -65,15 +66,29 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     std::vector<char*> argv;
     for (std::string& arg : args) argv.push_back(arg.data());
     argv.push_back(nullptr);
+    // lp with the signals as a program started from the shell has them (the
+    // command line blocks SIGINT and SIGTERM for its own watcher): Ctrl-C
+    // reaches it.
+    posix_spawnattr_t attributes;
+    posix_spawnattr_init(&attributes);
+    sigset_t none, defaults;
+    sigemptyset(&none);
+    sigemptyset(&defaults);
+    sigaddset(&defaults, SIGINT);
+    sigaddset(&defaults, SIGTERM);
+    posix_spawnattr_setsigmask(&attributes, &none);
+    posix_spawnattr_setsigdefault(&attributes, &defaults);
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETSIGMASK | POSIX_SPAWN_SETSIGDEF);
     pid_t pid = 0;
-    if (posix_spawnp(&pid, "lp", nullptr, nullptr, argv.data(), environ) != 0) {
-      throw DeviceFault(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
-    }
+    const int spawned = posix_spawnp(&pid, "lp", nullptr, &attributes, argv.data(), environ);
+    posix_spawnattr_destroy(&attributes);
+    if (spawned != 0) throw DeviceFault(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
     int status = 0;
     pid_t waited = 0;
     do {
       waited = waitpid(pid, &status, 0);
     } while (waited < 0 && errno == EINTR);
+    if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, "spool: cancelled");
     if (waited != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
       throw DeviceFault(FaultKind::Refused, fmt::format("spool: lp -d {} refused {} (exit status {})", printer_, file,
                                                         WIFEXITED(status) ? WEXITSTATUS(status) : -1));

@@ -32,7 +32,7 @@ class BottomLeftPacker {
   // `cancellation`, when given, is checked for every part placed (and
   // within each placement): pack() then throws core::Cancelled.
   BottomLeftPacker(const PartShapes& shapes, const core::Cancellation* cancellation = nullptr)
-      : shapes_(shapes), noFitPolygons_(shapes), cancellation_(cancellation) {}
+      : shapes_(shapes), noFitPolygons_(shapes, cancellation), cancellation_(cancellation) {}
 
   // Lays out the parts in `sequence`; returns placements in cutting order.
   // `policy` Strict fills only the last sheet; otherwise first fit over all sheets.

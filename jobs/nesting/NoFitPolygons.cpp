@@ -125,6 +125,7 @@ Paths NoFitPolygons::obstacles(int part, int k, const std::vector<PlacedShape>& 
   const Shape& moving = shapes_.at(part, k);
   std::vector<Paths> noFitPolygons;
   for (const PlacedShape& q : others) {
+    if (cancellation_) cancellation_->check();
     const Shape& fixed = shapes_.at(q.part, q.shape);
     // The no-fit polygon lies in this box.
     if (!matters({q.at.X + fixed.grownMinX - moving.grownMaxX, q.at.Y + fixed.grownMinY - moving.grownMaxY,

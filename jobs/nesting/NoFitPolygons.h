@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/Cancellation.h"
 #include "jobs/nesting/Shapes.h"
 
 namespace rotafab::jobs::nesting {
@@ -30,11 +31,13 @@ Paths unionOf(std::vector<Paths> regions);
 
 class NoFitPolygons {
  public:
-  explicit NoFitPolygons(const PartShapes& shapes) : shapes_(shapes) {}
+  // `cancellation`, when given, is checked for each placed shape obstacles() meets.
+  explicit NoFitPolygons(const PartShapes& shapes, const core::Cancellation* cancellation = nullptr)
+      : shapes_(shapes), cancellation_(cancellation) {}
 
   // The reference points where shape k of `part` would overlap one of
   // `others`: the union of their no-fit polygons, built only where a box of
-  // reference points `matters`.
+  // reference points `matters`. Throws core::Cancelled.
   Paths obstacles(int part, int k, const std::vector<PlacedShape>& others,
                   const std::function<bool(const Box&)>& matters);
 
@@ -50,6 +53,7 @@ class NoFitPolygons {
   static Paths placedRegion(const TurnedRegion& region, IntPoint at);
 
   const PartShapes& shapes_;
+  const core::Cancellation* cancellation_;
   std::map<std::pair<int, int>, Paths> shared_;  // (moving class, placed class) -> no-fit polygon
   size_t sharedPoints_ = 0;
   std::map<std::tuple<int, int, int, int>, Paths> wholes_;  // no-fit polygons without convex pieces

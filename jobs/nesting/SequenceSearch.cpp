@@ -146,7 +146,8 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
     // The compaction lets grown shapes reach into each other by a few grid
     // units; the layout is kept only if the true outlines keep the spacing
     // (within layoutProblems' tolerance).
-    if (layoutCost(compacted, parts) < layoutCost(best, parts) && layoutProblems(parts, compacted, options).empty()) {
+    if (layoutCost(compacted, parts) < layoutCost(best, parts) &&
+        layoutProblems(parts, compacted, options, 1e-3, &context.cancellation()).empty()) {
       best = std::move(compacted);
     }
   }

@@ -69,15 +69,16 @@ struct HostRig {
 
 TEST(DeviceHost, ServesARunToItsEndWithProgress) {
   HostRig rig(500);
-  ASSERT_TRUE(rig.client->writeLine(nlohmann::json{{"op", "connect"}}.dump()));
+  ASSERT_TRUE(rig.client->writeLine(nlohmann::json{{"op", "connect"}, {"id", 1}}.dump()));
   const auto connected = rig.next();
   ASSERT_TRUE(connected.value("ok", false)) << connected.dump();
   EXPECT_NE(connected.at("identity").get<std::string>().find("Grbl 1.1h"), std::string::npos);
   const jobs::Toolpath path = square(rig.driver.motionLimits());
-  ASSERT_TRUE(rig.client->writeLine(nlohmann::json{{"op", "run"}, {"toolpath", toJson(path)}}.dump()));
+  ASSERT_TRUE(rig.client->writeLine(nlohmann::json{{"op", "run"}, {"id", 2}, {"toolpath", toJson(path)}}.dump()));
   size_t strokes = 0;
   for (;;) {
     const auto answer = rig.next(30s);
+    if (answer.contains("alive")) continue;
     if (answer.contains("progress")) {
       strokes = progressOf(answer.at("progress")).stroke;
       continue;
@@ -97,11 +98,42 @@ TEST(DeviceHost, ServesARunToItsEndWithProgress) {
   EXPECT_FALSE(record.laserOn);
 }
 
+// A cancel sent right behind its run, before the host has started it, still
+// stops it; a cancel that comes after its run has ended stops nothing later.
+TEST(DeviceHost, ACancelAheadOfItsRunStopsItAndALateOneStopsNothing) {
+  HostRig rig(20);
+  rig.client->writeLine(nlohmann::json{{"op", "connect"}, {"id", 1}}.dump());
+  ASSERT_TRUE(rig.next().value("ok", false));
+  const auto path = toJson(square(rig.driver.motionLimits()));
+  rig.client->writeLine(nlohmann::json{{"op", "run"}, {"id", 2}, {"toolpath", path}}.dump());
+  rig.client->writeLine(nlohmann::json{{"op", "cancel"}, {"id", 2}}.dump());
+  for (;;) {
+    const auto answer = rig.next(20s);
+    if (answer.contains("alive") || answer.contains("progress")) continue;
+    ASSERT_TRUE(answer.contains("fault")) << answer.dump();
+    EXPECT_EQ(answer.at("fault").at("kind"), "cancelled");
+    EXPECT_TRUE(answer.at("fault").at("confirmed").get<bool>());
+    break;
+  }
+  EXPECT_FALSE(rig.simulator.record().laserOn);
+  // A cancel for run 2, late: run 3 goes to its end.
+  rig.client->writeLine(nlohmann::json{{"op", "cancel"}, {"id", 2}}.dump());
+  rig.client->writeLine(nlohmann::json{{"op", "run"}, {"id", 3}, {"toolpath", path}}.dump());
+  for (;;) {
+    const auto answer = rig.next(60s);
+    if (answer.contains("alive") || answer.contains("progress")) continue;
+    EXPECT_TRUE(answer.value("ok", false)) << answer.dump();
+    EXPECT_EQ(answer.at("id"), 3);
+    break;
+  }
+}
+
 TEST(DeviceHost, WhenTheOtherSideGoesTheRunStopsWithTheLaserOff) {
   HostRig rig(20);  // slow enough to be mid-job
-  rig.client->writeLine(nlohmann::json{{"op", "connect"}}.dump());
+  rig.client->writeLine(nlohmann::json{{"op", "connect"}, {"id", 1}}.dump());
   ASSERT_TRUE(rig.next().value("ok", false));
-  rig.client->writeLine(nlohmann::json{{"op", "run"}, {"toolpath", toJson(square(rig.driver.motionLimits()))}}.dump());
+  rig.client->writeLine(
+      nlohmann::json{{"op", "run"}, {"id", 2}, {"toolpath", toJson(square(rig.driver.motionLimits()))}}.dump());
   // Mid-job (the laser lit), the asking side is gone, as if killed.
   const auto until = std::chrono::steady_clock::now() + 20s;
   while (!rig.simulator.record().laserOn && std::chrono::steady_clock::now() < until) std::this_thread::sleep_for(5ms);
@@ -125,7 +157,7 @@ class Remote : public RemoteDevice {
 
 TEST(RemoteDevice, AHelperThatDiesMidJobIsADisconnectNotConfirmedOff) {
   // It answers the connect, then dies when the run comes.
-  Remote device({"/bin/sh", "-c", R"(read l; echo '{"ok":true,"identity":"fake"}'; read l; exit 3)"});
+  Remote device({"/bin/sh", "-c", R"(read l; echo '{"ok":true,"identity":"fake","id":1}'; read l; exit 3)"});
   EXPECT_EQ(device.connect(), "fake");
   const core::Cancellation never;
   try {
@@ -142,6 +174,7 @@ TEST(RemoteDevice, ASilentHelperTimesOutAndACancelIsPassedOn) {
   quick.request = 300ms;
   quick.stop = 500ms;
   quick.exit = 200ms;
+  quick.silence = 400ms;
   {
     Remote device({"/bin/sh", "-c", "sleep 30"}, quick);
     const auto start = std::chrono::steady_clock::now();
@@ -153,10 +186,26 @@ TEST(RemoteDevice, ASilentHelperTimesOutAndACancelIsPassedOn) {
     }
     EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
   }
+  // A helper that answers the connect, then falls silent in the run (no word
+  // that it is alive): a timeout, not a hang, the laser not confirmed off.
+  {
+    Remote device({"/bin/sh", "-c", R"(read l; echo '{"ok":true,"identity":"fake","id":1}'; sleep 30)"}, quick);
+    device.connect();
+    const core::Cancellation never;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      device.run(square({}), {}, never);
+      FAIL() << "ran";
+    } catch (const DeviceFault& fault) {
+      EXPECT_EQ(fault.kind, FaultKind::Timeout) << fault.what();
+      EXPECT_FALSE(fault.laserOffConfirmed);
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+  }
   // A helper that answers a cancel with the driver's fault: the cancel reaches it.
   Remote device(
       {"/bin/sh", "-c",
-       R"(read l; echo '{"ok":true,"identity":"fake"}'; read l; read l; case "$l" in *cancel*) echo '{"fault":{"kind":"cancelled","message":"fake: cancelled","confirmed":true}}';; esac; read l)"},
+       R"(read l; echo '{"ok":true,"identity":"fake","id":1}'; read l; read l; case "$l" in *cancel*) echo '{"fault":{"kind":"cancelled","message":"fake: cancelled","confirmed":true},"id":2}';; esac; read l)"},
       quick);
   device.connect();
   core::Cancellation cancel;
