@@ -5,14 +5,19 @@
 // and keeps them alive while the work runs; a daemon makes one context per
 // job, the command line one per command.
 
-#include <spdlog/logger.h>
-
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "core/Cancellation.h"
 #include "core/Executor.h"
 #include "core/Progress.h"
+
+// Declared, not included: spdlog's headers cost seconds in every file that
+// includes this one, and only WorkContext.cpp writes to the logger.
+namespace spdlog {
+class logger;
+}
 
 namespace rotafab::core {
 
@@ -35,12 +40,8 @@ class WorkContext {
   }
   [[nodiscard]] bool reportsProgress() const { return static_cast<bool>(progress_); }
 
-  void note(const std::string& text) const {
-    if (log_) log_->info(text);
-  }
-  void warn(const std::string& text) const {
-    if (log_) log_->warn(text);
-  }
+  void note(const std::string& text) const;
+  void warn(const std::string& text) const;
   [[nodiscard]] const std::shared_ptr<spdlog::logger>& log() const { return log_; }
 
   // The same executor, cancellation and logger, with progress going to `progress` instead.

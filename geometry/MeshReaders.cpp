@@ -42,7 +42,7 @@ std::vector<std::string_view> splitWords(std::string_view line) {
 }
 
 // Shortens a token for a message so that binary garbage cannot flood it.
-std::string quoted(std::string_view token) {
+std::string shownToken(std::string_view token) {
   std::string shown;
   for (char c : token.substr(0, 24)) shown += (static_cast<unsigned char>(c) >= 32 && c != 127) ? c : '?';
   return fmt::format("'{}{}'", shown, token.size() > 24 ? "..." : "");
@@ -82,7 +82,7 @@ class CommentedLines {
 long long countFrom(std::string_view token, int line, const char* what) {
   auto value = parseInteger(token);
   if (!value || *value < 0)
-    failAtLine(line, fmt::format("the {} count {} is not a non-negative integer", what, quoted(token)));
+    failAtLine(line, fmt::format("the {} count {} is not a non-negative integer", what, shownToken(token)));
   return *value;
 }
 
@@ -104,10 +104,11 @@ PolygonMesh readOff(std::string_view text) {
   } else {
     // Optional prefixes: ST (texture), C (colour), N (normal), 4 / n (dimension).
     if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") {
-      failAtLine(lines.lineNumber(), fmt::format("expected the OFF header, found {}", quoted(keyword)));
+      failAtLine(lines.lineNumber(), fmt::format("expected the OFF header, found {}", shownToken(keyword)));
     }
     if (keyword.find('4') != std::string_view::npos || keyword.find('n') != std::string_view::npos) {
-      failAtLine(lines.lineNumber(), fmt::format("{} (4D or nD) files are not supported; 3D OFF is", quoted(keyword)));
+      failAtLine(lines.lineNumber(),
+                 fmt::format("{} (4D or nD) files are not supported; 3D OFF is", shownToken(keyword)));
     }
     counts.assign(header->begin() + 1, header->end());
     if (!counts.empty() && counts[0] == "BINARY")
@@ -142,7 +143,7 @@ PolygonMesh readOff(std::string_view text) {
     for (int axis = 0; axis < 3; ++axis) {
       auto value = parseReal((*words)[axis]);
       if (!value)
-        failAtLine(lines.lineNumber(), fmt::format("vertex {}: {} is not a number", v, quoted((*words)[axis])));
+        failAtLine(lines.lineNumber(), fmt::format("vertex {}: {} is not a number", v, shownToken((*words)[axis])));
       p[axis] = *value;
     }
     checkFinite(p, v, lines.lineNumber());
@@ -157,7 +158,8 @@ PolygonMesh readOff(std::string_view text) {
     }
     const int line = lines.lineNumber();
     auto size = parseInteger((*words)[0]);
-    if (!size || *size < 1) failAtLine(line, fmt::format("face {}: {} is not a corner count", f, quoted((*words)[0])));
+    if (!size || *size < 1)
+      failAtLine(line, fmt::format("face {}: {} is not a corner count", f, shownToken((*words)[0])));
     if (static_cast<long long>(words->size()) - 1 < *size) {
       failAtLine(line, fmt::format("face {} states {} corners but lists {}", f, *size, words->size() - 1));
     }
@@ -165,7 +167,7 @@ PolygonMesh readOff(std::string_view text) {
     face.reserve(*size);
     for (long long i = 1; i <= *size; ++i) {
       auto index = parseInteger((*words)[i]);
-      if (!index) failAtLine(line, fmt::format("face {}: {} is not a vertex index", f, quoted((*words)[i])));
+      if (!index) failAtLine(line, fmt::format("face {}: {} is not a vertex index", f, shownToken((*words)[i])));
       if (*index < 0 || *index >= vertexCount) {
         failAtLine(line, fmt::format("face {} refers to vertex {}, but the file has {} vertices (0 to {})", f, *index,
                                      vertexCount, vertexCount - 1));
@@ -255,7 +257,7 @@ class PlyValues {
       while (position_ < body_.size() && !isSpace(body_[position_])) ++position_;
       std::string_view token = body_.substr(start, position_ - start);
       auto value = parseReal(token);
-      if (!value) failAtLine(line_, fmt::format("{} is not a number", quoted(token)));
+      if (!value) failAtLine(line_, fmt::format("{} is not a number", shownToken(token)));
       return value;
     }
     const size_t size = plyTypeSize(type);
@@ -333,7 +335,7 @@ PolygonMesh readPly(std::string_view bytes) {
       else if (w[1] == "binary_big_endian")
         format = PlyFormat::BinaryBigEndian;
       else
-        failAtLine(line, fmt::format("unknown format {}", quoted(w[1])));
+        failAtLine(line, fmt::format("unknown format {}", shownToken(w[1])));
     } else if (w[0] == "element") {
       if (w.size() < 3) failAtLine(line, "an element needs a name and a count");
       elements.push_back({std::string(w[1]), countFrom(w[2], line, "element"), {}});
@@ -343,12 +345,12 @@ PolygonMesh readPly(std::string_view bytes) {
       if (w.size() >= 5 && w[1] == "list") {
         auto countType = plyTypeNamed(w[2]);
         auto type = plyTypeNamed(w[3]);
-        if (!countType) failAtLine(line, fmt::format("unknown list count type {}", quoted(w[2])));
-        if (!type) failAtLine(line, fmt::format("unknown list value type {}", quoted(w[3])));
+        if (!countType) failAtLine(line, fmt::format("unknown list count type {}", shownToken(w[2])));
+        if (!type) failAtLine(line, fmt::format("unknown list value type {}", shownToken(w[3])));
         property = {std::string(w[4]), *type, true, *countType};
       } else if (w.size() >= 3 && w[1] != "list") {
         auto type = plyTypeNamed(w[1]);
-        if (!type) failAtLine(line, fmt::format("unknown property type {}", quoted(w[1])));
+        if (!type) failAtLine(line, fmt::format("unknown property type {}", shownToken(w[1])));
         property = {std::string(w[2]), *type, false, PlyType::UInt8};
       } else {
         failAtLine(line, "a property needs a type and a name");
@@ -398,11 +400,11 @@ PolygonMesh readPly(std::string_view bytes) {
     if (element.count > static_cast<long long>(values.remainingBytes())) {
       throw InvalidMeshError(
           fmt::format("truncated: the header states {} {} elements, more than the {} bytes left can hold",
-                      element.count, quoted(element.name), values.remainingBytes()));
+                      element.count, shownToken(element.name), values.remainingBytes()));
     }
     auto truncated = [&](long long read) {
       return InvalidMeshError(fmt::format("truncated: the header states {} {} elements, the file ends after {}",
-                                          element.count, quoted(element.name), read));
+                                          element.count, shownToken(element.name), read));
     };
     for (long long i = 0; i < element.count; ++i) {
       Point3 p = Point3::Zero();
@@ -414,7 +416,7 @@ PolygonMesh readPly(std::string_view bytes) {
           if (!size) throw truncated(i);
           if (*size < 0 || *size != std::floor(*size) || *size > 1e6) {
             throw InvalidMeshError(
-                fmt::format("{}{} {}: {} is not a list length", values.where(), quoted(element.name), i, *size));
+                fmt::format("{}{} {}: {} is not a list length", values.where(), shownToken(element.name), i, *size));
           }
           for (long long k = 0; k < static_cast<long long>(*size); ++k) {
             auto value = values.next(property.type);

@@ -6,7 +6,7 @@
 // as text (manifest.txt, `rotafab manifest`) and as a page to print.
 
 #include <filesystem>
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 

@@ -4,7 +4,7 @@
 // "shape": {"type": "simple_polygon", "data": [[x, y], ...]}}]}. One part per
 // copy of each item, numbered in file order.
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
 

@@ -10,8 +10,6 @@ using namespace jobs;
 
 namespace {
 
-constexpr double kMillimetresPerInch = 25.4;
-
 std::string millimetres(double inches) { return formatDecimal(inches * kMillimetresPerInch, 3); }
 
 }  // namespace

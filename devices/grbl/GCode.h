@@ -13,6 +13,9 @@
 
 namespace rotafab::devices::grbl {
 
+// GRBL speaks millimetres ($13=0); toolpaths are in inches.
+inline constexpr double kMillimetresPerInch = 25.4;
+
 struct GCodeOptions {
   double maxSpindle = 1000;  // $30: S for full power
 };

@@ -14,7 +14,6 @@ namespace rotafab::devices::grbl {
 namespace {
 
 constexpr char kStatus = '?', kHold = '!', kResume = '~', kReset = 0x18;
-constexpr double kMillimetresPerInch = 25.4;
 
 bool isBanner(const std::string& line) { return line.starts_with("Grbl ") || line.starts_with("GrblHAL "); }
 

@@ -2,7 +2,7 @@
 // GRBL 1.1 (and grblHAL) laser controllers, over serial or TCP.
 // Connect: wait for the banner, read `$$` and `$I` (the receive buffer from
 // [OPT:...]), refuse to cut unless laser mode is on ($32=1). Run: the job's
-// G-code (jobs/GCode.h) streamed by character counting against the receive
+// G-code (GCode.h) streamed by character counting against the receive
 // buffer (gnea/grbl's stream.py method), with realtime `?` status polls; a
 // hold is `!`, a resume `~`. On any error, alarm, timeout, cancel or
 // disconnect: feed hold, soft reset (0x18), and `M5 S0` once the controller

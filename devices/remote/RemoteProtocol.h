@@ -13,7 +13,7 @@
 // A toolpath goes whole, every double as the shortest decimal that reads
 // back to it exactly, so the helper runs the very job planned here.
 
-#include <nlohmann/json.hpp>
+#include <nlohmann/json_fwd.hpp>
 #include <optional>
 #include <string_view>
 

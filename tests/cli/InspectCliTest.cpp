@@ -5,13 +5,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/CliSupport.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {
-
-const std::string kCli = ROTAFAB_CLI;
-const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
 
 nlohmann::json inspectJson(const std::filesystem::path& mesh) {
   const CommandResult result = run(kCli + " inspect --json '" + mesh.string() + "'");

@@ -5,12 +5,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli/CliSupport.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {
-
-const std::string kCli = ROTAFAB_CLI;
 
 TEST(NestCli, StripRunWritesLayoutAndSummary) {
   TempDir dir;

@@ -10,13 +10,11 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "cli/CliSupport.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::test {
 namespace {
-
-const std::string kCli = ROTAFAB_CLI;
-const std::filesystem::path kSource = ROTAFAB_SOURCE_DIR;
 
 // The cube's bands made once for each set of `make` options, shared by the tests.
 std::filesystem::path madeCube(const std::string& options) {

@@ -42,7 +42,7 @@ PolygonMesh heightField(int n, const std::function<double(double, double)>& heig
   return mesh;
 }
 
-struct Structure {
+struct UnfoldedBands {
   PolygonMesh mesh;
   RotationSystem rs;
   BandDecomposition decomposition;
@@ -50,10 +50,10 @@ struct Structure {
   std::vector<FlatPanel> panels;
 };
 
-Structure build(PolygonMesh mesh) {
+UnfoldedBands build(PolygonMesh mesh) {
   const MeshAnalysis analysis = analyzeMesh(mesh);
   EXPECT_TRUE(analysis.usable());
-  Structure s{mesh, RotationSystem::fromMesh(mesh), {}, {}, {}};
+  UnfoldedBands s{mesh, RotationSystem::fromMesh(mesh), {}, {}, {}};
   s.decomposition = bandDecomposition(s.mesh, s.rs);
   s.bands = developableBands(s.rs, s.decomposition);
   for (int f = 0; f < s.mesh.faceCount(); ++f) s.panels.push_back(unfoldPanel(s.rs, s.decomposition, s.bands, f));
@@ -93,7 +93,7 @@ double relative(double a, double b) { return std::abs(a - b) / std::max({std::ab
 
 TEST(BandDecomposition, OnePanelPerFaceAndTwoCopiesOfEveryInteriorBand) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     ASSERT_EQ(s.panels.size(), static_cast<size_t>(s.mesh.faceCount())) << name;
     std::vector<int> copies(s.rs.edgeCount(), 0);
     for (const FlatPanel& panel : s.panels) {
@@ -107,7 +107,7 @@ TEST(BandDecomposition, OnePanelPerFaceAndTwoCopiesOfEveryInteriorBand) {
 
 TEST(BandDecomposition, VertexBandsArePlanarAndFaceOutwards) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     for (int f = 0; f < s.mesh.faceCount(); ++f) {
       const VertexBand& vb = s.decomposition.vertexBands[f];
       std::vector<Point3> face;
@@ -127,7 +127,7 @@ TEST(BandDecomposition, VertexBandsArePlanarAndFaceOutwards) {
 // areas are kept too.
 TEST(BandDecomposition, UnfoldingKeepsEveryLength) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     for (const FlatPanel& panel : s.panels) {
       const auto& corners = s.decomposition.vertexBands[panel.face].corners;
       const size_t n = corners.size();
@@ -162,7 +162,7 @@ TEST(BandDecomposition, UnfoldingKeepsEveryLength) {
 // not mirrored: holes placed on one are where they are on the other.
 TEST(BandDecomposition, BothCopiesOfABandAreCongruent) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     std::map<int, std::vector<const FlatBand*>> copies;
     for (const FlatPanel& panel : s.panels) {
       for (const FlatBand& band : panel.bands) copies[band.edge].push_back(&band);
@@ -198,7 +198,7 @@ TEST(BandDecomposition, BothCopiesOfABandAreCongruent) {
 // on every other.
 TEST(BandDecomposition, NoBandIsFlippedAtSaddles) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     int saddleBands = 0;
     for (int e = 0; e < s.rs.edgeCount(); ++e) {
       const EdgeBand& band = s.bands[e];
@@ -251,7 +251,7 @@ TEST(BandDecomposition, NoBandIsFlippedAtSaddles) {
 TEST(BandDecomposition, HermiteBandsAreTangentToBothVertexBands) {
   int hermite = 0;
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     std::map<BandCase, int> kinds;
     for (const EdgeBand& band : s.bands) kinds[band.kind] += band.edge >= 0;
     if (name == "disc") {
@@ -285,7 +285,7 @@ TEST(BandDecomposition, HermiteBandsAreTangentToBothVertexBands) {
 
 TEST(BandDecomposition, PanelsOfTheTestMeshesDoNotOverlapThemselves) {
   for (auto& [name, mesh] : testMeshes()) {
-    const Structure s = build(mesh);
+    const UnfoldedBands s = build(mesh);
     for (const FlatPanel& panel : s.panels) {
       EXPECT_TRUE(overlappingPieces(panel).empty()) << name << ": face " << panel.face;
     }
@@ -295,7 +295,7 @@ TEST(BandDecomposition, PanelsOfTheTestMeshesDoNotOverlapThemselves) {
 // The overlap check is not blind: a band laid across the vertex band, and a
 // vertex band that crosses itself, are both found.
 TEST(BandDecomposition, OverlapsAreFound) {
-  Structure s = build(cube());
+  UnfoldedBands s = build(cube());
   FlatPanel panel = s.panels.front();
   ASSERT_TRUE(overlappingPieces(panel).empty());
   FlatPanel crossed = panel;
@@ -328,7 +328,7 @@ TEST(BandDecomposition, ValenceTwoVerticesAreBuilt) {
       }
     }
   }
-  const Structure s = build(mesh);
+  const UnfoldedBands s = build(mesh);
   EXPECT_EQ(s.panels.size(), 6u);
   for (const FlatPanel& panel : s.panels) {
     EXPECT_TRUE(overlappingPieces(panel).empty()) << "face " << panel.face;

@@ -12,7 +12,7 @@
 
 #include "SheetFixture.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 namespace {
 
 std::vector<std::string> namesIn(const std::filesystem::path& folder) {
@@ -147,4 +147,4 @@ TEST(AtomicFile, AFailingWriterKeepsTheOldFile) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests

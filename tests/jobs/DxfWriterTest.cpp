@@ -10,7 +10,7 @@
 
 #include "SheetFixture.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 namespace {
 
 std::string dxfOf(const SheetDrawing& sheet) {
@@ -212,4 +212,4 @@ print(json.dumps(out))
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests

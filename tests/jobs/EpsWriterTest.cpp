@@ -9,7 +9,7 @@
 
 #include "SheetFixture.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 namespace {
 
 constexpr double kPointsPerInch = 72;
@@ -185,4 +185,4 @@ TEST(EpsWriter, CoordinatesHaveAThousandthOfAPoint) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests

@@ -18,11 +18,11 @@
 #include <string>
 #include <vector>
 
-#include "support/TestSupport.h"
 #include "geometry/HersheyFont.h"
 #include "jobs/SheetDrawing.h"
+#include "support/TestSupport.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 
 using rotafab::test::CommandResult;
 using rotafab::test::readFile;
@@ -205,4 +205,4 @@ inline Box pixelBox(const Image& image, Rgb colour, double dpi, double bedHeight
 
 inline std::string shellQuote(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
 
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests

@@ -10,7 +10,7 @@
 #include "jobs/EpsWriter.h"
 #include "jobs/SvgWriter.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 namespace {
 
 struct Writer {
@@ -105,4 +105,4 @@ TEST(SheetWriters, OutputDoesNotDependOnTheStreamsLocale) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests

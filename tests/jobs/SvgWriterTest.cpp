@@ -9,7 +9,7 @@
 
 #include "SheetFixture.h"
 
-namespace rotafab::jobs::test {
+namespace rotafab::jobs::sheet_tests {
 namespace {
 
 std::string svgOf(const SheetDrawing& sheet) {
@@ -237,4 +237,4 @@ TEST(SvgWriter, InkscapeReadsTheSameSheet) {
 }
 
 }  // namespace
-}  // namespace rotafab::jobs::test
+}  // namespace rotafab::jobs::sheet_tests
