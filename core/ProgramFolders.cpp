@@ -1,5 +1,7 @@
 #include "core/ProgramFolders.h"
 
+#include <unistd.h>
+
 namespace rotafab::core {
 
 std::filesystem::path programFolder() {
@@ -11,5 +13,14 @@ std::filesystem::path programFolder() {
 std::filesystem::path installedDataFolder() { return programFolder().parent_path() / "share" / "rotafab"; }
 
 std::filesystem::path installedHelperFolder() { return programFolder().parent_path() / "libexec" / "rotafab"; }
+
+std::string helperProgram(const std::string& name) {
+  const std::filesystem::path folder = programFolder();
+  if (folder.empty()) return name;
+  for (const auto& candidate : {folder / name, installedHelperFolder() / name}) {
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate.string();
+  }
+  return name;
+}
 
 }  // namespace rotafab::core

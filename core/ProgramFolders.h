@@ -4,6 +4,7 @@
 // PREFIX/share/rotafab and PREFIX/libexec/rotafab), wherever PREFIX is.
 
 #include <filesystem>
+#include <string>
 
 namespace rotafab::core {
 
@@ -16,5 +17,10 @@ std::filesystem::path installedDataFolder();
 
 // PREFIX/libexec/rotafab: the helper programs.
 std::filesystem::path installedHelperFolder();
+
+// The helper program `name`: beside the running program (the build tree),
+// else in installedHelperFolder(), else the bare name (found on the PATH, or
+// the error of starting it names the program that is missing).
+std::string helperProgram(const std::string& name);
 
 }  // namespace rotafab::core

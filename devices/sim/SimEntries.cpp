@@ -1,9 +1,6 @@
 #include "devices/sim/SimEntries.h"
 
 #include <fmt/format.h>
-#include <unistd.h>
-
-#include <filesystem>
 
 #include "core/ProgramFolders.h"
 #include "devices/UriParts.h"
@@ -65,21 +62,11 @@ class SimGrblEntry : public DriverEntry {
   [[nodiscard]] bool connectsForDryRun(const DeviceAddress&) const override { return true; }
 };
 
-// The helper beside this program (the build tree), or where it is installed.
-std::string helperPath() {
-  std::error_code error;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
-  for (const auto& candidate :
-       {self.parent_path() / kM2NanoHelper, self.parent_path().parent_path() / "libexec" / "rotafab" / kM2NanoHelper}) {
-    if (!error && ::access(candidate.c_str(), X_OK) == 0) return candidate.string();
-  }
-  return kM2NanoHelper;  // on the PATH, or the error says which program is missing
-}
-
 // The simulated M2 Nano and its driver, in the helper; its dry run is the M2 Nano's own, here.
 class SimulatedM2Nano : public remote::RemoteDevice {
  public:
-  explicit SimulatedM2Nano(double speed) : RemoteDevice({helperPath(), "--speed", fmt::format("{}", speed)}) {}
+  explicit SimulatedM2Nano(double speed)
+      : RemoteDevice({core::helperProgram(kM2NanoHelper), "--speed", fmt::format("{}", speed)}) {}
   [[nodiscard]] jobs::MotionLimits motionLimits() const override { return m2nano::motionLimits(); }
   [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override {
     return m2nano::egvProgram(toolpaths);

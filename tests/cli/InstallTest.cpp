@@ -16,9 +16,9 @@ TEST(Install, TheInstalledProgramFindsItsProfilesFontAndHelper) {
   const auto prefix = dir.path() / "prefix";
   const CommandResult installed = run("cmake --install " + quoted(ROTAFAB_BUILD_DIR) + " --prefix " + quoted(prefix));
   ASSERT_EQ(installed.status, 0) << installed.err;
-  for (const char* file :
-       {"bin/rotafab", "libexec/rotafab/rotafab-sim-m2nano", "share/rotafab/profiles/machines/workshop-32x18.yaml",
-        "share/rotafab/profiles/materials/posterboard.yaml", "share/rotafab/fonts/rowmans.jhf"}) {
+  for (const char* file : {"bin/rotafab", "libexec/rotafab/rotafab-sim-m2nano", "libexec/rotafab/rotafab-read-mesh",
+                           "share/rotafab/profiles/machines/workshop-32x18.yaml",
+                           "share/rotafab/profiles/materials/posterboard.yaml", "share/rotafab/fonts/rowmans.jhf"}) {
     EXPECT_TRUE(std::filesystem::is_regular_file(prefix / file)) << file;
   }
   // From a folder with no profiles of its own: every shipped profile is the installed one.

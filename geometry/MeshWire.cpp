@@ -1,0 +1,54 @@
+#include "geometry/MeshWire.h"
+
+#include <cstdint>
+#include <cstring>
+
+namespace rotafab::geometry {
+
+static_assert(sizeof(Point3) == 3 * sizeof(double), "Point3 is three packed doubles");
+
+std::string serializeMesh(const PolygonMesh& mesh) {
+  size_t corners = 0;
+  for (const auto& face : mesh.faces) corners += face.size();
+  std::string out;
+  out.reserve(16 + mesh.positions.size() * sizeof(Point3) + mesh.faces.size() * 4 + corners * sizeof(int));
+  auto put = [&](const void* data, size_t size) { out.append(static_cast<const char*>(data), size); };
+  const uint64_t vertices = mesh.positions.size(), faces = mesh.faces.size();
+  put(&vertices, sizeof vertices);
+  put(mesh.positions.data(), mesh.positions.size() * sizeof(Point3));
+  put(&faces, sizeof faces);
+  for (const auto& face : mesh.faces) {
+    const uint32_t size = static_cast<uint32_t>(face.size());
+    put(&size, sizeof size);
+    put(face.data(), face.size() * sizeof(int));
+  }
+  return out;
+}
+
+PolygonMesh deserializeMesh(std::string_view bytes) {
+  size_t at = 0;
+  auto take = [&](void* into, uint64_t size) {
+    if (size > bytes.size() - at) throw InvalidMeshError("the reader's result was cut short");
+    std::memcpy(into, bytes.data() + at, size);
+    at += size;
+  };
+  PolygonMesh mesh;
+  uint64_t vertices = 0, faces = 0;
+  take(&vertices, sizeof vertices);
+  if (vertices > bytes.size() / sizeof(Point3)) throw InvalidMeshError("the reader's result was cut short");
+  mesh.positions.resize(vertices);
+  take(mesh.positions.data(), vertices * sizeof(Point3));
+  take(&faces, sizeof faces);
+  if (faces > bytes.size() / sizeof(uint32_t)) throw InvalidMeshError("the reader's result was cut short");
+  mesh.faces.resize(faces);
+  for (auto& face : mesh.faces) {
+    uint32_t size = 0;
+    take(&size, sizeof size);
+    if (size > bytes.size() / sizeof(int)) throw InvalidMeshError("the reader's result was cut short");
+    face.resize(size);
+    take(face.data(), size * sizeof(int));
+  }
+  return mesh;
+}
+
+}  // namespace rotafab::geometry
