@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <optional>
 #include <system_error>
 
 extern char** environ;
@@ -63,6 +64,9 @@ class SpawnSetup {
     posix_spawn_file_actions_adddup2(&actions_, input, STDIN_FILENO);
     posix_spawn_file_actions_adddup2(&actions_, output, STDOUT_FILENO);
     posix_spawn_file_actions_addopen(&actions_, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+    // Nothing else of the caller's: a descriptor some library opened without
+    // close-on-exec (a serial port, a pseudo-terminal) must not live on in it.
+    posix_spawn_file_actions_addclosefrom_np(&actions_, STDERR_FILENO + 1);
     posix_spawnattr_init(&attributes_);
     sigset_t none, all;
     sigemptyset(&none);
@@ -88,6 +92,46 @@ class SpawnSetup {
   posix_spawnattr_t attributes_;
 };
 
+// A started child: reaped once, and killed and reaped if whoever started it
+// leaves early (an exception), so that no child runs on unwatched and no
+// zombie is left.
+class Child {
+ public:
+  explicit Child(pid_t pid) : pid_(pid) {}
+  ~Child() { kill(); }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+
+  // Its wait status once it has ended (-1 when it cannot be had: reaped
+  // elsewhere), nothing while it runs.
+  std::optional<int> poll() {
+    if (reaped_) return status_;
+    int status = 0;
+    pid_t ended;
+    while ((ended = ::waitpid(pid_, &status, WNOHANG)) < 0 && errno == EINTR) {
+    }
+    if (ended == 0) return std::nullopt;
+    reaped_ = true;
+    status_ = ended == pid_ ? status : -1;
+    return status_;
+  }
+  void kill() {
+    if (reaped_) return;
+    ::kill(pid_, SIGKILL);
+    int status = 0;
+    pid_t ended;
+    while ((ended = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {
+    }
+    reaped_ = true;
+    status_ = ended == pid_ ? status : -1;
+  }
+
+ private:
+  pid_t pid_;
+  bool reaped_ = false;
+  int status_ = -1;
+};
+
 }  // namespace
 
 ChildResult runChild(const std::vector<std::string>& argv, std::string_view input, std::chrono::milliseconds timeout,
@@ -102,15 +146,15 @@ ChildResult runChild(const std::vector<std::string>& argv, std::string_view inpu
   std::vector<char*> args;
   for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
   args.push_back(nullptr);
-  pid_t child = -1;
+  pid_t pid = -1;
   {
     const SpawnSetup setup(in.get(), writeEnd.get());
     const bool path = argv[0].find('/') != std::string::npos;
-    const int spawned =
-        path ? ::posix_spawn(&child, args[0], setup.actions(), setup.attributes(), args.data(), environ)
-             : ::posix_spawnp(&child, args[0], setup.actions(), setup.attributes(), args.data(), environ);
+    const int spawned = path ? ::posix_spawn(&pid, args[0], setup.actions(), setup.attributes(), args.data(), environ)
+                             : ::posix_spawnp(&pid, args[0], setup.actions(), setup.attributes(), args.data(), environ);
     if (spawned != 0) fail(spawned, "cannot start " + argv[0]);
   }
+  Child child(pid);  // from here on, however this returns, the child is gone
   writeEnd.reset();  // the child's end: the read sees its end once the child is gone
 
   ChildResult result;
@@ -139,28 +183,24 @@ ChildResult runChild(const std::vector<std::string>& argv, std::string_view inpu
   readEnd.reset();
   // A child that closed its output may still not end: the same deadline and
   // cancel hold until it has.
-  int status = 0;
-  while (!timedOut && !cancelled) {
-    const pid_t ended = ::waitpid(child, &status, WNOHANG);
-    if (ended == child || (ended < 0 && errno != EINTR)) break;
+  std::optional<int> status;
+  while (!timedOut && !cancelled && !(status = child.poll())) {
     if (std::chrono::steady_clock::now() >= deadline) timedOut = true;
     if (cancellation && cancellation->cancelled()) cancelled = true;
-    if (ended == 0 && !timedOut && !cancelled) ::usleep(2000);
+    if (!timedOut && !cancelled) ::usleep(2000);
   }
-  if (timedOut || cancelled) {
-    ::kill(child, SIGKILL);
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-  }
+  if (timedOut || cancelled) child.kill();
   if (cancelled) throw Cancelled();
   if (timedOut) {
     result.status = ChildResult::Status::TimedOut;
-  } else if (WIFEXITED(status) && WEXITSTATUS(status) == 0) {
+  } else if (*status >= 0 && WIFEXITED(*status) && WEXITSTATUS(*status) == 0) {
     result.status = ChildResult::Status::Finished;
   } else {
+    // Unknown (-1: another part of the program reaped it, or SIGCHLD is
+    // ignored) is no answer either.
     result.status = ChildResult::Status::Crashed;
-    result.signal = WIFSIGNALED(status) ? WTERMSIG(status) : 0;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 0;
+    result.signal = *status >= 0 && WIFSIGNALED(*status) ? WTERMSIG(*status) : 0;
+    result.exitCode = *status >= 0 && WIFEXITED(*status) ? WEXITSTATUS(*status) : -1;
     result.output.clear();
   }
   return result;

@@ -24,7 +24,7 @@ struct ChildResult {
   Status status = Status::Crashed;
   std::string output;  // what the child wrote (Finished only: it exited with status 0)
   int signal = 0;      // the signal that ended the child (Crashed), 0 if it exited
-  int exitCode = 0;    // its exit status (Crashed without a signal)
+  int exitCode = 0;    // its exit status (Crashed without a signal; -1 when unknown)
 };
 
 // Runs argv[0] (a path, or a name looked up on the PATH) with `input` as its
@@ -32,9 +32,12 @@ struct ChildResult {
 // messages must not reach the user's terminal). The child has default signal
 // handling and a process group of its own (a Ctrl-C at the terminal reaches
 // the caller, who cancels; it never kills the child behind the caller's
-// back). Past `timeout` the child is killed (TimedOut); a cancel (checked
-// every 100 ms) kills it and throws Cancelled. Throws std::system_error when
-// the program cannot be started.
+// back), and no descriptor of the caller's but those three. Past `timeout`
+// the child is killed (TimedOut); a cancel (checked every 100 ms) kills it
+// and throws Cancelled. However it returns, the child has ended and been
+// reaped; it is tied to the calling thread for that long (a helper may ask
+// to die with it: PR_SET_PDEATHSIG). Throws std::system_error when the
+// program cannot be started ("cannot start PROGRAM: ...").
 ChildResult runChild(const std::vector<std::string>& argv, std::string_view input, std::chrono::milliseconds timeout,
                      const Cancellation* cancellation = nullptr);
 

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -43,14 +44,14 @@ PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& exte
                                  const std::filesystem::path* path, const core::Cancellation* cancellation) {
   // Generous: Assimp reads 200k faces of OBJ in about 0.15 s.
   const auto timeout = std::chrono::seconds(120 + bytes.size() / 1'000'000);
-  std::vector<std::string> argv{core::helperProgram(kMeshReader), extension};
+  // The reader dies with this process (it is told which one to watch).
+  std::vector<std::string> argv{core::helperProgram(kMeshReader), std::to_string(::getpid()), extension};
   if (path) argv.push_back(std::filesystem::absolute(*path).string());
   core::ChildResult result;
   try {
     result = core::runChild(argv, bytes, timeout, cancellation);
   } catch (const std::system_error& error) {
-    throw InvalidMeshError(fmt::format("cannot start the mesh reader {} ({}); is rotafab installed whole?", argv[0],
-                                       error.code().message()));
+    throw InvalidMeshError(fmt::format("the mesh reader could not be run: {}", error.what()));
   }
   std::string format = extension;
   std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::toupper(c); });
@@ -58,9 +59,15 @@ PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& exte
     throw InvalidMeshError(fmt::format("the {} reader (Assimp) did not finish within {} s", format,
                                        std::chrono::duration_cast<std::chrono::seconds>(timeout).count()));
   }
+  if (result.status == core::ChildResult::Status::Crashed && result.signal != 0) {
+    throw InvalidMeshError(fmt::format("the {} reader (Assimp) crashed on this file ({}): the file is malformed",
+                                       format, ::strsignal(result.signal)));
+  }
+  // Not the file's fault, as far as can be told: a reader that cannot load
+  // its libraries exits with 127, and says so only on its standard error.
   if (result.status == core::ChildResult::Status::Crashed || result.output.empty()) {
-    throw InvalidMeshError(fmt::format("the {} reader (Assimp) crashed on this file{}: the file is malformed", format,
-                                       result.signal ? fmt::format(" ({})", ::strsignal(result.signal)) : ""));
+    throw InvalidMeshError(
+        fmt::format("the {} reader ({}) ended with status {} and no answer", format, argv[0], result.exitCode));
   }
   if (result.output[0] == 'E') throw InvalidMeshError(result.output.substr(1));
   if (result.output[0] != 'M') throw InvalidMeshError(fmt::format("the {} reader's reply is not a mesh", format));

@@ -1,11 +1,13 @@
-// rotafab-read-mesh EXTENSION [PATH] < BYTES: reads a mesh file with Assimp
-// and writes it back on standard output, for the importer (MeshImport.cpp),
-// which runs this program so that Assimp runs in a process of its own. The
-// bytes of the file come on standard input; PATH, when given, is where they
-// came from, for the files they refer to. The reply is one tag byte, then the
+// rotafab-read-mesh PARENT EXTENSION [PATH] < BYTES: reads a mesh file with
+// Assimp and writes it back on standard output, for the importer
+// (MeshImport.cpp), which runs this program so that Assimp runs in a process
+// of its own. PARENT is the importer's process id: this program ends with it.
+// The bytes of the file come on standard input; PATH, when given, is where
+// they came from, for the files they refer to. The reply is one tag byte, then the
 // mesh ('M', MeshWire.h) or one line saying what is wrong with the file ('E').
 // Exit status 0 whenever a reply was written; anything else is a crash.
 
+#include <fcntl.h>
 #include <sys/prctl.h>
 #include <unistd.h>
 
@@ -53,18 +55,24 @@ std::string firstLineOf(const char* text) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // Gone with the program that asked: nobody would read the answer.
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (argc < 2 || argc > 3) {
-    std::fputs("usage: rotafab-read-mesh EXTENSION [PATH] < BYTES (run by rotafab, not by people)\n", stderr);
+  if (argc < 3 || argc > 4) {
+    std::fputs("usage: rotafab-read-mesh PARENT EXTENSION [PATH] < BYTES (run by rotafab, not by people)\n", stderr);
     return 2;
   }
+  // Gone with the program that asked: nobody would read the answer. Asked
+  // first, then checked: the parent may have gone before the ask.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (std::to_string(::getppid()) != argv[1]) ::_exit(5);
+  // The reply on a descriptor of its own; a library's prints go nowhere.
+  const int replyTo = ::fcntl(STDOUT_FILENO, F_DUPFD_CLOEXEC, 3);
+  if (const int devNull = ::open("/dev/null", O_WRONLY); devNull >= 0) ::dup2(devNull, STDOUT_FILENO);
+  if (replyTo < 0) ::_exit(6);
   namespace geo = rotafab::geometry;
   std::string reply;
   try {
     const std::string bytes = readAll(STDIN_FILENO);
-    const std::filesystem::path path = argc == 3 ? argv[2] : "";
-    reply = "M" + geo::serializeMesh(geo::readWithAssimp(bytes, argv[1], argc == 3 ? &path : nullptr));
+    const std::filesystem::path path = argc == 4 ? argv[3] : "";
+    reply = "M" + geo::serializeMesh(geo::readWithAssimp(bytes, argv[2], argc == 4 ? &path : nullptr));
   } catch (const geo::InvalidMeshError& error) {
     reply = std::string("E") + error.what();
   } catch (const std::bad_alloc&) {
@@ -75,5 +83,5 @@ int main(int argc, char** argv) {
   }
   // _exit: no destructors of Assimp's statics, and no leak report of a
   // sanitizer build (Debian's Assimp leaks on some inputs) in the way.
-  ::_exit(writeAll(STDOUT_FILENO, reply) ? 0 : 4);
+  ::_exit(writeAll(replyTo, reply) ? 0 : 4);
 }

@@ -47,6 +47,15 @@ PolygonMesh deserializeMesh(std::string_view bytes) {
     if (size > bytes.size() / sizeof(int)) throw InvalidMeshError("the reader's result was cut short");
     face.resize(size);
     take(face.data(), size * sizeof(int));
+    // What the importer goes on with must hold, whatever the reader's state
+    // was when it wrote (its heap may have been spoilt by a hostile file).
+    for (int v : face) {
+      if (v < 0 || static_cast<uint64_t>(v) >= vertices) throw InvalidMeshError("the reader's result is corrupt");
+    }
+  }
+  if (at != bytes.size()) throw InvalidMeshError("the reader's result is corrupt");
+  for (const Point3& p : mesh.positions) {
+    if (!p.allFinite()) throw InvalidMeshError("the reader's result is corrupt");
   }
   return mesh;
 }

@@ -13,7 +13,8 @@ namespace rotafab::geometry {
 
 std::string serializeMesh(const PolygonMesh& mesh);
 
-// Throws InvalidMeshError when the bytes are cut short.
+// Throws InvalidMeshError when the bytes are cut short or are no mesh (an
+// index out of range, a coordinate not finite, bytes left over).
 PolygonMesh deserializeMesh(std::string_view bytes);
 
 }  // namespace rotafab::geometry

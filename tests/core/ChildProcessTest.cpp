@@ -5,15 +5,21 @@
 
 #include "core/ChildProcess.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <system_error>
 #include <thread>
+
+#include "support/TestSupport.h"
 
 namespace rotafab::core {
 namespace {
@@ -48,15 +54,33 @@ TEST(ChildProcess, AFailedExitIsACrashWithItsStatus) {
   EXPECT_EQ(result.exitCode, 3);
 }
 
-TEST(ChildProcess, HangIsKilledAtTheTimeout) {
+// The child's process id, which it wrote into `file`; and whether a process
+// of that id is still there (a zombie would be).
+bool stillThere(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  pid_t pid = 0;
+  in >> pid;
+  EXPECT_GT(pid, 0) << "the child wrote no process id";
+  return pid > 0 && (::kill(pid, 0) == 0 || errno != ESRCH);
+}
+
+TEST(ChildProcess, HangIsKilledAtTheTimeoutAndReaped) {
+  test::TempDir dir;
+  const auto pidFile = dir.path() / "pid";
   const auto start = std::chrono::steady_clock::now();
-  EXPECT_EQ(shell("exec sleep 30", {}, 300ms).status, ChildResult::Status::TimedOut);
+  EXPECT_EQ(shell("echo $$ > '" + pidFile.string() + "'; exec sleep 30", {}, 300ms).status,
+            ChildResult::Status::TimedOut);
+  EXPECT_FALSE(stillThere(pidFile));
   // A child that closed its output and still does not end.
-  EXPECT_EQ(shell("exec >&-; exec sleep 30", {}, 300ms).status, ChildResult::Status::TimedOut);
+  EXPECT_EQ(shell("exec >&-; echo $$ > '" + pidFile.string() + "'; exec sleep 30", {}, 300ms).status,
+            ChildResult::Status::TimedOut);
+  EXPECT_FALSE(stillThere(pidFile));
   EXPECT_LT(std::chrono::steady_clock::now() - start, 5s);
 }
 
 TEST(ChildProcess, ACancelKillsTheChildAtOnce) {
+  test::TempDir dir;
+  const auto pidFile = dir.path() / "pid";
   Cancellation cancellation;
   std::chrono::steady_clock::time_point cancelledAt;
   std::thread canceller([&] {
@@ -64,10 +88,37 @@ TEST(ChildProcess, ACancelKillsTheChildAtOnce) {
     cancelledAt = std::chrono::steady_clock::now();
     cancellation.cancel();
   });
-  EXPECT_THROW(shell("exec sleep 30", {}, 60s, &cancellation), Cancelled);
+  EXPECT_THROW(shell("echo $$ > '" + pidFile.string() + "'; exec sleep 30", {}, 60s, &cancellation), Cancelled);
   const auto returnedAt = std::chrono::steady_clock::now();
   canceller.join();
   EXPECT_LT(returnedAt - cancelledAt, 500ms);
+  EXPECT_FALSE(stillThere(pidFile)) << "the cancelled child is still there";
+}
+
+TEST(ChildProcess, TheChildHasOnlyItsThreeStandardDescriptors) {
+  // One the caller opened without close-on-exec, as some libraries do.
+  const int leaky = ::open("/dev/null", O_RDONLY);
+  ASSERT_GE(leaky, 3);
+  const ChildResult result = shell("cd /proc/self/fd && echo *");
+  ::close(leaky);
+  ASSERT_EQ(result.status, ChildResult::Status::Finished);
+  // The shell's glob opens the folder itself: one more descriptor, its own.
+  EXPECT_EQ(result.output.substr(0, 6), "0 1 2 ") << result.output;
+  EXPECT_EQ(result.output.find(" " + std::to_string(leaky) + " "), std::string::npos) << result.output;
+  EXPECT_LE(std::count(result.output.begin(), result.output.end(), ' '), 3) << result.output;
+}
+
+TEST(ChildProcess, AnExitStatusThatCannotBeHadIsNoAnswer) {
+  // With SIGCHLD ignored the system reaps the child itself: its status is
+  // lost, and what it wrote is not taken as a whole answer.
+  struct sigaction ignore {
+  }, previous{};
+  ignore.sa_handler = SIG_IGN;
+  ::sigaction(SIGCHLD, &ignore, &previous);
+  const ChildResult result = shell("printf partial; exit 1");
+  ::sigaction(SIGCHLD, &previous, nullptr);
+  EXPECT_EQ(result.status, ChildResult::Status::Crashed);
+  EXPECT_TRUE(result.output.empty());
 }
 
 TEST(ChildProcess, StartsWithDefaultSignalsInAGroupOfItsOwn) {
