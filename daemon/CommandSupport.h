@@ -36,6 +36,8 @@ inline std::string flagOf(geometry::Parameter parameter) {
       return "--structure";
     case geometry::Parameter::Holes:
       return "--holes";
+    case geometry::Parameter::Repair:
+      return "--repair";
     case geometry::Parameter::Size:
       return "--size";
     case geometry::Parameter::Scale:

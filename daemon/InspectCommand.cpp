@@ -10,6 +10,8 @@
 #include "daemon/ExitCode.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
+#include "geometry/MeshRepair.h"
+#include "jobs/Manifest.h"
 
 namespace rotafab::cli {
 namespace {
@@ -31,7 +33,25 @@ nlohmann::ordered_json topologyJson(const geometry::MeshTopology& t) {
           {"manifold", t.manifold}};
 }
 
-void printText(const std::string& name, const geometry::PolygonMesh& mesh, const geometry::MeshAnalysis& analysis) {
+void printRepairPreview(const geometry::RepairPreview& preview) {
+  if (preview.repairs.empty()) {
+    fmt::print("`rotafab make` (--repair auto) has nothing to repair here; it refuses this mesh too\n");
+    return;
+  }
+  fmt::print("`rotafab make` (--repair auto) would:\n");
+  for (const auto& repair : preview.repairs) fmt::print("  {}\n", repair.line());
+  if (preview.after.usable()) {
+    const auto& after = preview.after.topology;
+    fmt::print("after which the mesh is usable (genus {}, {} component{})\n",
+               after.genus ? std::to_string(*after.genus) : "undefined", after.components,
+               after.components == 1 ? "" : "s");
+  } else {
+    fmt::print("and still refuse it: {}\n", preview.after.problems.front().message);
+  }
+}
+
+void printText(const std::string& name, const geometry::PolygonMesh& mesh, const geometry::MeshAnalysis& analysis,
+               const geometry::RepairPreview& preview) {
   const auto& t = analysis.topology;
   std::map<size_t, int> sides;
   for (const auto& face : mesh.faces) ++sides[face.size()];
@@ -56,23 +76,30 @@ void printText(const std::string& name, const geometry::PolygonMesh& mesh, const
     return;
   }
   constexpr size_t kShown = 20;
-  fmt::print("{} problem{} (`rotafab make` refuses this mesh):\n", analysis.problems.size(),
+  fmt::print("{} problem{} (`rotafab make --repair none` refuses this mesh):\n", analysis.problems.size(),
              analysis.problems.size() == 1 ? "" : "s");
   for (size_t i = 0; i < analysis.problems.size() && i < kShown; ++i)
     fmt::print("  {}\n", analysis.problems[i].message);
   if (analysis.problems.size() > kShown) fmt::print("  ... and {} more\n", analysis.problems.size() - kShown);
+  printRepairPreview(preview);
 }
 
 int runInspect(const InspectOptions& options) {
   try {
     geometry::ImportedMesh imported = geometry::importMesh(options.mesh);
     for (const auto& warning : imported.warnings) fmt::print(stderr, "warning: {}: {}\n", options.mesh, warning);
+    const geometry::RepairPreview preview = geometry::previewRepair(imported.mesh);
     const geometry::MeshAnalysis analysis = geometry::analyzeMesh(imported.mesh);
     if (options.json) {
       for (const auto& note : analysis.notes) fmt::print(stderr, "note: {}: {}\n", options.mesh, note);
-      std::cout << topologyJson(analysis.topology).dump() << '\n';
+      nlohmann::ordered_json object = topologyJson(analysis.topology);
+      if (!analysis.usable()) {
+        object["repairs"] = jobs::repairsJson(preview.repairs);
+        object["usable_after_repair"] = preview.after.usable();
+      }
+      std::cout << object.dump() << '\n';
     } else {
-      printText(options.mesh, imported.mesh, analysis);
+      printText(options.mesh, imported.mesh, analysis, preview);
     }
     return kSuccess;
   } catch (const geometry::InvalidMeshError& error) {
@@ -96,7 +123,8 @@ void addInspectCommand(CLI::App& app, int& status) {
       ->required();
   inspect->add_flag("--json", options->json,
                     "Print one JSON object: vertices, edges, faces, boundary_loops, components, euler, genus, "
-                    "orientable, manifold");
+                    "orientable, manifold; for a broken mesh also repairs (what `make --repair auto` would do) and "
+                    "usable_after_repair");
   inspect->footer(
       "Counts are of the mesh as imported and cleaned: vertices at identical positions welded, faces with fewer than "
       "3\n"

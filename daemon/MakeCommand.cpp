@@ -18,7 +18,7 @@ namespace {
 
 struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
-  std::string size, fastener, kerf, holes = "keep", up = "y", order = "window", layout = "nest";
+  std::string size, fastener, kerf, holes = "keep", repair = "auto", up = "y", order = "window", layout = "nest";
   std::optional<double> scale, tension;
   std::optional<int> start;
   int samples = 8, window = 8;
@@ -37,6 +37,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.holes = options.holes == "fill"    ? jobs::HolesMode::Fill
                   : options.holes == "error" ? jobs::HolesMode::Error
                                              : jobs::HolesMode::Keep;
+  request.repair = options.repair == "auto";
   request.tension = options.tension;
   request.samples = options.samples;
   if (!options.fastener.empty()) request.fastener = lengthOption(options.fastener, "--fastener", true);
@@ -118,6 +119,11 @@ void addMakeCommand(CLI::App& app, int& status) {
   make->add_option("--holes", options->holes, "Open meshes: keep the boundary open, fill each hole, or refuse")
       ->capture_default_str()
       ->check(CLI::IsMember({"keep", "fill", "error"}));
+  make->add_option("--repair", options->repair,
+                   "auto: weld, drop duplicate faces, split non-manifold edges and bow-tie vertices, orient (each "
+                   "repair said and recorded in manifest.json); none: refuse a broken mesh")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "none"}));
   make->add_option("--tension", options->tension,
                    "Corner-cutting tension a of eq. 5.2, 0 < a < 1 (default: Doo-Sabin, a = 1/4 + 5/(4N))");
   make->add_option("--samples", options->samples, "Segments along each edge band")

@@ -7,37 +7,9 @@
 #include <queue>
 #include <unordered_map>
 
+#include "geometry/EdgeUses.h"
+
 namespace rotafab::geometry {
-namespace {
-
-class DisjointSets {
- public:
-  explicit DisjointSets(size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0); }
-  int find(int x) {
-    while (parent_[x] != x) x = parent_[x] = parent_[parent_[x]];
-    return x;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
-  }
-
- private:
-  std::vector<int> parent_;
-};
-
-// One side of an edge: face `face` runs from `from` to `to` at corner `corner`
-// (the corner of `from`; corners are numbered over all faces in order).
-struct EdgeUse {
-  int low, high;  // the edge's endpoints, low < high
-  int face;
-  int corner;
-  bool forward;  // from == low
-};
-
-}  // namespace
-
 MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
   MeshAnalysis analysis;
   MeshTopology& topology = analysis.topology;
@@ -45,10 +17,9 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
   topology.faces = mesh.faceCount();
   const double diagonal = boundingBoxDiagonal(mesh);
 
-  std::vector<int> firstCorner(mesh.faces.size() + 1, 0);
-  for (size_t f = 0; f < mesh.faces.size(); ++f)
-    firstCorner[f + 1] = firstCorner[f] + static_cast<int>(mesh.faces[f].size());
-  const int cornerCount = firstCorner.back();
+  const EdgeUses edgeUses(mesh);
+  const std::vector<EdgeUse>& uses = edgeUses.uses;
+  const int cornerCount = edgeUses.cornerCount();
 
   // Messages name elements as the file numbers them.
   auto vertexName = [&](int v) { return mesh.sourceVertexIndex(v); };
@@ -59,8 +30,6 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     return formatIndexList(names);
   };
 
-  std::vector<EdgeUse> uses;
-  uses.reserve(cornerCount);
   std::vector<char> faceHasRepeat(mesh.faces.size(), 0);
   for (int f = 0; f < mesh.faceCount(); ++f) {
     const auto& face = mesh.faces[f];
@@ -77,23 +46,8 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
           {MeshProblemKind::ZeroAreaFace,
            fmt::format("face {} has zero area (its corners {} are collinear)", faceName(f), vertexNames(face))});
     }
-    for (size_t i = 0; i < face.size(); ++i) {
-      const int from = face[i], to = face[(i + 1) % face.size()];
-      uses.push_back({std::min(from, to), std::max(from, to), f, firstCorner[f] + static_cast<int>(i), from < to});
-    }
   }
-  std::sort(uses.begin(), uses.end(), [](const EdgeUse& a, const EdgeUse& b) {
-    return std::tie(a.low, a.high, a.face) < std::tie(b.low, b.high, b.face);
-  });
-
-  // Corner of `face` at vertex v, given the corner where the face leaves `from`.
-  auto cornerAt = [&](const EdgeUse& use, int vertex) {
-    const int from = use.forward ? use.low : use.high;
-    if (vertex == from) return use.corner;
-    const int size = static_cast<int>(mesh.faces[use.face].size());
-    const int local = use.corner - firstCorner[use.face];
-    return firstCorner[use.face] + (local + 1) % size;
-  };
+  auto cornerAt = [&](const EdgeUse& use, int vertex) { return edgeUses.cornerAt(use, vertex); };
 
   DisjointSets fans(cornerCount);  // corners around a vertex joined across shared edges
   DisjointSets vertexComponents(mesh.positions.size());
@@ -148,7 +102,7 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
     for (int f = 0; f < mesh.faceCount(); ++f) {
       if (faceHasRepeat[f]) continue;
       for (size_t i = 0; i < mesh.faces[f].size(); ++i) {
-        const int corner = firstCorner[f] + static_cast<int>(i);
+        const int corner = edgeUses.firstCorner[f] + static_cast<int>(i);
         const int root = fans.find(corner);
         if (!seenRoot[root]) {
           seenRoot[root] = 1;
@@ -237,7 +191,7 @@ MeshAnalysis analyzeMesh(PolygonMesh& mesh) {
   for (int f = 0; f < mesh.faceCount(); ++f) {
     if (flip[f] != reverseComponent[faceComponent[f]]) {
       std::reverse(mesh.faces[f].begin(), mesh.faces[f].end());
-      ++analysis.flippedFaces;
+      if (analysis.flippedFaces++ == 0) analysis.firstFlippedFace = f;
       if (hadRelativeFlips[faceComponent[f]]) ++consistencyFlips;
     }
   }

@@ -35,6 +35,7 @@ struct MeshAnalysis {
   MeshTopology topology;
   std::vector<MeshProblem> problems;
   int flippedFaces = 0;            // faces reversed to make the orientation consistent
+  int firstFlippedFace = -1;       // the lowest of them (an index in the mesh), -1: none
   std::vector<std::string> notes;  // what was repaired, for people
 
   [[nodiscard]] bool usable() const { return problems.empty(); }

@@ -8,6 +8,8 @@ std::string parameterInWords(Parameter parameter) {
       return "structure";
     case Parameter::Holes:
       return "holes";
+    case Parameter::Repair:
+      return "repair";
     case Parameter::Size:
       return "structure size";
     case Parameter::Scale:

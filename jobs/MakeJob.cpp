@@ -14,6 +14,7 @@
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
+#include "geometry/MeshRepair.h"
 #include "geometry/ObjWriter.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/OutputFolder.h"
@@ -40,18 +41,28 @@ class Lap {
 const char* plural(int n) { return n == 1 ? "" : "s"; }
 
 // The mesh as read, checked, its holes filled if asked, at construction size.
-geometry::PolygonMesh importedMesh(const MakeRequest& request, MeshCounts& counts, const core::WorkContext& context) {
+geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context) {
   const std::string name = request.mesh.string();
   context.report({"import", "", 0, 0});
   geometry::ImportedMesh imported = geometry::importMesh(request.mesh, &context.cancellation());
   for (const auto& warning : imported.warnings) context.warn(fmt::format("{}: {}", name, warning));
   geometry::PolygonMesh& mesh = imported.mesh;
+  std::vector<geometry::MeshRepair> repairs;
+  if (request.repair) {
+    repairs = geometry::repairMesh(mesh);
+    for (const auto& repair : repairs) context.note(fmt::format("{}: repaired: {}", name, repair.line()));
+  }
   geometry::MeshAnalysis analysis = geometry::analyzeMesh(mesh);
   for (const auto& note : analysis.notes) context.note(fmt::format("{}: {}", name, note));
+  if (const geometry::MeshRepair oriented = geometry::orientRepair(analysis, mesh); oriented.count > 0) {
+    repairs.push_back(oriented);
+  }
   try {
     geometry::requireUsable(analysis);
   } catch (const geometry::InvalidMeshError& error) {
-    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    throw core::UserError(fmt::format(
+        "{}: {}{}", name, error.what(),
+        request.repair ? "" : fmt::format("; {} auto repairs it where it can", request.names(Parameter::Repair))));
   }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {
@@ -72,7 +83,7 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, MeshCounts& count
   }
   // The mesh as built (after --holes fill): one panel per face.
   const geometry::MeshTopology& topology = analysis.topology;
-  counts = {topology.vertices, topology.edges, topology.faces, topology.genus};
+  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs)};
   double scale = 0;
   try {
     scale = geometry::constructionScale(mesh, request.size, request.scale, request.names);

@@ -34,6 +34,7 @@ struct MakeRequest {
   std::optional<double> size;   // the largest side, inches; or
   std::optional<double> scale;  // inches per mesh unit; neither: the mean edge becomes 2 in
   HolesMode holes = HolesMode::Keep;
+  bool repair = true;  // SPEC's --repair auto (geometry/MeshRepair.h); false: none, a broken mesh is refused
   // The band decomposition's options (geometry/BandStructure.h).
   std::optional<double> tension;
   int samples = 8;
@@ -58,7 +59,7 @@ struct PhaseSeconds {
 struct PlannedJob {
   std::filesystem::path meshFile;  // as the request named it
   std::string title;               // "bunny (band)"
-  MeshCounts mesh;                 // of the mesh as built (after --holes fill)
+  BuiltMesh mesh;                  // of the mesh as built (after --holes fill)
   profiles::Bed bed;               // the machine's
   geometry::Structure structure;
   std::vector<Part> parts;  // structureParts()

@@ -79,7 +79,15 @@ nlohmann::ordered_json sourceOf(const geometry::PanelSource& source) {
 
 }  // namespace
 
-nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const MeshCounts& mesh,
+nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs) {
+  nlohmann::ordered_json list = nlohmann::ordered_json::array();
+  for (const geometry::MeshRepair& repair : repairs) {
+    list.push_back({{"kind", repair.kind}, {"count", repair.count}, {"first", repair.first}});
+  }
+  return list;
+}
+
+nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
                                          const profiles::Bed& bed, const SheetPlan& plan,
                                          const std::vector<std::vector<std::string>>& files) {
   nlohmann::ordered_json manifest;
@@ -90,6 +98,7 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
                       {"edges", mesh.edges},
                       {"faces", mesh.faces},
                       {"genus", mesh.genus ? nlohmann::ordered_json(*mesh.genus) : nlohmann::ordered_json(nullptr)}};
+  if (!mesh.repairs.empty()) manifest["repairs"] = repairsJson(mesh.repairs);
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
   // Which panel (and piece) each planned part is, in structureParts()'s order.

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "geometry/MeshRepair.h"
 #include "geometry/Structure.h"
 #include "jobs/Part.h"
 #include "jobs/SheetPlanner.h"
@@ -17,10 +18,16 @@
 
 namespace rotafab::jobs {
 
-struct MeshCounts {
+// The mesh as built (repaired, its holes filled if asked): SPEC's "mesh"
+// counts, and the repairs made to it ("repairs", named and counted).
+struct BuiltMesh {
   int vertices = 0, edges = 0, faces = 0;
   std::optional<int> genus;
+  std::vector<geometry::MeshRepair> repairs;
 };
+
+// SPEC's manifest "repairs": [{"kind", "count", "first"}], in the order made.
+nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs);
 
 // The panels as parts for the planner: outline, holes (polygons of
 // kHoleSides sides around the circle, so the fastener still passes), labels
@@ -35,7 +42,7 @@ std::vector<Part> structureParts(const geometry::Structure& structure);
 std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure);
 
 // `files[s]`: the files written for sheet s + 1.
-nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const MeshCounts& mesh,
+nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
                                          const profiles::Bed& bed, const SheetPlan& plan,
                                          const std::vector<std::vector<std::string>>& files);
 

@@ -327,6 +327,51 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   fails(mesh + " --structure pleat", 2, "--structure");
 }
 
+// A broken mesh of the kind people download: two solids touching at a
+// vertex (the file's vertex 2), one face given twice. By default make repairs
+// it, says each repair on stderr and records it in manifest.json; with
+// --repair none it refuses it and says that auto repairs it.
+TEST(MakeCli, RepairsABrokenMeshAndSaysSo) {
+  TempDir dir;
+  const std::string mesh = quoted(dir.write("touching.off",
+                                            "OFF\n8 9 0\n9 9 9\n0 0 0\n1 1 1\n1 0 0\n0 1 0\n2 2 1\n2 1 2\n1 2 2\n"
+                                            "3 1 3 4\n3 1 4 2\n3 1 2 3\n3 3 2 4\n"
+                                            "3 2 5 6\n3 2 6 7\n3 2 7 5\n3 5 7 6\n3 6 5 2\n"));
+  const CommandResult made =
+      run(kCli + " make " + mesh + " --structure band --size 12in --time 0 --json --out " + quoted(dir.path() / "a"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  EXPECT_EQ(nlohmann::json::parse(made.out).at("panels"), 8);
+  EXPECT_NE(made.err.find("repaired: dropped 1 duplicate face (the first: face 8)"), std::string::npos) << made.err;
+  EXPECT_NE(made.err.find("repaired: split 1 bow-tie vertex into one copy per fan of faces (the first: vertex 2)"),
+            std::string::npos)
+      << made.err;
+  const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
+  ASSERT_TRUE(manifest.contains("repairs")) << manifest.dump();
+  const auto& repairs = manifest.at("repairs");
+  ASSERT_GE(repairs.size(), 2u);
+  EXPECT_EQ(repairs[0], nlohmann::json({{"kind", "drop-duplicate-face"}, {"count", 1}, {"first", "face 8"}}));
+  EXPECT_EQ(repairs[1], nlohmann::json({{"kind", "split-bowtie"}, {"count", 1}, {"first", "vertex 2"}}));
+  EXPECT_EQ(manifest.at("mesh").at("vertices"), 8) << "the counts are of the repaired mesh";
+  EXPECT_EQ(manifest.at("mesh").at("genus"), 0);
+
+  const CommandResult refused =
+      run(kCli + " make " + mesh + " --structure band --repair none --out " + quoted(dir.path() / "b"));
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("; --repair auto repairs it where it can"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "b"));
+
+  // inspect says what auto would do, in both forms.
+  const CommandResult text = run(kCli + " inspect " + mesh);
+  EXPECT_EQ(text.status, 0);
+  EXPECT_NE(text.out.find("`rotafab make` (--repair auto) would:\n  dropped 1 duplicate face"), std::string::npos)
+      << text.out;
+  EXPECT_NE(text.out.find("after which the mesh is usable (genus 0, 2 components)"), std::string::npos) << text.out;
+  const auto json = nlohmann::json::parse(run(kCli + " inspect --json " + mesh).out);
+  EXPECT_EQ(json.at("manifold"), false);
+  EXPECT_EQ(json.at("usable_after_repair"), true);
+  EXPECT_EQ(json.at("repairs").size(), 2u);
+}
+
 // Ctrl-C while the bunny is being nested (and SIGTERM, as a service manager
 // sends it): make stops at once, says so, leaves no folder, and exits as a
 // shell expects of a command a signal stopped. Started in the background by

@@ -15,6 +15,7 @@
 #include "geometry/FloodFill.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
+#include "geometry/MeshRepair.h"
 #include "geometry/PanelUnfolding.h"
 #include "geometry/Primitives.h"
 #include "support/CrumpledMesh.h"
@@ -29,9 +30,19 @@ using test::atConstructionSize;
 
 PolygonMesh imported(const std::filesystem::path& path) { return atConstructionSize(importMesh(path.string()).mesh); }
 
+// Two cubes that share an edge (non-manifold), as --repair auto leaves them:
+// two closed cubes, each with its own copy of the edge.
+PolygonMesh cubesSharingAnEdgeRepaired() {
+  PolygonMesh mesh = cube();
+  test::append(mesh, cube(), Point3(2, 2, 0));
+  cleanMesh(mesh);
+  EXPECT_EQ(repairMesh(mesh).size(), 1u);
+  return atConstructionSize(mesh);
+}
+
 // Meshes made here, the bunny, and two that other programs wrote: Geomview's
 // tube of quads (open, two boundary loops) and CGAL's double torus with three
-// holes (genus 2, open, triangles).
+// holes (genus 2, open, triangles); and a mesh repaired by --repair auto.
 std::map<std::string, PolygonMesh> meshes() {
   return {{"soccer ball", atConstructionSize(truncatedIcosahedron())},
           {"torus", atConstructionSize(torus(10, 6))},
@@ -39,7 +50,8 @@ std::map<std::string, PolygonMesh> meshes() {
           {"disc", atConstructionSize(disc(7))},
           {"bunny", imported(std::string(ROTAFAB_SOURCE_DIR) + "/examples/bunny.obj")},
           {"tref.off", imported(test::publicMesh("/usr/share/geomview/geom/tref.off"))},
-          {"double-torus-3-holes.off", imported(test::publicMesh(test::cgalMesh("double-torus-3-holes.off")))}};
+          {"double-torus-3-holes.off", imported(test::publicMesh(test::cgalMesh("double-torus-3-holes.off")))},
+          {"cubes sharing an edge, repaired", cubesSharingAnEdgeRepaired()}};
 }
 
 // Both copies of every band carry its holes: the same number, the same
@@ -191,7 +203,8 @@ TEST(BandStructure, LabelsStayInsideTheirPanelsClearOfHolesAndEachOther) {
 }
 
 // Flood fill: panel 1 is the lowest face; each later panel joins one
-// numbered before it; numbers are a breadth-first order.
+// numbered before it, but the first of another piece of the mesh, which is
+// the lowest face not yet reached; numbers are a breadth-first order.
 TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
   for (auto& [name, mesh] : meshes()) {
     BandOptions options;
@@ -200,10 +213,22 @@ TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
     int previousParent = 0;
     for (const Panel& panel : s.panels) {
       if (panel.id == 1) continue;
-      const int parent =
-          std::min_element(panel.joins.begin(), panel.joins.end(), [](const PanelJoin& a, const PanelJoin& b) {
-            return a.panel < b.panel;
-          })->panel;
+      const auto earliest = std::min_element(panel.joins.begin(), panel.joins.end(),
+                                             [](const PanelJoin& a, const PanelJoin& b) { return a.panel < b.panel; });
+      if (earliest == panel.joins.end() || earliest->panel > panel.id) {
+        // A piece of its own: it starts from its lowest face.
+        std::map<int, int> faceOfSource;
+        for (int f = 0; f < mesh.faceCount(); ++f) faceOfSource[mesh.sourceFaceIndex(f)] = f;
+        const double height = faceCentroid(mesh, faceOfSource.at(panel.source.face)).y();
+        for (const Panel& later : s.panels) {
+          if (later.id <= panel.id) continue;
+          EXPECT_LE(height, faceCentroid(mesh, faceOfSource.at(later.source.face)).y())
+              << name << ": panel " << panel.id << " starts a piece but is not its lowest face";
+        }
+        previousParent = panel.id;
+        continue;
+      }
+      const int parent = earliest->panel;
       EXPECT_LT(parent, panel.id) << name << ": panel " << panel.id << " joins no panel placed before it";
       EXPECT_GE(parent, previousParent) << name << ": not breadth-first at panel " << panel.id;
       previousParent = parent;

@@ -21,16 +21,6 @@ std::vector<std::string> messages(const MeshAnalysis& analysis) {
   return out;
 }
 
-// Appends `other` to `mesh` as a separate component.
-void append(PolygonMesh& mesh, const PolygonMesh& other, const Point3& offset) {
-  const int base = mesh.vertexCount();
-  for (const auto& p : other.positions) mesh.positions.push_back(p + offset);
-  for (auto face : other.faces) {
-    for (int& v : face) v += base;
-    mesh.faces.push_back(face);
-  }
-}
-
 TEST(MeshAnalysis, EdgeSharedByThreeFacesIsNamed) {
   PolygonMesh mesh;
   mesh.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
@@ -44,7 +34,7 @@ TEST(MeshAnalysis, EdgeSharedByThreeFacesIsNamed) {
 TEST(MeshAnalysis, BowTieVertexIsNamed) {
   // Two tetrahedra touching at one vertex: every edge is fine, the vertex is not.
   PolygonMesh mesh = tetrahedron();
-  append(mesh, tetrahedron(), Point3(2, 2, 2));  // vertex 0 of the copy lands on (3,3,3); move it onto vertex 0
+  test::append(mesh, tetrahedron(), Point3(2, 2, 2));  // vertex 0 of the copy lands on (3,3,3); move it onto vertex 0
   mesh.positions[4] = mesh.positions[0];
   for (auto& face : mesh.faces)
     for (int& v : face)
@@ -124,8 +114,8 @@ TEST(MeshAnalysis, ZeroAreaFaceAndRepeatedCornerAreNamed) {
 TEST(MeshAnalysis, CountsOfSeveralComponentsAndBoundaries) {
   // A cube, a torus and an open disc, side by side.
   PolygonMesh mesh = cube();
-  append(mesh, torus(6, 4), Point3(10, 0, 0));
-  append(mesh, disc(5), Point3(-10, 0, 0));
+  test::append(mesh, torus(6, 4), Point3(10, 0, 0));
+  test::append(mesh, disc(5), Point3(-10, 0, 0));
   const MeshTopology t = test::topologyOf(mesh);
   EXPECT_EQ(t.components, 3);
   EXPECT_EQ(t.boundaryLoops, 1);

@@ -15,6 +15,17 @@ inline geometry::PolygonMesh atConstructionSize(geometry::PolygonMesh mesh) {
   return mesh;
 }
 
+// Appends `other` to `mesh`, its vertices moved by `offset` (a separate
+// component unless a vertex lands on one of `mesh`'s and is welded).
+inline void append(geometry::PolygonMesh& mesh, const geometry::PolygonMesh& other, const geometry::Point3& offset) {
+  const int base = mesh.vertexCount();
+  for (const auto& p : other.positions) mesh.positions.push_back(p + offset);
+  for (auto face : other.faces) {
+    for (int& v : face) v += base;
+    mesh.faces.push_back(face);
+  }
+}
+
 inline geometry::MeshTopology topologyOf(geometry::PolygonMesh mesh) { return geometry::analyzeMesh(mesh).topology; }
 
 }  // namespace rotafab::test

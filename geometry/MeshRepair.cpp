@@ -1,0 +1,231 @@
+#include "geometry/MeshRepair.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+
+#include "geometry/EdgeUses.h"
+#include "geometry/MeshImport.h"
+
+namespace rotafab::geometry {
+namespace {
+
+// Vertices within this share of the box's diagonal are one: far below any
+// edge a builder could cut, above the noise of a float written and read back.
+constexpr double kWeldTolerance = 1e-6;
+
+std::string vertexName(const PolygonMesh& mesh, int v) { return fmt::format("vertex {}", mesh.sourceVertexIndex(v)); }
+std::string faceName(const PolygonMesh& mesh, int f) { return fmt::format("face {}", mesh.sourceFaceIndex(f)); }
+
+// Welds vertices closer than the tolerance to an earlier one (a grid of cells
+// the tolerance wide: a near vertex is in the same cell or a neighbouring one).
+void weldNear(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
+  const double tolerance = kWeldTolerance * boundingBoxDiagonal(mesh);
+  if (!(tolerance > 0)) return;
+  using Cell = std::array<long long, 3>;
+  struct CellHash {
+    size_t operator()(const Cell& c) const {
+      return static_cast<size_t>(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+    }
+  };
+  std::unordered_map<Cell, std::vector<int>, CellHash> cells;
+  cells.reserve(mesh.positions.size());
+  auto cellOf = [&](const Point3& p) {
+    return Cell{static_cast<long long>(std::floor(p.x() / tolerance)),
+                static_cast<long long>(std::floor(p.y() / tolerance)),
+                static_cast<long long>(std::floor(p.z() / tolerance))};
+  };
+  int welded = 0, firstWelded = -1;
+  for (int v = 0; v < mesh.vertexCount(); ++v) {
+    const Cell cell = cellOf(mesh.positions[v]);
+    int onto = -1;
+    for (long long dx = -1; dx <= 1 && onto < 0; ++dx)
+      for (long long dy = -1; dy <= 1 && onto < 0; ++dy)
+        for (long long dz = -1; dz <= 1 && onto < 0; ++dz) {
+          const auto it = cells.find({cell[0] + dx, cell[1] + dy, cell[2] + dz});
+          if (it == cells.end()) continue;
+          for (int w : it->second) {
+            if ((mesh.positions[w] - mesh.positions[v]).norm() <= tolerance) {
+              onto = w;
+              break;
+            }
+          }
+        }
+    if (onto < 0) {
+      cells[cell].push_back(v);
+      continue;
+    }
+    if (firstWelded < 0) firstWelded = v;
+    ++welded;
+    mesh.positions[v] = mesh.positions[onto];  // cleanMesh() welds identical positions
+  }
+  if (welded == 0) return;
+  const std::string first = vertexName(mesh, firstWelded);
+  const int facesBefore = mesh.faceCount();
+  std::vector<int> sourcesBefore(mesh.faceCount());
+  for (int f = 0; f < mesh.faceCount(); ++f) sourcesBefore[f] = mesh.sourceFaceIndex(f);
+  cleanMesh(mesh);
+  repairs.push_back({"weld", welded, first});
+  if (const int collapsed = facesBefore - mesh.faceCount(); collapsed > 0) {
+    // The first face that went: the first source index missing from what is kept.
+    std::vector<int> kept(mesh.faceCount());
+    for (int f = 0; f < mesh.faceCount(); ++f) kept[f] = mesh.sourceFaceIndex(f);
+    std::sort(kept.begin(), kept.end());
+    int gone = sourcesBefore.front();
+    for (int source : sourcesBefore) {
+      if (!std::binary_search(kept.begin(), kept.end(), source)) {
+        gone = source;
+        break;
+      }
+    }
+    repairs.push_back({"drop-collapsed-face", collapsed, fmt::format("face {}", gone)});
+  }
+}
+
+// The face's corners from its lowest vertex, in the direction whose second
+// corner is lower: the same for the same cycle whichever way it runs.
+std::vector<int> canonicalCycle(const std::vector<int>& face) {
+  const size_t n = face.size();
+  const size_t low = static_cast<size_t>(std::min_element(face.begin(), face.end()) - face.begin());
+  const bool forward = face[(low + 1) % n] <= face[(low + n - 1) % n];
+  std::vector<int> cycle(n);
+  for (size_t i = 0; i < n; ++i) cycle[i] = face[forward ? (low + i) % n : (low + n - i) % n];
+  return cycle;
+}
+
+void dropDuplicateFaces(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
+  std::map<std::vector<int>, int> seen;
+  std::vector<char> duplicate(mesh.faces.size(), 0);
+  int count = 0, firstDuplicate = -1;
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (!seen.emplace(canonicalCycle(mesh.faces[f]), f).second) {
+      duplicate[f] = 1;
+      if (count++ == 0) firstDuplicate = f;
+    }
+  }
+  if (count == 0) return;
+  repairs.push_back({"drop-duplicate-face", count, faceName(mesh, firstDuplicate)});
+  std::vector<std::vector<int>> faces;
+  std::vector<int> sources;
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (duplicate[f]) continue;
+    faces.push_back(std::move(mesh.faces[f]));
+    sources.push_back(mesh.sourceFaceIndex(f));
+  }
+  mesh.faces = std::move(faces);
+  mesh.sourceFace = std::move(sources);
+}
+
+bool visitsAVertexTwice(std::vector<int> face) {
+  std::sort(face.begin(), face.end());
+  return std::adjacent_find(face.begin(), face.end()) != face.end();
+}
+
+// Cuts edges of more than two faces open and gives each fan of faces around
+// a vertex its own copy of it. Corners (face, position) around a vertex are
+// joined across every edge of exactly two faces; each class of corners is a
+// fan. An edge of more than two faces joins nothing, so its faces meet again
+// only where they share a fan at both ends.
+void splitFans(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
+  const EdgeUses edges(mesh);
+  DisjointSets fans(edges.cornerCount());
+  std::vector<char> onCutEdge(mesh.positions.size(), 0);
+  int cutEdges = 0;
+  std::string firstCut;
+  edges.forEachEdge([&](size_t begin, size_t end) {
+    const EdgeUse& a = edges.uses[begin];
+    if (end - begin == 2 && edges.uses[begin + 1].face != a.face) {
+      for (int v : {a.low, a.high}) fans.unite(edges.cornerAt(a, v), edges.cornerAt(edges.uses[begin + 1], v));
+    } else if (end - begin > 2) {
+      onCutEdge[a.low] = onCutEdge[a.high] = 1;
+      if (cutEdges++ == 0) {
+        const int x = mesh.sourceVertexIndex(a.low), y = mesh.sourceVertexIndex(a.high);
+        firstCut = fmt::format("edge ({}, {})", std::min(x, y), std::max(x, y));
+      }
+    }
+  });
+  // The first fan of a vertex keeps it; every other fan gets a copy.
+  std::vector<int> fanVertex(edges.cornerCount(), -1);  // by root corner
+  std::vector<char> hasFan(mesh.positions.size(), 0);
+  int bowTies = 0, firstBowTie = -1;
+  std::vector<char> countedBowTie(mesh.positions.size(), 0);
+  if (mesh.sourceVertex.empty()) {
+    mesh.sourceVertex.resize(mesh.positions.size());
+    std::iota(mesh.sourceVertex.begin(), mesh.sourceVertex.end(), 0);
+  }
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (visitsAVertexTwice(mesh.faces[f])) continue;  // left to the analysis, which refuses it
+    for (size_t i = 0; i < mesh.faces[f].size(); ++i) {
+      const int root = fans.find(edges.firstCorner[f] + static_cast<int>(i));
+      int& v = mesh.faces[f][i];
+      if (fanVertex[root] < 0) {
+        if (!hasFan[v]) {
+          hasFan[v] = 1;
+          fanVertex[root] = v;
+        } else {
+          if (!onCutEdge[v] && !countedBowTie[v]) {
+            countedBowTie[v] = 1;
+            if (bowTies++ == 0) firstBowTie = v;
+          }
+          fanVertex[root] = mesh.vertexCount();
+          mesh.positions.push_back(mesh.positions[v]);
+          mesh.sourceVertex.push_back(mesh.sourceVertex[v]);
+        }
+      }
+      v = fanVertex[root];
+    }
+  }
+  if (cutEdges > 0) repairs.push_back({"split-nonmanifold-edge", cutEdges, firstCut});
+  if (bowTies > 0) repairs.push_back({"split-bowtie", bowTies, vertexName(mesh, firstBowTie)});
+}
+
+}  // namespace
+
+std::string MeshRepair::line() const {
+  const bool one = count == 1;
+  std::string what;
+  if (kind == "weld") {
+    what =
+        fmt::format("welded {} vert{} to a nearer neighbour than 1e-6 of the mesh's size", count, one ? "ex" : "ices");
+  } else if (kind == "drop-collapsed-face") {
+    what = fmt::format("dropped {} face{} that the weld collapsed", count, one ? "" : "s");
+  } else if (kind == "drop-duplicate-face") {
+    what = fmt::format("dropped {} duplicate face{}", count, one ? "" : "s");
+  } else if (kind == "split-nonmanifold-edge") {
+    what = fmt::format("split {} edge{} shared by more than two faces", count, one ? "" : "s");
+  } else if (kind == "split-bowtie") {
+    what = fmt::format("split {} bow-tie vert{} into one copy per fan of faces", count, one ? "ex" : "ices");
+  } else if (kind == "orient") {
+    what = fmt::format("reversed {} face{} to orient the surface consistently and outwards", count, one ? "" : "s");
+  } else {
+    what = fmt::format("{}: {}", kind, count);
+  }
+  return fmt::format("{} (the first: {})", what, first);
+}
+
+std::vector<MeshRepair> repairMesh(PolygonMesh& mesh) {
+  std::vector<MeshRepair> repairs;
+  weldNear(mesh, repairs);
+  dropDuplicateFaces(mesh, repairs);
+  splitFans(mesh, repairs);
+  return repairs;
+}
+
+RepairPreview previewRepair(PolygonMesh copy) {
+  RepairPreview preview;
+  preview.repairs = repairMesh(copy);
+  preview.after = analyzeMesh(copy);
+  return preview;
+}
+
+MeshRepair orientRepair(const MeshAnalysis& analysis, const PolygonMesh& mesh) {
+  if (analysis.flippedFaces == 0) return {};
+  return {"orient", analysis.flippedFaces, faceName(mesh, analysis.firstFlippedFace)};
+}
+
+}  // namespace rotafab::geometry

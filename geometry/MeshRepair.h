@@ -1,0 +1,58 @@
+#pragma once
+// The repairs that make a mesh from the wild buildable (`make --repair
+// auto`), each named and counted with where the first one is, as the file
+// numbers its elements. In this order:
+//
+//   weld                    vertices within a tolerance relative to the
+//                           mesh's size (1e-6 of its box's diagonal) become one
+//                           (identical positions are welded on import); faces
+//                           that collapse with them go: drop-collapsed-face
+//   drop-duplicate-face     a face that runs through the same corners as an
+//                           earlier one, in either direction
+//   split-nonmanifold-edge  an edge of more than two faces is cut open; the
+//                           faces that meet around each end of it in one fan
+//                           keep a common copy of that end, so each sheet of
+//                           faces keeps its own edge and is closed again there
+//   split-bowtie            a vertex whose faces form several fans (surfaces
+//                           touching at a point) gets one copy per fan
+//
+// The orientation (consistent, and outward on closed components) is then
+// made by analyzeMesh() (MeshAnalysis.h), and orientRepair() names it. What
+// cannot be repaired (a non-orientable surface, a face that visits a vertex
+// twice, an edge still shared by three faces after the cut) stays a problem
+// of the analysis.
+
+#include <string>
+#include <vector>
+
+#include "geometry/MeshAnalysis.h"
+#include "geometry/PolygonMesh.h"
+
+namespace rotafab::geometry {
+
+struct MeshRepair {
+  std::string kind;   // as above: SPEC's manifest "repairs"[].kind
+  int count = 0;      // of the elements repaired
+  std::string first;  // "vertex 44", "edge (12, 57)", "face 9" (the file's numbering)
+
+  // One line for people: "split 2 bow-tie vertices (the first: vertex 44)".
+  [[nodiscard]] std::string line() const;
+};
+
+// Repairs the mesh in place (before analyzeMesh); the repairs made, in order
+// (none: empty). Vertex copies keep the source index of the vertex they copy.
+std::vector<MeshRepair> repairMesh(PolygonMesh& mesh);
+
+// What repairMesh() would do to a copy of the mesh, and the analysis of
+// the result (for `inspect`).
+struct RepairPreview {
+  std::vector<MeshRepair> repairs;
+  MeshAnalysis after;
+};
+RepairPreview previewRepair(PolygonMesh copy);
+
+// The faces analyzeMesh() reversed, as a repair record ("orient"); empty
+// kind when it reversed none.
+MeshRepair orientRepair(const MeshAnalysis& analysis, const PolygonMesh& mesh);
+
+}  // namespace rotafab::geometry
