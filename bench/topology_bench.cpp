@@ -21,9 +21,11 @@
 
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
+#include "geometry/CoplanarMerge.h"
 #include "geometry/FaceTracing.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
+#include "geometry/MeshRepair.h"
 #include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
 
@@ -99,6 +101,33 @@ void BM_Analyze(benchmark::State& state) {
   state.SetComplexityN(state.range(0));
 }
 BENCHMARK(BM_Analyze)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// `make --repair auto` (geometry/MeshRepair.h) on the torus with every
+// hundredth face given twice, so that each repair step has work. Target:
+// linear, under 1 s at 200k faces.
+void BM_Repair(benchmark::State& state) {
+  geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
+  const int faces = mesh.faceCount();
+  for (int f = 0; f < faces; f += 100) mesh.faces.push_back(mesh.faces[f]);
+  for (auto _ : state) {
+    geo::PolygonMesh copy = mesh;
+    benchmark::DoNotOptimize(geo::repairMesh(copy).size());
+  }
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_Repair)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// Merging coplanar faces (geometry/CoplanarMerge.h), as an STL gets it, on
+// the torus: each pair of triangles merged back into its grid's planar quad.
+void BM_MergeCoplanar(benchmark::State& state) {
+  const geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
+  for (auto _ : state) {
+    geo::PolygonMesh copy = mesh;
+    benchmark::DoNotOptimize(geo::mergeCoplanarFaces(copy, 1.0).regions);
+  }
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_MergeCoplanar)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
 
 void BM_RotationSystemAndTrace(benchmark::State& state) {
   const geo::PolygonMesh mesh = triangulatedTorus(state.range(0));

@@ -135,7 +135,7 @@ class Child {
 }  // namespace
 
 ChildResult runChild(const std::vector<std::string>& argv, std::string_view input, std::chrono::milliseconds timeout,
-                     const Cancellation* cancellation) {
+                     const Cancellation* cancellation, const std::vector<std::string>& environment) {
   if (argv.empty()) throw std::invalid_argument("runChild: no program");
   const Descriptor in = inputFile(input);
   int fds[2];
@@ -146,12 +146,22 @@ ChildResult runChild(const std::vector<std::string>& argv, std::string_view inpu
   std::vector<char*> args;
   for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
   args.push_back(nullptr);
+  std::vector<char*> env;
+  for (char** entry = environ; *entry; ++entry) env.push_back(*entry);
+  for (const std::string& entry : environment) {
+    const std::string name = entry.substr(0, entry.find('=') + 1);
+    if (std::none_of(env.begin(), env.end(), [&](const char* e) { return std::string_view(e).starts_with(name); })) {
+      env.push_back(const_cast<char*>(entry.c_str()));
+    }
+  }
+  env.push_back(nullptr);
   pid_t pid = -1;
   {
     const SpawnSetup setup(in.get(), writeEnd.get());
     const bool path = argv[0].find('/') != std::string::npos;
-    const int spawned = path ? ::posix_spawn(&pid, args[0], setup.actions(), setup.attributes(), args.data(), environ)
-                             : ::posix_spawnp(&pid, args[0], setup.actions(), setup.attributes(), args.data(), environ);
+    const int spawned =
+        path ? ::posix_spawn(&pid, args[0], setup.actions(), setup.attributes(), args.data(), env.data())
+             : ::posix_spawnp(&pid, args[0], setup.actions(), setup.attributes(), args.data(), env.data());
     if (spawned != 0) fail(spawned, "cannot start " + argv[0]);
   }
   Child child(pid);  // from here on, however this returns, the child is gone

@@ -38,7 +38,10 @@ struct ChildResult {
 // reaped; it is tied to the calling thread for that long (a helper may ask
 // to die with it: PR_SET_PDEATHSIG). Throws std::system_error when the
 // program cannot be started ("cannot start PROGRAM: ...").
+// `environment`: NAME=VALUE entries added to the caller's environment for
+// the child (an entry whose name the caller's environment has already is
+// not added: the user's setting wins).
 ChildResult runChild(const std::vector<std::string>& argv, std::string_view input, std::chrono::milliseconds timeout,
-                     const Cancellation* cancellation = nullptr);
+                     const Cancellation* cancellation = nullptr, const std::vector<std::string>& environment = {});
 
 }  // namespace rotafab::core

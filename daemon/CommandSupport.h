@@ -38,6 +38,8 @@ inline std::string flagOf(geometry::Parameter parameter) {
       return "--holes";
     case geometry::Parameter::Repair:
       return "--repair";
+    case geometry::Parameter::MergeCoplanar:
+      return "--merge-coplanar";
     case geometry::Parameter::Size:
       return "--size";
     case geometry::Parameter::Scale:

@@ -10,6 +10,8 @@ std::string parameterInWords(Parameter parameter) {
       return "holes";
     case Parameter::Repair:
       return "repair";
+    case Parameter::MergeCoplanar:
+      return "coplanar merge angle";
     case Parameter::Size:
       return "structure size";
     case Parameter::Scale:

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <regex>
@@ -10,6 +12,7 @@
 #include "core/UserError.h"
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
+#include "geometry/CoplanarMerge.h"
 #include "geometry/FastenerHoles.h"
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
@@ -40,6 +43,10 @@ class Lap {
 
 const char* plural(int n) { return n == 1 ? "" : "s"; }
 
+// An STL holds triangles only: its planar faces come back as one face each
+// when their triangles lie within this angle of one plane.
+constexpr double kStlMergeDegrees = 1.0;
+
 // The mesh as read, checked, its holes filled if asked, at construction size.
 geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context) {
   const std::string name = request.mesh.string();
@@ -63,6 +70,21 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
     throw core::UserError(fmt::format(
         "{}: {}{}", name, error.what(),
         request.repair ? "" : fmt::format("; {} auto repairs it where it can", request.names(Parameter::Repair))));
+  }
+  std::string extension = request.mesh.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  const double mergeDegrees = request.mergeCoplanar.value_or(extension == ".stl" ? kStlMergeDegrees : 0.0);
+  if (mergeDegrees > 0) {
+    const geometry::CoplanarMerge merged = geometry::mergeCoplanarFaces(mesh, mergeDegrees);
+    if (merged.regions > 0) {
+      context.note(
+          fmt::format("{}: merged its {} faces into {}, adjacent faces within {:g} degree{} of one plane "
+                      "becoming one ({} 0 keeps them apart)",
+                      name, merged.facesBefore, merged.facesAfter, mergeDegrees, mergeDegrees == 1 ? "" : "s",
+                      request.names(Parameter::MergeCoplanar)));
+      analysis = geometry::analyzeMesh(mesh);
+    }
   }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {

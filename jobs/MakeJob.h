@@ -34,6 +34,10 @@ struct MakeRequest {
   std::optional<double> size;   // the largest side, inches; or
   std::optional<double> scale;  // inches per mesh unit; neither: the mean edge becomes 2 in
   HolesMode holes = HolesMode::Keep;
+  // Adjacent faces within this many degrees of one plane become one face
+  // (geometry/CoplanarMerge.h); by default 1 for an STL file (triangles
+  // only), off (0) for every other format.
+  std::optional<double> mergeCoplanar;
   bool repair = true;  // SPEC's --repair auto (geometry/MeshRepair.h); false: none, a broken mesh is refused
   // The band decomposition's options (geometry/BandStructure.h).
   std::optional<double> tension;

@@ -2,6 +2,7 @@
 // built program: the files of SPEC, manifest.json as SPEC describes it,
 // sheets Ghostscript reads, exit statuses and one-line errors.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -370,6 +371,38 @@ TEST(MakeCli, RepairsABrokenMeshAndSaysSo) {
   EXPECT_EQ(json.at("manifold"), false);
   EXPECT_EQ(json.at("usable_after_repair"), true);
   EXPECT_EQ(json.at("repairs").size(), 2u);
+}
+
+// An STL holds triangles only: by default make merges faces within 1 degree
+// of one plane, so that a cube is 6 panels, as it was drawn, not 12.
+TEST(MakeCli, AnStlCubeIsSixPanels) {
+  TempDir dir;
+  const double corners[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const int triangles[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                                {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  std::string stl = "solid cube\n";
+  for (const auto& t : triangles) {
+    stl += "  facet normal 0 0 0\n    outer loop\n";
+    for (int v : t) stl += fmt::format("      vertex {} {} {}\n", corners[v][0], corners[v][1], corners[v][2]);
+    stl += "    endloop\n  endfacet\n";
+  }
+  const std::string mesh = quoted(dir.write("cube.stl", stl + "endsolid cube\n"));
+  const CommandResult merged =
+      run(kCli + " make " + mesh + " --structure band --size 8in --time 0 --json --out " + quoted(dir.path() / "a"));
+  ASSERT_EQ(merged.status, 0) << merged.err;
+  EXPECT_EQ(nlohmann::json::parse(merged.out).at("panels"), 6);
+  EXPECT_NE(merged.err.find("merged its 12 faces into 6"), std::string::npos) << merged.err;
+  const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
+  EXPECT_EQ(manifest.at("mesh"), nlohmann::json({{"vertices", 8}, {"edges", 12}, {"faces", 6}, {"genus", 0}}));
+  const CommandResult kept = run(kCli + " make " + mesh + " --structure band --size 8in --time 0 --json " +
+                                 "--merge-coplanar 0 --out " + quoted(dir.path() / "b"));
+  ASSERT_EQ(kept.status, 0) << kept.err;
+  EXPECT_EQ(nlohmann::json::parse(kept.out).at("panels"), 12);
+  // An STL OpenSCAD wrote (a sphere cut flat on one side: curved triangles stay, the flat ones merge).
+  const CommandResult openscad =
+      run(kCli + " make " + quoted(publicMesh("/usr/share/openscad/testdata/scad/3D/features/import.stl")) +
+          " --structure band --layout rows --json --out " + quoted(dir.path() / "c"));
+  EXPECT_EQ(openscad.status, 0) << openscad.err;
 }
 
 // Ctrl-C while the bunny is being nested (and SIGTERM, as a service manager

@@ -40,6 +40,15 @@ TEST(ChildProcess, InputGoesInAndOutputComesBackWhole) {
   EXPECT_EQ(result.output.find_first_not_of('x'), big.size());
 }
 
+TEST(ChildProcess, TheEnvironmentGetsWhatTheCallerAddsUnlessItHasItAlready) {
+  ::setenv("ROTAFAB_TEST_SET", "caller", 1);
+  const ChildResult result = runChild({"/bin/sh", "-c", "printf '%s %s' \"$ROTAFAB_TEST_SET\" \"$ROTAFAB_TEST_NEW\""},
+                                      "", 10s, nullptr, {"ROTAFAB_TEST_SET=added", "ROTAFAB_TEST_NEW=added"});
+  ::unsetenv("ROTAFAB_TEST_SET");
+  ASSERT_EQ(result.status, ChildResult::Status::Finished);
+  EXPECT_EQ(result.output, "caller added");
+}
+
 TEST(ChildProcess, AbortIsACrashWithItsSignal) {
   const ChildResult result = shell("printf partial; kill -ABRT $$");
   EXPECT_EQ(result.status, ChildResult::Status::Crashed);

@@ -1,0 +1,87 @@
+#include "daemon/MakeOptions.h"
+
+#include "daemon/CommandSupport.h"
+
+namespace rotafab::cli {
+
+jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalogue& catalogue) {
+  jobs::MakeRequest request;
+  request.mesh = options.mesh;
+  request.structure = options.structure == "weave" ? geometry::StructureKind::Weave : geometry::StructureKind::Band;
+  request.machine = profiles::findMachine(catalogue, options.machine);
+  request.material = profiles::findMaterial(catalogue, options.material);
+  if (!options.size.empty()) request.size = lengthOption(options.size, "--size", true);
+  request.scale = options.scale;
+  request.holes = options.holes == "fill"    ? jobs::HolesMode::Fill
+                  : options.holes == "error" ? jobs::HolesMode::Error
+                                             : jobs::HolesMode::Keep;
+  request.repair = options.repair == "auto";
+  request.mergeCoplanar = options.mergeCoplanar;
+  request.tension = options.tension;
+  request.samples = options.samples;
+  if (!options.fastener.empty()) request.fastener = lengthOption(options.fastener, "--fastener", true);
+  request.start = options.start;
+  request.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
+  request.scoreFolds = options.scoreFolds;
+  if (!options.kerf.empty()) request.kerf = lengthOption(options.kerf, "--kerf");
+  request.seconds = options.seconds;
+  request.order = orderOption(options.order);
+  request.window = options.window;
+  request.rows = options.layout == "rows";
+  request.names = flagOf;
+  return request;
+}
+
+void addMakeOptions(CLI::App& make, MakeOptions& options) {
+  make.add_option("MESH", options.mesh, "Mesh file: OBJ, OFF, PLY, STL, glTF/GLB, 3MF, ...")->required();
+  make.add_option("--structure", options.structure, "band (dissertation ch. V) or weave (ch. IV)")
+      ->required()
+      ->check(CLI::IsMember({"band", "weave"}));
+  make.add_option("--out", options.out, "Output folder (default: MESHNAME-band)");
+  make.add_option("--machine", options.machine, "Machine profile: the bed, margins and colours")->capture_default_str();
+  make.add_option("--material", options.material, "Material profile: kerf and fastener diameter")
+      ->capture_default_str();
+  make.add_flag("--json", options.json,
+                "Print one JSON object: panels, sheets, fasteners, utilization, seconds per phase");
+  auto* size = make.add_option("--size", options.size, "Scale so that the largest bounding-box side is this long");
+  make.add_option("--scale", options.scale, "Scale the mesh by this factor (inches per mesh unit)")->excludes(size);
+  make.add_option("--holes", options.holes, "Open meshes: keep the boundary open, fill each hole, or refuse")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"keep", "fill", "error"}));
+  make.add_option("--repair", options.repair,
+                  "auto: weld, drop duplicate faces, split non-manifold edges and bow-tie vertices, orient (each "
+                  "repair said and recorded in manifest.json); none: refuse a broken mesh")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "none"}));
+  make.add_option("--merge-coplanar", options.mergeCoplanar,
+                  "Merge adjacent faces within this many degrees of one plane into one panel (default: 1 for STL, "
+                  "whose faces are all triangles; 0 for other formats)")
+      ->check(CLI::Range(0.0, 45.0));
+  make.add_option("--tension", options.tension,
+                  "Corner-cutting tension a of eq. 5.2, 0 < a < 1 (default: Doo-Sabin, a = 1/4 + 5/(4N))");
+  make.add_option("--samples", options.samples, "Segments along each edge band")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 64));
+  make.add_option("--fastener", options.fastener, "Fastener hole diameter (default: the material's, 1/8 in)");
+  make.add_option("--kerf", options.kerf, "Kerf (default: the material's)");
+  make.add_option("--start", options.start, "Flood-fill start face (index in the file; default: the lowest face)");
+  make.add_option("--up", options.up, "The vertical axis, for the lowest face")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"x", "y", "z"}));
+  make.add_flag("--score-folds", options.scoreFolds, "Score the folds between each vertex band and its bands");
+  make.add_option("--time", options.seconds, "Nesting improvement budget in seconds")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 86400.0));
+  make.add_option("--order", options.order, "Cutting order: strict, window or free (see `rotafab nest`)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"strict", "window", "free"}));
+  make.add_option("--window", options.window, "With --order window: at most this many places from the assembly order")
+      ->capture_default_str();
+  make.add_option("--layout", options.layout,
+                  "nest (true shapes, interlocking) or rows (boxes in rows, in assembly order, on more sheets: a "
+                  "quick preview; --order, --window and --time do not apply)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"nest", "rows"}));
+}
+
+}  // namespace rotafab::cli

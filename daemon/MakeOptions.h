@@ -1,0 +1,31 @@
+#pragma once
+// The options of `rotafab make` (SPEC, "Command line"): their table, and the
+// request (jobs/MakeJob.h) they make.
+
+#include <CLI/CLI.hpp>
+#include <optional>
+#include <string>
+
+#include "jobs/MakeJob.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::cli {
+
+struct MakeOptions {
+  std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
+  std::string size, fastener, kerf, holes = "keep", repair = "auto", up = "y", order = "window", layout = "nest";
+  std::optional<double> scale, tension, mergeCoplanar;
+  std::optional<int> start;
+  int samples = 8, window = 8;
+  double seconds = 5.0;
+  bool json = false, scoreFolds = false;
+};
+
+// Declares every option of `make` on the verb, into `options`.
+void addMakeOptions(CLI::App& make, MakeOptions& options);
+
+// The request the options make; throws core::UserError on a bad length or an
+// unknown profile.
+jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalogue& catalogue);
+
+}  // namespace rotafab::cli

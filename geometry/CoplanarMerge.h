@@ -1,0 +1,28 @@
+#pragma once
+// Faces as the designer meant them: an STL holds triangles only, so a cube
+// comes as 12 triangles and would be built as 12 panels. Adjacent faces that
+// lie within an angle of one plane are merged into one polygon face, where
+// the merged face is a simple polygon (a region that would have a hole, or
+// pinch at a vertex, or fold over itself in the plane, is left as it is).
+//
+// A region grows from a seed face (in face order) across shared edges to
+// faces whose normal is within the angle of the seed's, so that every face
+// of a region is within the angle of one plane, the seed's. Every vertex on
+// a merged face's outline is kept (a neighbour may share it); a vertex inside
+// a merged region goes.
+
+#include "geometry/PolygonMesh.h"
+
+namespace rotafab::geometry {
+
+struct CoplanarMerge {
+  int facesBefore = 0;
+  int facesAfter = 0;
+  int regions = 0;  // merged faces made of more than one face
+};
+
+// The mesh must be an oriented manifold (analyzeMesh() has found no
+// problem); `degrees` > 0. Merged faces keep their seed's source index.
+CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees);
+
+}  // namespace rotafab::geometry
