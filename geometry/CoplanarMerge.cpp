@@ -1,10 +1,12 @@
 #include "geometry/CoplanarMerge.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <queue>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "core/Polygon2.h"
@@ -80,6 +82,53 @@ std::vector<int> regionOutline(const PolygonMesh& mesh, const std::vector<int>& 
   return outline;
 }
 
+// A vertex on a straight side between two merged faces, that had more
+// faces before and has only those two now, goes from both: the band
+// decomposition gives a face's corner at a vertex of two faces a place that
+// does not depend on the vertex, so two such vertices in a row would put one
+// point twice into a panel (V.1-V.2, a band of zero length). It stays where
+// taking it out would leave a face of two corners, add an edge the two faces
+// already share elsewhere, or bend the side by more than the angle.
+int straightenSides(const PolygonMesh& before, std::vector<std::vector<int>>& faces, double degrees) {
+  const size_t vertices = before.positions.size();
+  std::vector<int> facesBefore(vertices, 0);
+  for (const auto& face : before.faces)
+    for (int v : face) ++facesBefore[v];
+  std::vector<std::vector<int>> facesOf(vertices);
+  std::unordered_set<long long> edges;
+  auto key = [](int a, int b) { return edgeKey(std::min(a, b), std::max(a, b)); };
+  for (int f = 0; f < static_cast<int>(faces.size()); ++f) {
+    for (size_t i = 0; i < faces[f].size(); ++i) {
+      facesOf[faces[f][i]].push_back(f);
+      edges.insert(key(faces[f][i], faces[f][(i + 1) % faces[f].size()]));
+    }
+  }
+  const double cosLimit = std::cos(degrees * std::numbers::pi / 180.0);
+  int straightened = 0;
+  for (int v = 0; v < static_cast<int>(vertices); ++v) {
+    if (facesOf[v].size() != 2 || facesBefore[v] <= 2) continue;
+    auto& a = faces[facesOf[v][0]];
+    auto& b = faces[facesOf[v][1]];
+    if (a.size() <= 3 || b.size() <= 3) continue;
+    const size_t i = std::find(a.begin(), a.end(), v) - a.begin(), j = std::find(b.begin(), b.end(), v) - b.begin();
+    const int previous = a[(i + a.size() - 1) % a.size()], next = a[(i + 1) % a.size()];
+    // Inside the surface: b runs the same two sides the other way.
+    if (b[(j + 1) % b.size()] != previous || b[(j + b.size() - 1) % b.size()] != next) continue;
+    if (edges.count(key(previous, next))) continue;
+    const Point3 in = before.positions[v] - before.positions[previous],
+                 out = before.positions[next] - before.positions[v];
+    if (in.dot(out) < cosLimit * in.norm() * out.norm()) continue;
+    a.erase(a.begin() + static_cast<long>(i));
+    b.erase(b.begin() + static_cast<long>(j));
+    edges.erase(key(previous, v));
+    edges.erase(key(v, next));
+    edges.insert(key(previous, next));
+    facesOf[v].clear();
+    ++straightened;
+  }
+  return straightened;
+}
+
 }  // namespace
 
 CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees) {
@@ -96,8 +145,7 @@ CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees) {
   }
 
   std::vector<int> regionOf(mesh.faces.size(), -1);
-  std::vector<std::vector<int>> faces;
-  std::vector<int> sources;
+  std::unordered_map<int, std::vector<int>> outlineOfSeed;  // the merged regions
   for (int seed = 0; seed < mesh.faceCount(); ++seed) {
     if (regionOf[seed] >= 0) continue;
     const int id = seed;  // a region is named by its seed
@@ -117,19 +165,29 @@ CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees) {
     std::vector<int> outline;
     if (region.size() > 1) outline = regionOutline(mesh, region, regionOf, id, faceOfEdge, normals[seed]);
     if (outline.empty()) {
-      // Not one simple face: each face stays as it is (and leaves the region,
+      // Not one simple face: each face stays as it is (a region of its own,
       // so that no later region counts it as inside).
-      for (int f : region) {
-        regionOf[f] = mesh.faceCount() + f;
-        faces.push_back(mesh.faces[f]);
-        sources.push_back(mesh.sourceFaceIndex(f));
-      }
+      for (int f : region) regionOf[f] = mesh.faceCount() + f;
       continue;
     }
     ++result.regions;
-    faces.push_back(std::move(outline));
-    sources.push_back(mesh.sourceFaceIndex(seed));
+    outlineOfSeed.emplace(seed, std::move(outline));
   }
+  // In the order of the faces, each merged face where its seed was.
+  std::vector<std::vector<int>> faces;
+  std::vector<int> sources;
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    if (const auto merged = outlineOfSeed.find(f); merged != outlineOfSeed.end()) {
+      faces.push_back(std::move(merged->second));
+    } else if (regionOf[f] < mesh.faceCount()) {
+      continue;  // inside a merged face
+    } else {
+      faces.push_back(mesh.faces[f]);
+    }
+    sources.push_back(mesh.sourceFaceIndex(f));
+  }
+
+  if (result.regions > 0) result.straightened = straightenSides(mesh, faces, degrees);
 
   // Vertices no face refers to any more (inside a merged region) go; the
   // others keep their order and their source index. No welding: a vertex

@@ -7,9 +7,10 @@
 //
 // A region grows from a seed face (in face order) across shared edges to
 // faces whose normal is within the angle of the seed's, so that every face
-// of a region is within the angle of one plane, the seed's. Every vertex on
-// a merged face's outline is kept (a neighbour may share it); a vertex inside
-// a merged region goes.
+// of a region is within the angle of one plane, the seed's. A vertex inside
+// a merged region goes, and so does one left on a straight side between just
+// two merged faces; every other vertex on an outline is kept (a neighbour
+// shares it).
 
 #include "geometry/PolygonMesh.h"
 
@@ -18,7 +19,8 @@ namespace rotafab::geometry {
 struct CoplanarMerge {
   int facesBefore = 0;
   int facesAfter = 0;
-  int regions = 0;  // merged faces made of more than one face
+  int regions = 0;       // merged faces made of more than one face
+  int straightened = 0;  // vertices taken out of straight sides between two merged faces
 };
 
 // The mesh must be an oriented manifold (analyzeMesh() has found no

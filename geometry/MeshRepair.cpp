@@ -30,7 +30,10 @@ void weldNear(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
   using Cell = std::array<long long, 3>;
   struct CellHash {
     size_t operator()(const Cell& c) const {
-      return static_cast<size_t>(c[0] * 73856093LL ^ c[1] * 19349663LL ^ c[2] * 83492791LL);
+      // Unsigned: wraps where a signed product would overflow (a small part far from the origin).
+      return static_cast<size_t>(static_cast<unsigned long long>(c[0]) * 73856093ULL ^
+                                 static_cast<unsigned long long>(c[1]) * 19349663ULL ^
+                                 static_cast<unsigned long long>(c[2]) * 83492791ULL);
     }
   };
   std::unordered_map<Cell, std::vector<int>, CellHash> cells;
@@ -39,6 +42,31 @@ void weldNear(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
     return Cell{static_cast<long long>(std::floor(p.x() / tolerance)),
                 static_cast<long long>(std::floor(p.y() / tolerance)),
                 static_cast<long long>(std::floor(p.z() / tolerance))};
+  };
+  // Where each vertex goes (itself, or the earlier vertex it is welded to).
+  std::vector<int> target(mesh.positions.size());
+  std::iota(target.begin(), target.end(), 0);
+  std::vector<std::vector<int>> facesOf;  // made when first needed
+  // Whether welding v onto w would make a face visit w twice: v and a corner
+  // that is, or goes to, w are in one face and not neighbours there. (Two
+  // neighbours welded make the face one corner shorter, which is fine.)
+  auto wouldPinch = [&](int v, int w) {
+    if (facesOf.empty()) {
+      facesOf.resize(mesh.positions.size());
+      for (int f = 0; f < mesh.faceCount(); ++f)
+        for (int corner : mesh.faces[f]) facesOf[corner].push_back(f);
+    }
+    for (int f : facesOf[v]) {
+      const auto& corners = mesh.faces[f];
+      const size_t n = corners.size();
+      for (size_t i = 0; i < n; ++i) {
+        if (corners[i] != v) continue;
+        for (size_t j = 0; j < n; ++j) {
+          if (j != i && j != (i + 1) % n && j != (i + n - 1) % n && target[corners[j]] == w) return true;
+        }
+      }
+    }
+    return false;
   };
   int welded = 0, firstWelded = -1;
   for (int v = 0; v < mesh.vertexCount(); ++v) {
@@ -50,7 +78,7 @@ void weldNear(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
           const auto it = cells.find({cell[0] + dx, cell[1] + dy, cell[2] + dz});
           if (it == cells.end()) continue;
           for (int w : it->second) {
-            if ((mesh.positions[w] - mesh.positions[v]).norm() <= tolerance) {
+            if ((mesh.positions[w] - mesh.positions[v]).norm() <= tolerance && !wouldPinch(v, w)) {
               onto = w;
               break;
             }
@@ -62,6 +90,7 @@ void weldNear(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
     }
     if (firstWelded < 0) firstWelded = v;
     ++welded;
+    target[v] = onto;
     mesh.positions[v] = mesh.positions[onto];  // cleanMesh() welds identical positions
   }
   if (welded == 0) return;
@@ -131,6 +160,13 @@ bool visitsAVertexTwice(std::vector<int> face) {
 // joined across every edge of exactly two faces; each class of corners is a
 // fan. An edge of more than two faces joins nothing, so its faces meet again
 // only where they share a fan at both ends.
+// Edge sides with no other side: the open boundary.
+int loneSides(const EdgeUses& edges) {
+  int lone = 0;
+  edges.forEachEdge([&](size_t begin, size_t end) { lone += end - begin == 1; });
+  return lone;
+}
+
 void splitFans(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
   const EdgeUses edges(mesh);
   DisjointSets fans(edges.cornerCount());
@@ -180,7 +216,16 @@ void splitFans(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
       v = fanVertex[root];
     }
   }
-  if (cutEdges > 0) repairs.push_back({"split-nonmanifold-edge", cutEdges, firstCut});
+  if (cutEdges > 0) {
+    const int loneSidesBefore = loneSides(edges);
+    // Where no two faces at a cut edge share a fan at both of its ends, their
+    // sides stay open (an inner wall between two closed parts): say how many.
+    MeshRepair cut{"split-nonmanifold-edge", cutEdges, firstCut};
+    // Only cut edges change their count of sides: the rise in sides with no
+    // partner is theirs.
+    cut.leftOpen = loneSides(EdgeUses(mesh)) - loneSidesBefore;
+    repairs.push_back(cut);
+  }
   if (bowTies > 0) repairs.push_back({"split-bowtie", bowTies, vertexName(mesh, firstBowTie)});
 }
 
@@ -205,7 +250,12 @@ std::string MeshRepair::line() const {
   } else {
     what = fmt::format("{}: {}", kind, count);
   }
-  return fmt::format("{} (the first: {})", what, first);
+  std::string open;
+  if (leftOpen > 0) {
+    open = fmt::format("; {} side{} of them left open, where no two faces belonged together", leftOpen,
+                       leftOpen == 1 ? "" : "s");
+  }
+  return fmt::format("{} (the first: {}){}", what, first, open);
 }
 
 std::vector<MeshRepair> repairMesh(PolygonMesh& mesh) {

@@ -13,6 +13,10 @@
 //                           faces that meet around each end of it in one fan
 //                           keep a common copy of that end, so each sheet of
 //                           faces keeps its own edge and is closed again there
+//                           where it wraps around the ends (two solids that
+//                           touch along an edge); where it does not (a wall
+//                           inside a solid), the sides stay open, and are
+//                           counted (leftOpen)
 //   split-bowtie            a vertex whose faces form several fans (surfaces
 //                           touching at a point) gets one copy per fan
 //
@@ -34,6 +38,7 @@ struct MeshRepair {
   std::string kind;   // as above: SPEC's manifest "repairs"[].kind
   int count = 0;      // of the elements repaired
   std::string first;  // "vertex 44", "edge (12, 57)", "face 9" (the file's numbering)
+  int leftOpen = 0;   // split-nonmanifold-edge: edge sides that no other face closes (an inner wall's)
 
   // One line for people: "split 2 bow-tie vertices (the first: vertex 44)".
   [[nodiscard]] std::string line() const;

@@ -84,6 +84,12 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
                       name, merged.facesBefore, merged.facesAfter, mergeDegrees, mergeDegrees == 1 ? "" : "s",
                       request.names(Parameter::MergeCoplanar)));
       analysis = geometry::analyzeMesh(mesh);
+      try {
+        geometry::requireUsable(analysis);
+      } catch (const geometry::InvalidMeshError& error) {
+        throw core::UserError(fmt::format("{}: with its coplanar faces merged: {}; {} 0 keeps them apart", name,
+                                          error.what(), request.names(Parameter::MergeCoplanar)));
+      }
     }
   }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {

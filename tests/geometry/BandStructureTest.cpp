@@ -210,7 +210,7 @@ TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
     BandOptions options;
     const Structure s = buildBandStructure(mesh, options, test::context());
     EXPECT_EQ(s.panels.front().source.face, mesh.sourceFaceIndex(lowestFace(mesh, 1))) << name;
-    int previousParent = 0;
+    int previousParent = 0, pieces = 1;
     for (const Panel& panel : s.panels) {
       if (panel.id == 1) continue;
       const auto earliest = std::min_element(panel.joins.begin(), panel.joins.end(),
@@ -226,6 +226,7 @@ TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
               << name << ": panel " << panel.id << " starts a piece but is not its lowest face";
         }
         previousParent = panel.id;
+        ++pieces;
         continue;
       }
       const int parent = earliest->panel;
@@ -233,6 +234,7 @@ TEST(BandStructure, PanelsAreNumberedBreadthFirstFromTheLowestFace) {
       EXPECT_GE(parent, previousParent) << name << ": not breadth-first at panel " << panel.id;
       previousParent = parent;
     }
+    EXPECT_EQ(pieces, test::topologyOf(mesh).components) << name << ": a piece starts only where one begins";
     options.start = s.panels[3].source.face;
     EXPECT_EQ(buildBandStructure(mesh, options, test::context()).panels.front().source.face, options.start) << name;
   }

@@ -171,12 +171,37 @@ TEST(MeshRepair, MessagesNameTheFilesNumbering) {
   ASSERT_EQ(kinds(repairs), std::vector<std::string>{"split-bowtie"});
   EXPECT_EQ(repairs[0].first, "vertex 2");
   EXPECT_EQ(repairs[0].line(), "split 1 bow-tie vertex into one copy per fan of faces (the first: vertex 2)");
-  MeshAnalysis analysis = analyzeMesh(imported.mesh);
+  EXPECT_TRUE(analyzeMesh(imported.mesh).usable());
+}
+
+TEST(MeshRepair, AWallInsideASolidIsCutOffAndItsOpenSidesCounted) {
+  // Two cubes side by side with the square between them kept: each of its
+  // four edges has three faces, and no two of them belong together.
+  PolygonMesh mesh = cube();
+  test::append(mesh, cube(), Point3(2, 0, 0));
+  mesh = cleaned(mesh);
+  // The shared square is in both cubes once (x = 1), facing opposite ways:
+  // keep one of them as the wall, drop the other.
+  const auto repairs = repairMesh(mesh);
+  const MeshAnalysis analysis = analyzeMesh(mesh);
+  ASSERT_FALSE(repairs.empty());
+  const auto cut = std::find_if(repairs.begin(), repairs.end(),
+                                [](const MeshRepair& r) { return r.kind == "split-nonmanifold-edge"; });
+  ASSERT_NE(cut, repairs.end()) << repairs.front().line();
+  EXPECT_EQ(cut->count, 4);
+  EXPECT_GT(cut->leftOpen, 0);
+  EXPECT_NE(cut->line().find("left open"), std::string::npos) << cut->line();
   EXPECT_TRUE(analysis.usable());
-  const MeshRepair oriented = orientRepair(analysis, imported.mesh);
-  if (oriented.count > 0) {
-    EXPECT_EQ(oriented.first.rfind("face ", 0), 0u);
-  }
+}
+
+TEST(MeshRepair, AWeldNeverMakesAFaceVisitAVertexTwice) {
+  // A hexagon pinched in its middle: corners 0 and 3 a millionth apart.
+  PolygonMesh mesh;
+  mesh.positions = {{0, 0, 0}, {-1, 1, 0}, {-1, -1, 0}, {1e-7, 0, 0}, {1, -1, 0}, {1, 1, 0}};
+  mesh.faces = {{0, 1, 2, 3, 4, 5}};
+  const auto repairs = repairMesh(mesh);
+  EXPECT_TRUE(repairs.empty()) << repairs.front().line();
+  EXPECT_EQ(mesh.faces.front().size(), 6u);
 }
 
 TEST(MeshRepair, CgalsCowHasABowTieAndIsUsableOnceRepaired) {
