@@ -10,25 +10,12 @@
 #include <vector>
 
 #include "core/Polygon2.h"
+#include "geometry/BandDecomposition.h"
 
 namespace rotafab::geometry {
 namespace {
 
 long long edgeKey(int from, int to) { return (static_cast<long long>(from) << 32) | static_cast<unsigned>(to); }
-
-// The unit normal of a face (Newell's method: right for any planar polygon
-// and a fair average for a warped one).
-Point3 faceNormal(const PolygonMesh& mesh, int face) {
-  Point3 normal = Point3::Zero();
-  const auto& corners = mesh.faces[face];
-  for (size_t i = 0; i < corners.size(); ++i) {
-    const Point3& a = mesh.positions[corners[i]];
-    const Point3& b = mesh.positions[corners[(i + 1) % corners.size()]];
-    normal += a.cross(b);
-  }
-  const double length = normal.norm();
-  return length > 0 ? Point3(normal / length) : Point3::Zero();
-}
 
 // The outline of a region of faces (oriented alike) as one loop of
 // vertices, or nothing when it is not a disc with one simple outline.
@@ -139,7 +126,9 @@ CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees) {
   faceOfEdge.reserve(mesh.faces.size() * 4);
   std::vector<Point3> normals(mesh.faces.size());
   for (int f = 0; f < mesh.faceCount(); ++f) {
-    normals[f] = faceNormal(mesh, f);
+    std::vector<Point3> polygon;
+    for (int v : mesh.faces[f]) polygon.push_back(mesh.positions[v]);
+    normals[f] = newellNormal(polygon);
     const auto& corners = mesh.faces[f];
     for (size_t i = 0; i < corners.size(); ++i) faceOfEdge[edgeKey(corners[i], corners[(i + 1) % corners.size()])] = f;
   }
