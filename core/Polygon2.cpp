@@ -4,11 +4,6 @@
 #include <limits>
 
 namespace rotafab::core {
-namespace {
-
-double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
-
-}  // namespace
 
 double signedArea(const Polygon2& polygon) {
   double twice = 0;

@@ -10,6 +10,12 @@ namespace rotafab::core {
 using Point2 = Eigen::Vector2d;
 using Polygon2 = std::vector<Point2>;
 
+// The z of the cross product: positive when b lies counter-clockwise of a.
+inline double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Positive when o, a, b turn counter-clockwise (a left turn at a), zero when in line.
+inline double turn(const Point2& o, const Point2& a, const Point2& b) { return cross(a - o, b - o); }
+
 // Signed area (positive counter-clockwise).
 double signedArea(const Polygon2& polygon);
 

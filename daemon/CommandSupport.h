@@ -40,6 +40,8 @@ inline std::string flagOf(geometry::Parameter parameter) {
       return "--repair";
     case geometry::Parameter::MergeCoplanar:
       return "--merge-coplanar";
+    case geometry::Parameter::Panels:
+      return "--panels";
     case geometry::Parameter::Size:
       return "--size";
     case geometry::Parameter::Scale:

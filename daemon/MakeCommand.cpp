@@ -17,6 +17,17 @@
 namespace rotafab::cli {
 namespace {
 
+// "stands: ..." or "tips over: ... hang it from ...", with the mass when the material gives it.
+std::string stabilityLine(const geometry::Stability& stability) {
+  const std::string mass = stability.massKg ? fmt::format("; mass {:.3g} kg", *stability.massKg) : "";
+  if (stability.stands) {
+    return fmt::format("stands: its centre of mass is {:.2f} in inside its footprint{}", stability.margin, mass);
+  }
+  return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {} and {}",
+                     -stability.margin, mass, geometry::formatPoint(stability.hangPoints.at(0)),
+                     geometry::formatPoint(stability.hangPoints.at(1)));
+}
+
 void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
   const auto& s = job.seconds;
   if (options.json) {
@@ -27,6 +38,16 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
   fmt::print("{}: {} panels on {} sheet{} ({:.1f}% of the usable bed area), {} fasteners; written to {}/\n",
              options.mesh, job.structure.panels.size(), sheets, sheets == 1 ? "" : "s", 100 * job.sheets.utilization,
              job.structure.fasteners, job.folder.string());
+  if (const auto& simplified = job.mesh.simplified) {
+    if (simplified->simplified()) {
+      fmt::print("  panels asked: {}; the mesh simplified from {} faces to {}\n", simplified->asked,
+                 simplified->facesBefore, simplified->facesAfter);
+    } else {
+      fmt::print("  panels asked: {}; the mesh has {} faces, not simplified\n", simplified->asked,
+                 simplified->facesAfter);
+    }
+  }
+  fmt::print("  {}\n", stabilityLine(job.stability));
   fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, writing {:.2f} s\n", s.import, s.geometry,
              s.nesting, s.writing);
   fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", job.folder.string(), job.folder.string());

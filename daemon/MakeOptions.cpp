@@ -17,6 +17,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
                                              : jobs::HolesMode::Keep;
   request.repair = options.repair == "auto";
   request.mergeCoplanar = options.mergeCoplanar;
+  request.panels = options.panels;
   request.tension = options.tension;
   request.samples = options.samples;
   if (!options.fastener.empty()) request.fastener = lengthOption(options.fastener, "--fastener", true);
@@ -57,6 +58,10 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
                   "Merge adjacent faces within this many degrees of one plane into one panel (default: 1 for STL, "
                   "whose faces are all triangles; 0 for other formats)")
       ->check(CLI::Range(0.0, 45.0));
+  make.add_option("--panels", options.panels,
+                  "Simplify the mesh to about this many faces, one panel each (quadric edge collapse that keeps the "
+                  "shape, the genus and the boundary; polygons become triangles)")
+      ->check(CLI::Range(4, 10000000));
   make.add_option("--tension", options.tension,
                   "Corner-cutting tension a of eq. 5.2, 0 < a < 1 (default: Doo-Sabin, a = 1/4 + 5/(4N))");
   make.add_option("--samples", options.samples, "Segments along each edge band")

@@ -15,7 +15,7 @@ struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
   std::string size, fastener, kerf, holes = "keep", repair = "auto", up = "y", order = "window", layout = "nest";
   std::optional<double> scale, tension, mergeCoplanar;
-  std::optional<int> start;
+  std::optional<int> start, panels;
   int samples = 8, window = 8;
   double seconds = 5.0;
   bool json = false, scoreFolds = false;

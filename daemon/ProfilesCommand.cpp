@@ -58,6 +58,8 @@ int runProfiles(const ProfilesOptions& options) {
                                   {"thickness", m.thickness},
                                   {"kerf", m.kerf},
                                   {"fastener", m.fastenerDiameter},
+                                  {"areal_density", m.arealDensity > 0 ? nlohmann::json(m.arealDensity) : nullptr},
+                                  {"fastener_mass", m.fastenerMass},
                                   {"file", m.source.string()}});
     }
     std::cout << out.dump() << '\n';

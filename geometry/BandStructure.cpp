@@ -313,4 +313,20 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
   return result;
 }
 
+GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,
+                                          const core::WorkContext& context) {
+  GrownStructure result;
+  for (int attempt = 1;; ++attempt) {
+    try {
+      result.structure = buildBandStructure(mesh, options, context);
+      return result;
+    } catch (const NoRoomForHoleError& error) {
+      if (attempt == kGrowAttempts || !std::isfinite(error.scaleNeeded)) throw;
+      result.grown *= error.scaleNeeded;
+      for (Point3& p : mesh.positions) p *= error.scaleNeeded;
+      context.report({"geometry", "larger, for the fasteners", static_cast<size_t>(attempt), 0});
+    }
+  }
+}
+
 }  // namespace rotafab::geometry

@@ -34,4 +34,20 @@ struct BandOptions {
 // "fastener holes" (of the bands), "labels" (of the panels).
 Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context);
 
+// The structure at the smallest size, from the mesh's, at which every band
+// has room for its fastener (FastenerHoles.h, kLeastClearance): when some
+// band has none, the mesh is scaled by what the bands without room ask
+// (every length of the structure scales with it) and built again, at most
+// kGrowAttempts times (a hole may move to a tighter place on the larger
+// band). `mesh` is left at the size built; `grown` says how many times its
+// size it became (1: as given). Throws as buildBandStructure() does, the
+// NoRoomForHoleError of the last attempt.
+struct GrownStructure {
+  Structure structure;
+  double grown = 1;
+};
+constexpr int kGrowAttempts = 3;
+GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,
+                                          const core::WorkContext& context);
+
 }  // namespace rotafab::geometry

@@ -27,7 +27,7 @@ double constructionScale(const PolygonMesh& mesh, std::optional<double> size, st
     }
   }
   if (edges.empty() || !(total > 0)) throw std::invalid_argument("the mesh has no edge of positive length to scale by");
-  return 2.0 / (total / static_cast<double>(edges.size()));
+  return kMeanEdgeInches / (total / static_cast<double>(edges.size()));
 }
 
 }  // namespace rotafab::geometry

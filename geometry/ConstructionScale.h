@@ -10,6 +10,9 @@
 
 namespace rotafab::geometry {
 
+// The mean edge's length at the default scale.
+constexpr double kMeanEdgeInches = 2.0;
+
 // Inches per mesh unit. Throws ParameterError (Size) when the mesh has no
 // extent to scale to a size, std::invalid_argument when it has no edge of
 // positive length.

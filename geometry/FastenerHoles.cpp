@@ -186,9 +186,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       placed.clearance = std::min(kClearance, fromOutlines);
       if (most < kLeastClearance / kClearance) {
         throw BandTooSmall{
-            fmt::format("{}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole even {} diameters "
-                        "from every outline",
-                        edgeName(band.edge), length, width, diameter, kLeastClearance),
+            fmt::format("{}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole {:g} diameter{} "
+                        "from every outline (centre to edge)",
+                        edgeName(band.edge), length, width, diameter, kLeastClearance, kLeastClearance == 1 ? "" : "s"),
             // (with 2% to spare: the search for the hole's place is on a grid)
             most > 0 ? 1.02 * kLeastClearance / kClearance / most : std::numeric_limits<double>::infinity()};
       }

@@ -36,7 +36,9 @@
 
 namespace rotafab::geometry {
 
-constexpr double kClearance = 1.5, kLeastClearance = 0.75;
+// Chipboard tears where less than a diameter of it is left between a hole's
+// centre and the edge (a web of half a diameter): no hole is drawn nearer.
+constexpr double kClearance = 1.5, kLeastClearance = 1.0;
 
 // A point of an edge band: a triangle (EdgeBand::triangles() indices) and weights.
 struct BandPoint {

@@ -12,6 +12,8 @@ std::string parameterInWords(Parameter parameter) {
       return "repair";
     case Parameter::MergeCoplanar:
       return "coplanar merge angle";
+    case Parameter::Panels:
+      return "panel count";
     case Parameter::Size:
       return "structure size";
     case Parameter::Scale:

@@ -14,6 +14,7 @@ enum class Parameter {
   Holes,          // what to do with an open mesh's holes: keep, fill, refuse
   Repair,         // whether to repair a broken mesh (MeshRepair.h) or refuse it
   MergeCoplanar,  // the angle within which adjacent faces are merged into one (CoplanarMerge.h)
+  Panels,         // the face count the mesh is simplified to (Simplification.h)
   Size,           // the largest side of the structure
   Scale,          // inches per mesh unit
   Fastener,       // the fastener hole's diameter
@@ -23,8 +24,8 @@ enum class Parameter {
 // How messages name a parameter.
 using ParameterNames = std::function<std::string(Parameter)>;
 
-// In words: "structure", "holes", "repair", "coplanar merge angle", "structure size", "scale", "fastener diameter",
-// "start face".
+// In words: "structure", "holes", "repair", "coplanar merge angle", "panel count", "structure size", "scale", "fastener
+// diameter", "start face".
 std::string parameterInWords(Parameter parameter);
 
 // A parameter's value that cannot be built with; the message names it as

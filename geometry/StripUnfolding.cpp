@@ -7,7 +7,7 @@
 namespace rotafab::geometry {
 namespace {
 
-double cross(const Point2& a, const Point2& b) { return a.x() * b.y() - a.y() * b.x(); }
+using core::cross;
 
 // The point at distances `fromP` and `fromQ` from p and q, on the other side
 // of the line pq from `away`.

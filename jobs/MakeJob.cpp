@@ -19,6 +19,7 @@
 #include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
 #include "geometry/ObjWriter.h"
+#include "geometry/Simplification.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/OutputFolder.h"
 
@@ -46,6 +47,40 @@ const char* plural(int n) { return n == 1 ? "" : "s"; }
 // An STL holds triangles only: its planar faces come back as one face each
 // when their triangles lie within this angle of one plane.
 constexpr double kStlMergeDegrees = 1.0;
+
+// --panels N: the mesh simplified to about N faces (after the merge of
+// coplanar faces, so that flat regions are taken first and nothing merges
+// the count down after), its topology checked to be the same.
+geometry::Simplification simplifiedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
+                                        geometry::MeshAnalysis& analysis, const core::WorkContext& context) {
+  const std::string name = request.mesh.string();
+  const geometry::MeshTopology before = analysis.topology;
+  geometry::Simplification simplified;
+  try {
+    simplified = geometry::simplifyMesh(mesh, *request.panels, context);
+  } catch (const geometry::InvalidMeshError& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  } catch (const std::invalid_argument& error) {
+    throw core::UserError(fmt::format("{} {}: {}", request.names(Parameter::Panels), *request.panels, error.what()));
+  }
+  if (!simplified.simplified()) {
+    context.note(fmt::format("{}: {} faces, no more than the {} asked: not simplified", name, simplified.facesBefore,
+                             simplified.asked));
+    return simplified;
+  }
+  analysis = geometry::analyzeMesh(mesh);
+  const geometry::MeshTopology& after = analysis.topology;
+  if (after.genus != before.genus || after.components != before.components ||
+      after.boundaryLoops != before.boundaryLoops || !analysis.problems.empty()) {
+    // The decimater refuses every collapse that changes the topology; this is the proof.
+    throw core::UserError(fmt::format("{}: simplified to {} faces it would not keep its topology; build it without {}",
+                                      name, simplified.facesAfter, request.names(Parameter::Panels)));
+  }
+  context.note(fmt::format("{}: simplified from {} faces{} to {} ({} asked), keeping its genus and boundary", name,
+                           simplified.facesBefore, simplified.triangulated ? " (polygons split into triangles)" : "",
+                           simplified.facesAfter, simplified.asked));
+  return simplified;
+}
 
 // The mesh as read, checked, its holes filled if asked, at construction size.
 geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context) {
@@ -92,6 +127,10 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
       }
     }
   }
+  std::optional<geometry::Simplification> simplified;
+  if (request.panels) {
+    simplified = simplifiedMesh(request, mesh, analysis, context);
+  }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {
       throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} keep or fill builds it", name,
@@ -111,7 +150,7 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   }
   // The mesh as built (after --holes fill): one panel per face.
   const geometry::MeshTopology& topology = analysis.topology;
-  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs)};
+  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs), simplified};
   double scale = 0;
   try {
     scale = geometry::constructionScale(mesh, request.size, request.scale, request.names);
@@ -146,7 +185,8 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
                      : fmt::format("{} or larger would give every band room", larger);
 }
 
-geometry::Structure builtStructure(const MakeRequest& request, const geometry::PolygonMesh& mesh,
+// `grown`: how many times the default size the structure had to become for its fasteners (1: as it was).
+geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, double& grown,
                                    const core::WorkContext& context) {
   const std::string name = request.mesh.string();
   geometry::BandOptions band;
@@ -157,14 +197,40 @@ geometry::Structure builtStructure(const MakeRequest& request, const geometry::P
   band.up = request.up;
   band.scoreFolds = request.scoreFolds;
   band.names = request.names;
+  // With no size or scale given, the structure grows until every band has room for its fastener.
+  const bool scaleChosen = !request.size && !request.scale;
   try {
-    return geometry::buildBandStructure(mesh, band, context);
+    if (!scaleChosen) return geometry::buildBandStructure(mesh, band, context);
+    geometry::GrownStructure built = geometry::buildBandStructureWithRoom(mesh, band, context);
+    grown = built.grown;
+    if (grown > 1) {
+      Eigen::AlignedBox3d box;
+      for (const geometry::Point3& p : mesh.positions) box.extend(p);
+      context.note(fmt::format(
+          "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), the smallest size "
+          "at which every band has room for its {:.3f} in fastener hole {:g} diameter from every outline; {} or {} "
+          "sets the size",
+          name, geometry::kMeanEdgeInches * grown, geometry::kMeanEdgeInches, box.sizes().maxCoeff(), band.fastener,
+          geometry::kLeastClearance, request.names(Parameter::Size), request.names(Parameter::Scale)));
+    }
+    return std::move(built.structure);
   } catch (const geometry::NoRoomForHoleError& error) {
     throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
                                       roomAdvice(request, mesh, band.fastener, error.scaleNeeded)));
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   }
+}
+
+// Square inches to square metres: the areal density is in grams per square metre.
+constexpr double kSquareMetresPerSquareInch = 0.0254 * 0.0254;
+
+geometry::StabilityOptions stabilityOptions(const MakeRequest& request) {
+  geometry::StabilityOptions options;
+  options.up = request.up;
+  options.gramsPerSquareInch = request.material.arealDensity * kSquareMetresPerSquareInch;
+  options.gramsPerFastener = request.material.fastenerMass;
+  return options;
 }
 
 }  // namespace
@@ -183,12 +249,14 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   }
   PlannedJob job;
   job.title = fmt::format("{} ({})", request.mesh.stem().string(), geometry::structureName(request.structure));
-  const geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
+  geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
   job.seconds.import = lap();
   context.check();
 
-  job.structure = builtStructure(request, mesh, context);
+  double grown = 1;
+  job.structure = builtStructure(request, mesh, grown, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
+  job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.seconds.geometry = lap();
 
   PlanOptions plan;
@@ -203,7 +271,12 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   try {
     job.sheets = planSheets(job.parts, request.machine, plan, context);
   } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    throw core::UserError(fmt::format(
+        "{}: {}{}", name, error.what(),
+        grown > 1 ? fmt::format(" at {:.2f} times the default size, the smallest at which every band has room for "
+                                "its fastener; a smaller {} needs a smaller size",
+                                grown, request.names(Parameter::Fastener))
+                  : ""));
   }
   job.seconds.nesting = lap();
   job.meshFile = request.mesh;
@@ -224,6 +297,7 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
                     job.meshFile.string(), job.structure.panels.size()));
   });
   job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
+  job.manifest["stability"] = stabilityJson(job.stability);
   writeFileAtomically(output.staging() / "manifest.json", job.manifest.dump(1) + "\n");
   writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
   context.check();
@@ -236,12 +310,15 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
 
 nlohmann::ordered_json summaryJson(const PlannedJob& job) {
   const PhaseSeconds& s = job.seconds;
-  return {
+  nlohmann::ordered_json summary = {
       {"panels", job.structure.panels.size()},
       {"sheets", job.sheets.sheets.size()},
       {"fasteners", job.structure.fasteners},
       {"utilization", job.sheets.utilization},
       {"seconds", {{"import", s.import}, {"geometry", s.geometry}, {"nesting", s.nesting}, {"writing", s.writing}}}};
+  if (job.mesh.simplified) summary["simplified"] = simplifiedJson(*job.mesh.simplified);
+  summary["stability"] = stabilityJson(job.stability);
+  return summary;
 }
 
 PlannedJob makeJob(const MakeRequest& request, const std::filesystem::path& folder, const core::WorkContext& context) {

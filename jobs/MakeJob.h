@@ -14,6 +14,7 @@
 
 #include "core/WorkContext.h"
 #include "geometry/Parameters.h"
+#include "geometry/Stability.h"
 #include "geometry/Structure.h"
 #include "jobs/Manifest.h"
 #include "jobs/Nesting.h"
@@ -38,6 +39,8 @@ struct MakeRequest {
   // (geometry/CoplanarMerge.h); by default 1 for an STL file (triangles
   // only), off (0) for every other format.
   std::optional<double> mergeCoplanar;
+  // Simplify to about this many faces, one panel each (geometry/Simplification.h).
+  std::optional<int> panels;
   bool repair = true;  // SPEC's --repair auto (geometry/MeshRepair.h); false: none, a broken mesh is refused
   // The band decomposition's options (geometry/BandStructure.h).
   std::optional<double> tension;
@@ -66,7 +69,8 @@ struct PlannedJob {
   BuiltMesh mesh;                  // of the mesh as built (after --holes fill)
   profiles::Bed bed;               // the machine's
   geometry::Structure structure;
-  std::vector<Part> parts;  // structureParts()
+  geometry::Stability stability;  // of the structure as built, standing on the request's up axis
+  std::vector<Part> parts;        // structureParts()
   SheetPlan sheets;
   // Once written (writeJob()):
   std::filesystem::path folder;
@@ -92,7 +96,8 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
 // SPEC's summary of a written job (`make --json`): {"panels", "sheets",
-// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "writing"}}.
+// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "writing"}}, and
+// "simplified": {"asked", "faces"} when a panel count was asked, and "stability" (stabilityJson()).
 nlohmann::ordered_json summaryJson(const PlannedJob& job);
 
 // planJob() then writeJob().

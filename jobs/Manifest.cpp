@@ -87,6 +87,23 @@ nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repa
   return list;
 }
 
+nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified) {
+  return {{"asked", simplified.asked}, {"faces", simplified.facesAfter}};
+}
+
+nlohmann::ordered_json stabilityJson(const geometry::Stability& stability) {
+  const auto point = [](const geometry::Point3& p) { return nlohmann::ordered_json::array({p.x(), p.y(), p.z()}); };
+  nlohmann::ordered_json hang = nlohmann::ordered_json::array(), footprint = nlohmann::ordered_json::array();
+  for (const geometry::Point3& p : stability.hangPoints) hang.push_back(point(p));
+  for (const geometry::Point3& p : stability.footprint) footprint.push_back(point(p));
+  return {{"stands", stability.stands},
+          {"margin", stability.margin},
+          {"center_of_mass", point(stability.centerOfMass)},
+          {"mass_kg", stability.massKg ? nlohmann::ordered_json(*stability.massKg) : nlohmann::ordered_json(nullptr)},
+          {"hang_points", hang},
+          {"footprint", footprint}};
+}
+
 nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
                                          const profiles::Bed& bed, const SheetPlan& plan,
                                          const std::vector<std::vector<std::string>>& files) {
@@ -99,6 +116,7 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
                       {"faces", mesh.faces},
                       {"genus", mesh.genus ? nlohmann::ordered_json(*mesh.genus) : nlohmann::ordered_json(nullptr)}};
   if (!mesh.repairs.empty()) manifest["repairs"] = repairsJson(mesh.repairs);
+  if (mesh.simplified) manifest["simplified"] = simplifiedJson(*mesh.simplified);
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
   // Which panel (and piece) each planned part is, in structureParts()'s order.

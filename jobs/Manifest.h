@@ -11,6 +11,8 @@
 #include <vector>
 
 #include "geometry/MeshRepair.h"
+#include "geometry/Simplification.h"
+#include "geometry/Stability.h"
 #include "geometry/Structure.h"
 #include "jobs/Part.h"
 #include "jobs/SheetPlanner.h"
@@ -24,10 +26,19 @@ struct BuiltMesh {
   int vertices = 0, edges = 0, faces = 0;
   std::optional<int> genus;
   std::vector<geometry::MeshRepair> repairs;
+  std::optional<geometry::Simplification> simplified;  // when a panel count was asked
 };
 
 // SPEC's manifest "repairs": [{"kind", "count", "first"}], in the order made.
 nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs);
+
+// SPEC's manifest "simplified": {"asked": N, "faces": M}, the faces the mesh was left with.
+nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified);
+
+// SPEC's manifest "stability": {"stands", "margin", "center_of_mass", "mass_kg" (null when the
+// material's areal density is not known), "hang_points" (two when it does not stand, else empty),
+// "footprint" (its corners on the ground)}; inches.
+nlohmann::ordered_json stabilityJson(const geometry::Stability& stability);
 
 // The panels as parts for the planner: outline, holes (polygons of
 // kHoleSides sides around the circle, so the fastener still passes), labels

@@ -256,8 +256,10 @@ MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
   const ProfileReader reader(file);
   const YAML::Node root = reader.load();
   requireKind(reader, root, "material");
-  reader.keys(root, "", {"kind", "name", "description", "thickness", "kerf", "fastener", "machines"},
-              {"name", "thickness", "kerf"});
+  reader.keys(
+      root, "",
+      {"kind", "name", "description", "thickness", "kerf", "fastener", "areal_density", "fastener_mass", "machines"},
+      {"name", "thickness", "kerf"});
   MaterialProfile material;
   material.source = file;
   material.name = reader.text(root["name"], "name");
@@ -267,6 +269,10 @@ MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
   if (material.kerf >= 0.25)
     reader.fail(root["kerf"], "kerf", "must be under 0.25in: a laser cut is a few thousandths wide");
   if (root["fastener"]) material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false);
+  // Grams per square metre, as board and paper are sold (posterboard about
+  // 350, 1/16 in chipboard about 1,000, 3 mm birch plywood about 2,000).
+  if (root["areal_density"]) material.arealDensity = reader.number(root["areal_density"], "areal_density", 1.0, 1e5);
+  if (root["fastener_mass"]) material.fastenerMass = reader.number(root["fastener_mass"], "fastener_mass", 0.0, 1e3);
   if (const YAML::Node machines = root["machines"]) {
     if (!machines.IsMap()) reader.fail(machines, "machines", "expected a map from machine name to settings");
     std::vector<std::string> names;

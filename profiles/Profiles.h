@@ -61,6 +61,11 @@ struct MaterialProfile {
   double thickness = 0.0;  // inches
   double kerf = 0.0;       // width of the cut, inches
   double fastenerDiameter = 0.125;
+  // For the structure's mass and centre of mass (will it stand?): grams per
+  // square metre of the sheet (YAML `areal_density`), 0 when the profile does
+  // not say; grams per fastener with its nut or clip (`fastener_mass`).
+  double arealDensity = 0.0;
+  double fastenerMass = 0.0;
   std::map<std::string, std::map<Operation, PowerSpeed>> machines;  // machine name -> overrides
   std::filesystem::path source;
 };

@@ -5,6 +5,8 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -299,7 +301,8 @@ TEST(MakeCli, JsonSummaryAndErrors) {
     for (std::string line; std::getline(lines, line);) {
       if (line.starts_with("error: "))
         ++errors;
-      else if (!line.starts_with("make: ") && !line.starts_with("Run `rotafab"))
+      else if (!line.starts_with("make: ") && !line.starts_with("Run `rotafab") && !line.starts_with("note: ") &&
+               !line.starts_with("warning: "))
         ++others;
     }
     EXPECT_EQ(errors, 1) << args << ": " << r.err;
@@ -309,10 +312,22 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   fails(mesh + " --structure weave", 1, "--structure weave");
   fails(mesh + " --structure band --tension 1.5", 1, "tension");
   fails(mesh + " --structure band --start 32", 1, "--start 32");
-  fails(mesh + " --structure band --fastener 2in", 1, "no room for a 2.000 in fastener hole");
-  // The error says which --fastener or --size would do, and either one does.
-  const CommandResult large =
-      run(kCli + " make " + mesh + " --structure band --fastener 1in --out " + quoted(dir.path() / "large"));
+  fails(mesh + " --structure band --size 20in --fastener 2in", 1, "no room for a 2.000 in fastener hole");
+  // With no size given, the ball grows until its bands have room, as long as its panels fit the bed.
+  fails(mesh + " --structure band --fastener 2in", 1,
+        "does not fit the usable area of 31.5 x 17.5 in any allowed rotation at 5.00 times the default size, the "
+        "smallest at which every band has room for its fastener; a smaller --fastener needs a smaller size");
+  const CommandResult grown =
+      run(kCli + " make " + mesh + " --structure band --fastener 1in --time 0 --out " + quoted(dir.path() / "grown"));
+  EXPECT_EQ(grown.status, 0) << grown.err;
+  EXPECT_NE(grown.err.find("scaled to a mean edge of 5.00 in, not 2 in (24.3 in at its largest side), the smallest "
+                           "size at which every band has room for its 1.000 in fastener hole 1 diameter from every "
+                           "outline; --size or --scale sets the size"),
+            std::string::npos)
+      << grown.err;
+  // At a size the user fixed, the error says which --fastener or --size would do, and either one does.
+  const CommandResult large = run(kCli + " make " + mesh + " --structure band --fastener 1in --size 12in --out " +
+                                  quoted(dir.path() / "large"));
   std::smatch advice;
   ASSERT_TRUE(std::regex_search(large.err, advice,
                                 std::regex(R"(\(nor have 89 other bands\); (--fastener \S+) or smaller, or )"
@@ -404,6 +419,109 @@ TEST(MakeCli, AnStlCubeIsSixPanels) {
           " --structure band --layout rows --json --out " + quoted(dir.path() / "c"));
   EXPECT_EQ(openscad.status, 0) << openscad.err;
   EXPECT_NE(openscad.err.find("merged its 46 faces into 22"), std::string::npos) << openscad.err;
+}
+
+// --panels N: the bunny of 3,674 triangles as the 2,000 panels asked (+- 5%),
+// its genus kept; the summary and the manifest say what was asked and got.
+TEST(MakeCli, ThePanelCountIsTheOneAsked) {
+  TempDir dir;
+  const std::string bunny = quoted(kSource / "examples/bunny.obj");
+  const CommandResult made =
+      run(kCli + " make " + bunny + " --structure band --panels 2000 --layout rows --json --out " +
+          quoted(dir.path() / "a"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto summary = nlohmann::json::parse(made.out);
+  EXPECT_NEAR(summary.at("panels").get<double>(), 2000, 100);
+  EXPECT_EQ(summary.at("simplified").at("asked"), 2000);
+  EXPECT_EQ(summary.at("simplified").at("faces"), summary.at("panels"));
+  EXPECT_NE(made.err.find("simplified from 3674 faces to "), std::string::npos) << made.err;
+  const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
+  EXPECT_EQ(manifest.at("simplified"), summary.at("simplified"));
+  EXPECT_EQ(manifest.at("mesh").at("genus"), 0);
+  EXPECT_EQ(manifest.at("mesh").at("faces"), summary.at("panels"));
+  EXPECT_EQ(manifest.at("panels").size(), summary.at("panels").get<size_t>());
+
+  // The text summary says it too; a count above the faces leaves the mesh alone.
+  const CommandResult text = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                 " --structure band --panels 100 --time 0 --out " + quoted(dir.path() / "b"));
+  ASSERT_EQ(text.status, 0) << text.err;
+  EXPECT_NE(text.out.find("panels asked: 100; the mesh has 6 faces, not simplified"), std::string::npos) << text.out;
+  EXPECT_NE(text.err.find("6 faces, no more than the 100 asked: not simplified"), std::string::npos) << text.err;
+  const CommandResult bad =
+      run(kCli + " make " + bunny + " --structure band --panels 2 --out " + quoted(dir.path() / "c"));
+  EXPECT_EQ(bad.status, 2) << bad.err;
+  EXPECT_NE(bad.err.find("--panels"), std::string::npos) << bad.err;
+}
+
+// Will it stand? The summary and the manifest say so. The bunny's centre of
+// mass is checked against the area-weighted centroid of structure.obj's
+// polygons (fasteners aside), its footprint against the lowest points there;
+// a leaning tower tips, and the summary says where to hang it.
+TEST(MakeCli, TheSummarySaysWhetherItStands) {
+  TempDir dir;
+  const CommandResult made =
+      run(kCli + " make " + quoted(kSource / "examples/bunny.obj") +
+          " --structure band --panels 2000 --layout rows --json --out " + quoted(dir.path() / "a"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto summary = nlohmann::json::parse(made.out);
+  const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
+  const auto& stability = manifest.at("stability");
+  EXPECT_EQ(summary.at("stability"), stability);
+  EXPECT_EQ(stability.at("stands").get<bool>(), stability.at("margin").get<double>() > 0);
+  EXPECT_EQ(stability.at("hang_points").size(), stability.at("stands").get<bool>() ? 0u : 2u);
+
+  std::vector<Eigen::Vector3d> vertices;
+  Eigen::Vector3d moment = Eigen::Vector3d::Zero(), low = Eigen::Vector3d::Constant(1e300),
+                  high = Eigen::Vector3d::Constant(-1e300);
+  double area = 0;
+  std::istringstream obj(readFile(dir.path() / "a/structure.obj"));
+  for (std::string line; std::getline(obj, line);) {
+    std::istringstream words(line);
+    std::string kind;
+    words >> kind;
+    if (kind == "v") {
+      Eigen::Vector3d p;
+      words >> p.x() >> p.y() >> p.z();
+      vertices.push_back(p);
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    } else if (kind == "f") {
+      std::vector<Eigen::Vector3d> corners;
+      for (std::string index; words >> index;) corners.push_back(vertices.at(std::stoi(index) - 1));
+      for (size_t i = 1; i + 1 < corners.size(); ++i) {
+        const double a = 0.5 * (corners[i] - corners[0]).cross(corners[i + 1] - corners[0]).norm();
+        area += a;
+        moment += a * (corners[0] + corners[i] + corners[i + 1]) / 3;
+      }
+    }
+  }
+  const Eigen::Vector3d centroid = moment / area;
+  const auto& com = stability.at("center_of_mass");
+  const Eigen::Vector3d reported(com[0].get<double>(), com[1].get<double>(), com[2].get<double>());
+  EXPECT_LT((reported - centroid).norm(), 0.01 * (high - low).norm())
+      << reported.transpose() << " against " << centroid.transpose();
+  ASSERT_GE(stability.at("footprint").size(), 3u);
+  for (const auto& p : stability.at("footprint")) EXPECT_NEAR(p[1].get<double>(), low.y(), 1e-9);
+  // Posterboard: 350 g/m2 and 0.4 g a fastener (profiles/materials/posterboard.yaml).
+  double panelArea = 0;
+  for (const auto& panel : manifest.at("panels")) panelArea += panel.at("area").get<double>();
+  const double expected = (panelArea * 0.0254 * 0.0254 * 350 + manifest.at("fasteners").get<double>() * 0.4) / 1000;
+  EXPECT_NEAR(stability.at("mass_kg").get<double>(), expected, 0.03 * expected);
+
+  // A tower of 2 in leaning 3 in over its 1 in base (y up): it tips, and the summary says where to hang it.
+  const auto tower = dir.write("tower.obj",
+                               "v 0 0 0\nv 1 0 0\nv 1 0 1\nv 0 0 1\nv 3 4 0\nv 4 4 0\nv 4 4 1\nv 3 4 1\n"
+                               "f 1 2 3 4\nf 8 7 6 5\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n");
+  const CommandResult tips =
+      run(kCli + " make " + quoted(tower) + " --structure band --size 20in --time 0 --out " + quoted(dir.path() / "b"));
+  ASSERT_EQ(tips.status, 0) << tips.err;
+  EXPECT_NE(tips.out.find("tips over: its centre of mass is "), std::string::npos) << tips.out;
+  EXPECT_NE(tips.out.find(" outside its footprint; mass "), std::string::npos) << tips.out;
+  EXPECT_NE(tips.out.find("; hang it from ("), std::string::npos) << tips.out;
+  const auto leaning = nlohmann::json::parse(readFile(dir.path() / "b/manifest.json")).at("stability");
+  EXPECT_FALSE(leaning.at("stands").get<bool>());
+  EXPECT_LT(leaning.at("margin").get<double>(), 0);
+  EXPECT_EQ(leaning.at("hang_points").size(), 2u);
 }
 
 // Ctrl-C while the bunny is being nested (and SIGTERM, as a service manager

@@ -28,7 +28,9 @@ namespace {
 
 using test::atConstructionSize;
 
-PolygonMesh imported(const std::filesystem::path& path) { return atConstructionSize(importMesh(path.string()).mesh); }
+PolygonMesh imported(const std::filesystem::path& path) {
+  return test::atBuildableSize(importMesh(path.string()).mesh);
+}
 
 // Two cubes that share an edge (non-manifold), as --repair auto leaves them:
 // two closed cubes, each with its own copy of the edge.
@@ -37,17 +39,17 @@ PolygonMesh cubesSharingAnEdgeRepaired() {
   test::append(mesh, cube(), Point3(2, 2, 0));
   cleanMesh(mesh);
   EXPECT_EQ(repairMesh(mesh).size(), 1u);
-  return atConstructionSize(mesh);
+  return test::atBuildableSize(mesh);
 }
 
 // Meshes made here, the bunny, and two that other programs wrote: Geomview's
 // tube of quads (open, two boundary loops) and CGAL's double torus with three
 // holes (genus 2, open, triangles); and a mesh repaired by --repair auto.
 std::map<std::string, PolygonMesh> meshes() {
-  return {{"soccer ball", atConstructionSize(truncatedIcosahedron())},
-          {"torus", atConstructionSize(torus(10, 6))},
-          {"genus 2", atConstructionSize(genusTwoSlab())},
-          {"disc", atConstructionSize(disc(7))},
+  return {{"soccer ball", test::atBuildableSize(truncatedIcosahedron())},
+          {"torus", test::atBuildableSize(torus(10, 6))},
+          {"genus 2", test::atBuildableSize(genusTwoSlab())},
+          {"disc", test::atBuildableSize(disc(7))},
           {"bunny", imported(std::string(ROTAFAB_SOURCE_DIR) + "/examples/bunny.obj")},
           {"tref.off", imported(test::publicMesh("/usr/share/geomview/geom/tref.off"))},
           {"double-torus-3-holes.off", imported(test::publicMesh(test::cgalMesh("double-torus-3-holes.off")))},

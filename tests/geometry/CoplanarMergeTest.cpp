@@ -77,7 +77,7 @@ TEST(CoplanarMerge, ABarOfUnitSquaresIsABoxOfSixFacesAndBuilds) {
   EXPECT_EQ(facesWithSides(mesh, 4), 6);
   EXPECT_EQ(mesh.vertexCount(), 8);
   ASSERT_TRUE(analyzeMesh(mesh).usable());
-  const Structure structure = buildBandStructure(test::atConstructionSize(mesh), BandOptions{}, test::context());
+  const Structure structure = buildBandStructure(test::atBuildableSize(mesh), BandOptions{}, test::context());
   EXPECT_EQ(structure.panels.size(), 6u);
 }
 
@@ -161,7 +161,7 @@ TEST(CoplanarMerge, AnLShapedPrismIsEightFacesAndBuilds) {
   EXPECT_EQ(facesWithSides(mesh, 6), 2);
   EXPECT_EQ(facesWithSides(mesh, 4), 6);
   ASSERT_TRUE(analyzeMesh(mesh).usable());
-  const PolygonMesh built = test::atConstructionSize(mesh);
+  const PolygonMesh built = test::atBuildableSize(mesh);
   const Structure structure = buildBandStructure(built, BandOptions{}, test::context());
   EXPECT_EQ(structure.panels.size(), 8u);
 }

@@ -220,7 +220,7 @@ TEST(MeshRepair, TwoCubesSharingAnEdgeBuildAsTwoStructures) {
   test::append(mesh, cube(), Point3(2, 2, 0));
   mesh = cleaned(mesh);
   repairMesh(mesh);
-  const PolygonMesh built = test::atConstructionSize(mesh);
+  const PolygonMesh built = test::atBuildableSize(mesh);
   const Structure structure = buildBandStructure(built, BandOptions{}, test::context());
   EXPECT_EQ(structure.panels.size(), 12u);
 }

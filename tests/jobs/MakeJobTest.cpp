@@ -93,6 +93,7 @@ TEST(MakeJob, CancelledInAnyPhaseStopsWithinASecondAndLeavesNothing) {
 TEST(MakeJob, ErrorsNameTheMeshAndTheOptionAsTheCallerNamesIt) {
   MakeRequest request = bunny(true);
   request.fastener = 2.0;  // no band of the bunny has room for a 2 in hole
+  request.size = 12.0;     // at the size the user fixed (with none, the bunny grows until they have room)
   request.names = [](geometry::Parameter p) { return p == geometry::Parameter::Fastener ? "fastener" : "size"; };
   test::TempDir dir;
   try {

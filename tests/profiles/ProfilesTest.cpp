@@ -50,6 +50,12 @@ TEST(Profiles, ShippedProfilesLoad) {
   const MaterialProfile plywood = findMaterial(catalogue, "plywood-3mm");
   EXPECT_NEAR(plywood.kerf, 0.15 / 25.4, 1e-12);
   EXPECT_EQ(plywood.machines.at("grbl-diode-400").at(Operation::Cut).passes, 4);
+  // Every shipped material weighs something: `make` says the structure's mass.
+  for (const MaterialProfile& material : catalogue.materials) {
+    EXPECT_GT(material.arealDensity, 0) << material.name;
+    EXPECT_GT(material.fastenerMass, 0) << material.name;
+  }
+  EXPECT_EQ(plywood.arealDensity, 2000);
   EXPECT_THROW(findMachine(catalogue, "nope"), ProfileError);
 }
 
@@ -154,6 +160,12 @@ TEST(Profiles, EveryInvalidMaterialIsRefusedWithItsPlace) {
   EXPECT_EQ(refusal(replaced(good, "speed: 40", "speed: 0"), true),
             "p.yaml:6:44: machines.workshop-32x18.cut.speed: must be between 0.1 and 100, not 0");
   EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", ""), true), "p.yaml:1:1: kerf: missing");
+  EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", "kerf: 0.1mm\nareal_density: 300\nfastener_mass: 0.5\n"), true),
+            "(accepted)");
+  EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", "kerf: 0.1mm\nareal_density: 0\n"), true),
+            "p.yaml:5:16: areal_density: must be between 1 and 100000, not 0");
+  EXPECT_EQ(refusal(replaced(good, "kerf: 0.1mm\n", "kerf: 0.1mm\nfastener_mass: heavy\n"), true),
+            "p.yaml:5:16: fastener_mass: expected a number, found 'heavy'");
 }
 
 }  // namespace
