@@ -28,6 +28,7 @@
 #include "geometry/MeshRepair.h"
 #include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
+#include "geometry/Simplification.h"
 
 namespace geo = rotafab::geometry;
 
@@ -128,6 +129,38 @@ void BM_MergeCoplanar(benchmark::State& state) {
   state.SetComplexityN(state.range(0));
 }
 BENCHMARK(BM_MergeCoplanar)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// `make --panels 5000` (geometry/Simplification.h): the torus, its surface
+// roughened as a scan is (each vertex moved along its radius by up to 1% of
+// the tube, the same way every run), simplified to 5,000 faces. Target:
+// linear, under 3 s at 200k faces.
+void BM_Simplify(benchmark::State& state) {
+  geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
+  unsigned noise = 12345;
+  for (geo::Point3& p : mesh.positions) {
+    noise = noise * 1103515245u + 12345u;
+    const geo::Point3 axis(p.x(), p.y(), 0);
+    const geo::Point3 radial = (p - axis.normalized() * 2.0).normalized();  // geo::torus's tube: 2 from the axis
+    p += radial * (0.0075 * ((noise >> 16) % 1000) / 1000.0);               // up to 1% of its 0.75 radius
+  }
+  rotafab::core::Executor executor(1);
+  const rotafab::core::Cancellation never;
+  const rotafab::core::WorkContext context(executor, never);
+  for (auto _ : state) {
+    geo::PolygonMesh copy = mesh;
+    benchmark::DoNotOptimize(geo::simplifyMesh(copy, 5000, context).facesAfter);
+  }
+  state.SetComplexityN(state.range(0));
+}
+BENCHMARK(BM_Simplify)
+    ->Arg(8000)
+    ->Arg(16000)
+    ->Arg(32000)
+    ->Arg(64000)
+    ->Arg(128000)
+    ->Arg(200000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
 
 void BM_RotationSystemAndTrace(benchmark::State& state) {
   const geo::PolygonMesh mesh = triangulatedTorus(state.range(0));
