@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -16,6 +17,34 @@
 namespace rotafab::geometry {
 
 namespace {
+
+// The point of a convex polygon where `room` is largest, and that room: a
+// grid over its box, then a pattern search around the best point.
+template <class Room>
+std::pair<Point2, double> mostRoomIn(const std::vector<Point2>& polygon, const Room& room) {
+  Eigen::AlignedBox2d box;
+  for (const Point2& p : polygon) box.extend(p);
+  Point2 best = Point2::Zero();
+  for (const Point2& p : polygon) best += p;
+  best /= static_cast<double>(polygon.size());
+  double most = room(best);
+  constexpr int kGrid = 16;
+  for (int a = 1; a < kGrid; ++a) {
+    for (int b = 1; b < kGrid; ++b) {
+      const Point2 p = box.min() + box.sizes().cwiseProduct(Point2(a, b) / kGrid);
+      if (const double r = room(p); r > most) most = r, best = p;
+    }
+  }
+  for (double step = box.sizes().maxCoeff() / kGrid; step > 1e-4 * box.sizes().maxCoeff(); step /= 2) {
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const Point2& d : {Point2(step, 0), Point2(-step, 0), Point2(0, step), Point2(0, -step)}) {
+        if (const double r = room(best + d); r > most) most = r, best += d, moved = true;
+      }
+    }
+  }
+  return {best, most};
+}
 
 double polygonArea3(const std::vector<Point3>& polygon) {
   Point3 sum = Point3::Zero();
@@ -90,9 +119,11 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
             fmt::format("{}: the band of {} overlaps itself when laid flat", where(), edgeName(flat[f].bands[j].edge)));
       }
       // The later band of the two, or else the earlier one: the first whose
-      // tab fits, its hole clear of the piece's and the panel's outlines and
-      // of the panel's other tabs.
+      // tab has room for its hole, at least kLeastClearance diameters from
+      // the piece's and the panel's outlines and clear of the panel's other
+      // tabs' holes; at the point of most clearance.
       std::string why;
+      double mostRoom = 0;  // of the tabs tried, the best share of the clearance needed
       const auto cutOff = [&](int index) {
         FlatPanel trial = flat[f];
         try {
@@ -101,29 +132,34 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
           why = error.what();
           return false;
         }
-        const FlatBand& cut = trial.bands[index];
-        // The tab is exactly twice the clearance deep, so its hole is at the
-        // clearance from the fold: allow for rounding (1e-9 in).
-        const double clearance = kClearance * options.fastener - 1e-9;
-        bool clear = distanceToOutline(cut.pieceOutline, cut.tab) >= clearance &&
-                     insidePolygon(trial.outline, cut.tab) && distanceToOutline(trial.outline, cut.tab) >= clearance;
-        for (const FlatBand& other : trial.bands) {
-          if (&other != &cut && other.detached && (other.tab - cut.tab).norm() < clearance + options.fastener) {
-            clear = false;
+        FlatBand& cut = trial.bands[index];
+        const auto room = [&](const Point2& p) {
+          if (!insidePolygon(cut.tabOutline, p) || !insidePolygon(trial.outline, p)) return -1.0;
+          double least = std::min(distanceToOutline(cut.pieceOutline, p), distanceToOutline(trial.outline, p));
+          for (const FlatBand& other : trial.bands) {
+            if (&other != &cut && other.detached) least = std::min(least, (other.tab - p).norm() - options.fastener);
           }
-        }
-        if (!clear) {
-          why = "the tab's hole would not keep its clearance";
+          return least / options.fastener;  // diameters
+        };
+        const auto [hole, clearance] = mostRoomIn(cut.tabOutline, room);
+        mostRoom = std::max(mostRoom, clearance / kLeastClearance);
+        if (clearance < kLeastClearance) {
+          why = fmt::format("its tab has no room for a {:.3f} in fastener hole {:g} diameter{} from every outline",
+                            options.fastener, kLeastClearance, kLeastClearance == 1 ? "" : "s");
           return false;
         }
+        cut.tab = hole;
         flat[f] = std::move(trial);
         return true;
       };
       if (!cutOff(j) && (i < 0 || !cutOff(i))) {
-        throw std::invalid_argument(fmt::format(
-            "{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}; a larger {} or a "
-            "smaller {} makes room",
-            where(), edgeName(flat[f].bands[j].edge), why, names(Parameter::Size), names(Parameter::Fastener)));
+        const std::string what =
+            fmt::format("{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}", where(),
+                        edgeName(flat[f].bands[j].edge), why);
+        // Every length but the fastener's grows with the mesh, and so does the tab's room.
+        if (mostRoom > 0) throw NoRoomForHoleError(what, 1, 1.02 / mostRoom, options.fastener, names);
+        throw std::invalid_argument(fmt::format("{}; a larger {} or a smaller {} makes room", what,
+                                                names(Parameter::Size), names(Parameter::Fastener)));
       }
       ++split;
     }
@@ -252,11 +288,13 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
       if (piece) {
         // The piece's name on its tab, along the side it is fastened to.
         std::vector<Point2> onTab;
+        const auto& t = copy.tabOutline;
+        Point2 middle = Point2::Zero();
+        for (const Point2& p : t) middle += p;
+        middle /= static_cast<double>(t.size());
         for (double u = 0.2; u <= 0.801; u += 0.15) {
-          for (double v = 0.2; v <= 0.801; v += 0.3) {
-            const auto& t = copy.tabOutline;
-            onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * ((1 - u) * t[3] + u * t[2]));
-          }
+          for (double v = 0.2; v <= 0.801; v += 0.3)
+            onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * middle);
         }
         const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
         if (const auto box = fitText(font, piece->name, std::atan2(side.y(), side.x()), copy.tabOutline,

@@ -61,33 +61,37 @@ void detachBand(FlatPanel& panel, int index, double depth) {
       static_cast<int>(std::find(panel.bandOfSide.begin(), panel.bandOfSide.end(), index) - panel.bandOfSide.begin());
   const Point2& from = panel.vertexBand[side];
   const Point2& to = panel.vertexBand[(side + 1) % sides];
-  const Point2& before = panel.vertexBand[(side + sides - 1) % sides];
-  const Point2& after = panel.vertexBand[(side + 2) % sides];
   const Point2 along = (to - from).normalized(), inward(-along.y(), along.x());
-  // Down the two neighbouring sides until `depth` from this one.
-  const double dropBefore = (before - from).dot(inward), dropAfter = (after - to).dot(inward);
-  if (!(dropBefore > depth && dropAfter > depth)) {
-    throw std::invalid_argument(fmt::format("its vertex band is too shallow for a tab {:.3f} in deep", depth));
-  }
-  const Point2 tabFrom = from + (before - from) * (depth / dropBefore);
-  const Point2 tabTo = to + (after - to) * (depth / dropAfter);
-  FlatBand& band = panel.bands[index];
-  band.detached = true;
-  band.tabOutline = {from, to, tabTo, tabFrom};
-  band.tab = (from + to + tabTo + tabFrom) / 4;
-  band.pieceOutline = band.outline;  // from `from` around the band to `to`
-  band.pieceOutline.push_back(tabTo);
-  band.pieceOutline.push_back(tabFrom);
-  // The tab must lie on the vertex band (no other corner of it inside the
-  // tab, no side across it), and the piece must not cross itself (a band
-  // that reached over its own vertex band could cross its tab).
+  // The tab: the vertex band up to `depth` from this side (all of it where
+  // it is shallower), so that it lies on the vertex band whatever the
+  // band's shape. Clipping by one line keeps a convex polygon one polygon.
   for (int c = 0; c < sides; ++c) {
-    if (c != side && c != (side + 1) % sides && insidePolygon(band.tabOutline, panel.vertexBand[c])) {
-      throw std::invalid_argument(fmt::format("its vertex band has a corner where the tab would go"));
+    if (core::turn(panel.vertexBand[c], panel.vertexBand[(c + 1) % sides], panel.vertexBand[(c + 2) % sides]) < 0) {
+      throw std::invalid_argument("its vertex band is not convex, so a tab cannot be cut from it");
     }
   }
-  if (core::outlinesCross(band.tabOutline, panel.vertexBand) || crossesItself(band.pieceOutline)) {
-    throw std::invalid_argument("the tab would not lie on the vertex band");
+  std::vector<Point2> tab;
+  const auto height = [&](const Point2& p) { return (p - from).dot(inward); };
+  for (int c = 0; c < sides; ++c) {
+    const Point2& p = panel.vertexBand[(side + c) % sides];
+    const Point2& q = panel.vertexBand[(side + c + 1) % sides];
+    if (height(p) <= depth) tab.push_back(p);
+    if ((height(p) < depth) != (height(q) < depth) && height(p) != height(q)) {
+      tab.push_back(p + (q - p) * ((depth - height(p)) / (height(q) - height(p))));
+    }
+  }
+  if (tab.size() < 3 || !(signedArea(tab) > 0)) throw std::invalid_argument("its vertex band has no room for a tab");
+  FlatBand& band = panel.bands[index];
+  band.detached = true;
+  band.tabOutline = tab;  // from, to, then around the vertex band back towards `from`
+  Point2 centre = Point2::Zero();
+  for (const Point2& p : tab) centre += p;
+  band.tab = centre / static_cast<double>(tab.size());
+  band.pieceOutline = band.outline;  // from `from` around the band to `to`
+  band.pieceOutline.insert(band.pieceOutline.end(), tab.begin() + 2, tab.end());
+  if (crossesItself(band.pieceOutline)) {
+    // A band that reaches over its own vertex band crosses its tab.
+    throw std::invalid_argument("the piece would cross its own tab");
   }
   rebuildOutline(panel);
 }

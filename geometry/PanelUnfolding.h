@@ -32,7 +32,7 @@ struct FlatBand {
   // band and a tab over the vertex band, fastened to it through `tab`.
   bool detached = false;
   std::vector<Point2> pieceOutline;  // counter-clockwise, in the panel's frame
-  std::vector<Point2> tabOutline;    // the tab alone
+  std::vector<Point2> tabOutline;    // the tab alone: the band's side (from, to), then over the vertex band
   Point2 tab = Point2::Zero();       // the extra fastener's hole, on the piece and on the vertex band
 
   // The point (s, t) of this copy: s from face A's side (0) to face B's (1)
@@ -55,13 +55,13 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
                       const std::vector<EdgeBand>& bands, int face);
 
 // V.4's remedy for a panel that would overlap itself: band `index` is cut
-// off and becomes a piece of its own, the band plus a tab `depth` deep over
-// the vertex band along their common side (the vertex band clipped to that
-// depth), fastened back through one extra hole in the middle of the tab.
-// The panel's outline loses the band. Throws std::invalid_argument when the
-// vertex band is too shallow there for the tab, when the tab would not lie
-// on the vertex band, or when the piece would cross itself; the panel is
-// then left half changed (detach a copy).
+// off and becomes a piece of its own, the band plus a tab over the vertex
+// band along their common side (the vertex band clipped to `depth` from
+// that side: all of it where it is shallower), fastened back through one
+// extra hole in the tab (`tab`: its corners' mean until the caller places
+// it). The panel's outline loses the band. Throws std::invalid_argument
+// when the vertex band is not convex or the piece would cross itself; the
+// panel is then left half changed (detach a copy).
 void detachBand(FlatPanel& panel, int index, double depth);
 
 // Pairs of the panel's pieces that overlap: -1 for the vertex band, else an
