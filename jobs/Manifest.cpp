@@ -303,6 +303,45 @@ std::string headline(const nlohmann::json& manifest) {
                      manifest.at("panels").size(), sheets, sheets == 1 ? "" : "s", manifest.at("fasteners").get<int>());
 }
 
+// What the builders should know before they start, from the manifest's
+// optional keys: how the mesh was repaired and simplified, and whether the
+// structure will stand or must be hung. One sentence each.
+std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
+  std::vector<std::string> notes;
+  if (manifest.contains("repairs")) {
+    for (const auto& repair : manifest.at("repairs")) {
+      const geometry::MeshRepair made{repair.at("kind").get<std::string>(), repair.at("count").get<int>(),
+                                      repair.at("first").get<std::string>()};
+      notes.push_back(fmt::format("The mesh was repaired: {}.", made.line()));
+    }
+  }
+  if (manifest.contains("simplified")) {
+    const auto& simplified = manifest.at("simplified");
+    notes.push_back(fmt::format("The mesh was simplified to {} faces ({} panels asked).",
+                                simplified.at("faces").get<int>(), simplified.at("asked").get<int>()));
+  }
+  if (manifest.contains("stability")) {
+    const auto& stability = manifest.at("stability");
+    const auto& mass = stability.at("mass_kg");
+    const std::string weighs = mass.is_number() ? fmt::format(" It weighs about {:.3g} kg.", mass.get<double>()) : "";
+    const double margin = stability.at("margin").get<double>();
+    if (stability.at("stands").get<bool>()) {
+      notes.push_back(
+          fmt::format("It stands: its centre of mass is {:.2f} in inside its footprint.{}", margin, weighs));
+    } else {
+      const auto point = [](const nlohmann::json& p) {
+        return fmt::format("({:.2f}, {:.2f}, {:.2f})", p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+      };
+      const auto& hang = stability.at("hang_points");
+      notes.push_back(
+          fmt::format("It will tip over: its centre of mass is {:.2f} in outside its footprint. Hang it from {} and {} "
+                      "(inches, as in structure.obj), or weight its base.{}",
+                      -margin, point(hang.at(0)), point(hang.at(1)), weighs));
+    }
+  }
+  return notes;
+}
+
 }  // namespace
 
 nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
@@ -324,6 +363,10 @@ std::string manifestText(const nlohmann::json& manifest) {
         "Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band\n"
         "with the same number on the panel named; fasten them through their holes.\n\n",
         headline(manifest));
+    if (const auto notes = buildNotes(manifest); !notes.empty()) {
+      for (const std::string& note : notes) text += note + "\n";
+      text += "\n";
+    }
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
       total += fastenersOf(step);
@@ -363,6 +406,7 @@ the same number on the panel named; fasten them through their holes.</p>
 <tr><th>step</th><th>panel</th><th>sheet</th><th>joins</th><th>fasteners</th></tr>
 )",
                                    xmlText(headline(manifest)));
+    for (const std::string& note : buildNotes(manifest)) html += fmt::format("<p>{}</p>\n", xmlText(note));
     int total = 0;
     for (const Step& step : stepsOf(manifest)) {
       const int fasteners = fastenersOf(step);

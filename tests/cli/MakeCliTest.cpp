@@ -272,6 +272,7 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
   EXPECT_EQ(svgs, manifest.at("sheets").size());
   EXPECT_EQ(html.out.find("<?xml"), std::string::npos);
   EXPECT_NE(html.out.find("<tr><td>2</td><td>2</td>"), std::string::npos);
+  EXPECT_NE(html.out.find("<p>It stands: its centre of mass is "), std::string::npos) << "before the steps, as in text";
   EXPECT_TRUE(html.out.ends_with("</html>\n"));
   TempDir dir;
   const CommandResult missing = run(kCli + " manifest '" + dir.path().string() + "'");
@@ -444,6 +445,10 @@ TEST(MakeCli, RepairsABrokenMeshAndSaysSo) {
   EXPECT_EQ(repairs[0], nlohmann::json({{"kind", "drop-duplicate-face"}, {"count", 1}, {"first", "face 8"}}));
   EXPECT_EQ(repairs[1], nlohmann::json({{"kind", "split-bowtie"}, {"count", 1}, {"first", "vertex 2"}}));
   EXPECT_EQ(manifest.at("mesh").at("vertices"), 8) << "the counts are of the repaired mesh";
+  EXPECT_NE(readFile(dir.path() / "a/manifest.txt")
+                .find("The mesh was repaired: dropped 1 duplicate face (the first: "
+                      "face 8)."),
+            std::string::npos);
   EXPECT_EQ(manifest.at("mesh").at("genus"), 0);
 
   const CommandResult refused =
@@ -595,6 +600,12 @@ TEST(MakeCli, TheSummarySaysWhetherItStands) {
   EXPECT_NE(tips.out.find(" outside its footprint; mass "), std::string::npos) << tips.out;
   EXPECT_NE(tips.out.find("; hang it from ("), std::string::npos) << tips.out;
   const auto leaning = nlohmann::json::parse(readFile(dir.path() / "b/manifest.json")).at("stability");
+  // The builders read it in the assembly steps, before step 1.
+  const std::string steps = readFile(dir.path() / "b/manifest.txt");
+  EXPECT_LT(steps.find("It will tip over: its centre of mass is "), steps.find("step    1:")) << steps;
+  EXPECT_NE(steps.find("Hang it from ("), std::string::npos) << steps;
+  EXPECT_NE(readFile(dir.path() / "a/manifest.txt").find("It stands: its centre of mass is "), std::string::npos);
+  EXPECT_NE(readFile(dir.path() / "a/manifest.txt").find("The mesh was simplified to "), std::string::npos);
   EXPECT_FALSE(leaning.at("stands").get<bool>());
   EXPECT_LT(leaning.at("margin").get<double>(), 0);
   EXPECT_EQ(leaning.at("hang_points").size(), 2u);
