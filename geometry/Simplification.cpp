@@ -9,6 +9,7 @@
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <OpenMesh/Tools/Decimater/Observer.hh>
 #include <array>
+#include <mutex>
 #include <stdexcept>
 #include <type_traits>
 
@@ -84,10 +85,12 @@ size_t decimate(TriMesh& mesh, size_t faces, const core::WorkContext& context, s
   return made;
 }
 
-// OpenMesh's streams off while it lives: a library's message is not ours to print.
+// OpenMesh's streams off while it lives: a library's message is not ours to
+// print. The streams are the process's, so one simplification runs at a
+// time (a daemon may plan two jobs at once).
 class QuietOpenMesh {
  public:
-  QuietOpenMesh() {
+  QuietOpenMesh() : lock_(mutex()) {
     omerr().disable();
     omlog().disable();
     omout().disable();
@@ -99,6 +102,13 @@ class QuietOpenMesh {
   }
   QuietOpenMesh(const QuietOpenMesh&) = delete;
   QuietOpenMesh& operator=(const QuietOpenMesh&) = delete;
+
+ private:
+  static std::mutex& mutex() {
+    static std::mutex streams;
+    return streams;
+  }
+  std::lock_guard<std::mutex> lock_;
 };
 
 Eigen::Vector2d inPlane(const Point3& p, const Point3& u, const Point3& v) { return {p.dot(u), p.dot(v)}; }
