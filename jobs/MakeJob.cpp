@@ -257,6 +257,9 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.structure = builtStructure(request, mesh, grown, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
+  Eigen::AlignedBox3d box;
+  for (const geometry::Point3& p : mesh.positions) box.extend(p);
+  job.size = box.sizes();
   job.seconds.geometry = lap();
 
   PlanOptions plan;
@@ -297,6 +300,7 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
                     job.meshFile.string(), job.structure.panels.size()));
   });
   job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
+  job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
   job.manifest["stability"] = stabilityJson(job.stability);
   writeFileAtomically(output.staging() / "manifest.json", job.manifest.dump(1) + "\n");
   writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
@@ -317,6 +321,7 @@ nlohmann::ordered_json summaryJson(const PlannedJob& job) {
       {"utilization", job.sheets.utilization},
       {"seconds", {{"import", s.import}, {"geometry", s.geometry}, {"nesting", s.nesting}, {"writing", s.writing}}}};
   if (job.mesh.simplified) summary["simplified"] = simplifiedJson(*job.mesh.simplified);
+  summary["size"] = {job.size.x(), job.size.y(), job.size.z()};
   summary["stability"] = stabilityJson(job.stability);
   return summary;
 }

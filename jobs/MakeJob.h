@@ -70,6 +70,7 @@ struct PlannedJob {
   profiles::Bed bed;               // the machine's
   geometry::Structure structure;
   geometry::Stability stability;  // of the structure as built, standing on the request's up axis
+  geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
   std::vector<Part> parts;        // structureParts()
   SheetPlan sheets;
   // Once written (writeJob()):
@@ -97,7 +98,8 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
 
 // SPEC's summary of a written job (`make --json`): {"panels", "sheets",
 // "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "writing"}}, and
-// "simplified": {"asked", "faces"} when a panel count was asked, and "stability" (stabilityJson()).
+// "simplified": {"asked", "faces"} when a panel count was asked, "size": [X, Y, Z] (the
+// structure's box, inches), and "stability" (stabilityJson()).
 nlohmann::ordered_json summaryJson(const PlannedJob& job);
 
 // planJob() then writeJob().

@@ -548,6 +548,7 @@ TEST(MakeCli, TheSummarySaysWhetherItStands) {
   const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
   const auto& stability = manifest.at("stability");
   EXPECT_EQ(summary.at("stability"), stability);
+  EXPECT_EQ(summary.at("size"), manifest.at("size"));
   EXPECT_EQ(stability.at("stands").get<bool>(), stability.at("margin").get<double>() > 0);
   EXPECT_EQ(stability.at("hang_points").size(), stability.at("stands").get<bool>() ? 0u : 2u);
 
@@ -583,6 +584,12 @@ TEST(MakeCli, TheSummarySaysWhetherItStands) {
       << reported.transpose() << " against " << centroid.transpose();
   ASSERT_GE(stability.at("footprint").size(), 3u);
   for (const auto& p : stability.at("footprint")) EXPECT_NEAR(p[1].get<double>(), low.y(), 1e-9);
+  // "size": the mesh's box as built; the panels, cut back at the corners, fill most of it.
+  for (int axis = 0; axis < 3; ++axis) {
+    const double size = manifest.at("size")[axis];
+    EXPECT_LE(high[axis] - low[axis], size + 1e-9) << axis;
+    EXPECT_GE(high[axis] - low[axis], 0.8 * size) << axis;
+  }
   // Posterboard: 350 g/m2 and 0.4 g a fastener (profiles/materials/posterboard.yaml).
   double panelArea = 0;
   for (const auto& panel : manifest.at("panels")) panelArea += panel.at("area").get<double>();
