@@ -69,9 +69,9 @@ struct PlannedJob {
   BuiltMesh mesh;                  // of the mesh as built (after --holes fill)
   profiles::Bed bed;               // the machine's
   geometry::Structure structure;
-  geometry::Stability stability;  // of the structure as built, standing on the request's up axis
+  geometry::Stability stability;                     // of the structure as built, standing on the request's up axis
   geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
-  std::vector<Part> parts;        // structureParts()
+  std::vector<Part> parts;                           // structureParts()
   SheetPlan sheets;
   // Once written (writeJob()):
   std::filesystem::path folder;
