@@ -169,6 +169,7 @@ CoplanarMerge mergeCoplanarFaces(PolygonMesh& mesh, double degrees) {
     if (const auto merged = outlineOfSeed.find(f); merged != outlineOfSeed.end()) {
       faces.push_back(std::move(merged->second));
     } else if (regionOf[f] < mesh.faceCount()) {
+      result.mergedInto[mesh.sourceFaceIndex(f)] = mesh.sourceFaceIndex(regionOf[f]);
       continue;  // inside a merged face
     } else {
       faces.push_back(mesh.faces[f]);

@@ -12,6 +12,8 @@
 // two merged faces; every other vertex on an outline is kept (a neighbour
 // shares it).
 
+#include <unordered_map>
+
 #include "geometry/PolygonMesh.h"
 
 namespace rotafab::geometry {
@@ -21,6 +23,8 @@ struct CoplanarMerge {
   int facesAfter = 0;
   int regions = 0;       // merged faces made of more than one face
   int straightened = 0;  // vertices taken out of straight sides between two merged faces
+  // A face merged into another, by source index: the source index of the merged face (its seed's).
+  std::unordered_map<int, int> mergedInto;
 };
 
 // The mesh must be an oriented manifold (analyzeMesh() has found no

@@ -106,12 +106,18 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
         "{}: {}{}", name, error.what(),
         request.repair ? "" : fmt::format("; {} auto repairs it where it can", request.names(Parameter::Repair))));
   }
+  std::optional<int> start = request.start;
   std::string extension = request.mesh.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(),
                  [](unsigned char c) { return std::tolower(c); });
   const double mergeDegrees = request.mergeCoplanar.value_or(extension == ".stl" ? kStlMergeDegrees : 0.0);
   if (mergeDegrees > 0) {
     const geometry::CoplanarMerge merged = geometry::mergeCoplanarFaces(mesh, mergeDegrees);
+    if (const auto into = merged.mergedInto.find(request.start.value_or(-1)); into != merged.mergedInto.end()) {
+      start = into->second;
+      context.note(fmt::format("{}: {} {}: face {} is part of face {} now, where the flood fill starts", name,
+                               request.names(Parameter::Start), *request.start, *request.start, *start));
+    }
     if (merged.regions > 0) {
       context.note(
           fmt::format("{}: merged its {} faces into {}, adjacent faces within {:g} degree{} of one plane "
@@ -150,7 +156,7 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   }
   // The mesh as built (after --holes fill): one panel per face.
   const geometry::MeshTopology& topology = analysis.topology;
-  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs), simplified};
+  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs), simplified, start};
   double scale = 0;
   try {
     scale = geometry::constructionScale(mesh, request.size, request.scale, request.names);
@@ -186,14 +192,15 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
 }
 
 // `grown`: how many times the default size the structure had to become for its fasteners (1: as it was).
-geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, double& grown,
-                                   const core::WorkContext& context) {
+// `start`: the flood fill's first face in the mesh as built.
+geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
+                                   double& grown, const core::WorkContext& context) {
   const std::string name = request.mesh.string();
   geometry::BandOptions band;
   band.tension = request.tension;
   band.samples = request.samples;
   band.fastener = request.fastener.value_or(request.material.fastenerDiameter);
-  band.start = request.start;
+  band.start = start;
   band.up = request.up;
   band.scoreFolds = request.scoreFolds;
   band.names = request.names;
@@ -254,7 +261,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   context.check();
 
   double grown = 1;
-  job.structure = builtStructure(request, mesh, grown, context);
+  job.structure = builtStructure(request, mesh, job.mesh.start, grown, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   Eigen::AlignedBox3d box;

@@ -27,6 +27,7 @@ struct BuiltMesh {
   std::optional<int> genus;
   std::vector<geometry::MeshRepair> repairs;
   std::optional<geometry::Simplification> simplified;  // when a panel count was asked
+  std::optional<int> start;  // the flood fill's first face as asked, or the face it was merged into
 };
 
 // SPEC's manifest "repairs": [{"kind", "count", "first"}], in the order made.

@@ -494,6 +494,13 @@ TEST(MakeCli, AnStlCubeIsSixPanels) {
                                  "--merge-coplanar 0 --out " + quoted(dir.path() / "b"));
   ASSERT_EQ(kept.status, 0) << kept.err;
   EXPECT_EQ(nlohmann::json::parse(kept.out).at("panels"), 12);
+  // The file's face 1 is part of face 0 once merged: the flood fill starts there.
+  const CommandResult started =
+      run(kCli + " make " + mesh + " --structure band --size 8in --time 0 --start 1 --out " + quoted(dir.path() / "d"));
+  ASSERT_EQ(started.status, 0) << started.err;
+  EXPECT_NE(started.err.find("--start 1: face 1 is part of face 0 now, where the flood fill starts"), std::string::npos)
+      << started.err;
+  EXPECT_EQ(nlohmann::json::parse(readFile(dir.path() / "d/manifest.json")).at("panels")[0].at("source").at("face"), 0);
   // An STL OpenSCAD wrote (a sphere cut flat on one side: curved triangles stay, the flat ones merge).
   const CommandResult openscad =
       run(kCli + " make " + quoted(publicMesh("/usr/share/openscad/testdata/scad/3D/features/import.stl")) +
