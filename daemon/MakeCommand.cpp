@@ -23,9 +23,14 @@ std::string stabilityLine(const geometry::Stability& stability) {
   if (stability.stands) {
     return fmt::format("stands: its centre of mass is {:.2f} in inside its footprint{}", stability.margin, mass);
   }
-  return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {} and {}",
-                     -stability.margin, mass, geometry::formatPoint(stability.hangPoints.at(0)),
-                     geometry::formatPoint(stability.hangPoints.at(1)));
+  const geometry::Point3 &p = stability.hangPoints.at(0), &q = stability.hangPoints.at(1);
+  const std::string hang =
+      p == q ? geometry::formatPoint(p) : fmt::format("{} and {}", geometry::formatPoint(p), geometry::formatPoint(q));
+  if (!(stability.margin < -0.005)) {
+    return fmt::format("balances on the edge of its footprint, and a touch tips it{}; hang it from {}", mass, hang);
+  }
+  return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {}",
+                     -stability.margin, mass, hang);
 }
 
 void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {

@@ -133,11 +133,20 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
           return false;
         }
         FlatBand& cut = trial.bands[index];
+        // Tabs of one panel may lie on each other, but none over another's hole.
+        for (const FlatBand& other : trial.bands) {
+          if (&other != &cut && other.detached && insidePolygon(cut.tabOutline, other.tab)) {
+            why = "its tab would cover the hole of another band's tab";
+            return false;
+          }
+        }
         const auto room = [&](const Point2& p) {
           if (!insidePolygon(cut.tabOutline, p) || !insidePolygon(trial.outline, p)) return -1.0;
           double least = std::min(distanceToOutline(cut.pieceOutline, p), distanceToOutline(trial.outline, p));
           for (const FlatBand& other : trial.bands) {
-            if (&other != &cut && other.detached) least = std::min(least, (other.tab - p).norm() - options.fastener);
+            if (&other == &cut || !other.detached) continue;
+            least = std::min(least, (other.tab - p).norm() - options.fastener);
+            if (insidePolygon(other.tabOutline, p)) return -1.0;  // under another tab
           }
           return least / options.fastener;  // diameters
         };
@@ -156,10 +165,15 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
         const std::string what =
             fmt::format("{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}", where(),
                         edgeName(flat[f].bands[j].edge), why);
-        // Every length but the fastener's grows with the mesh, and so does the tab's room.
-        if (mostRoom > 0) throw NoRoomForHoleError(what, 1, 1.02 / mostRoom, options.fastener, names);
-        throw std::invalid_argument(fmt::format("{}; a larger {} or a smaller {} makes room", what,
-                                                names(Parameter::Size), names(Parameter::Fastener)));
+        // The tab's room grows with the mesh, but only until the tab is as
+        // deep as it may be, and other tabs may be in the way: an estimate.
+        if (mostRoom > 0) {
+          NoRoomForHoleError error(what, 1, 1.02 / mostRoom, options.fastener, names);
+          error.estimate = true;
+          throw error;
+        }
+        throw std::invalid_argument(fmt::format("{}; split that face in the mesh, or simplify the mesh ({} N)", what,
+                                                names(Parameter::Panels)));
       }
       ++split;
     }
@@ -360,6 +374,7 @@ GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& 
       return result;
     } catch (const NoRoomForHoleError& error) {
       if (attempt == kGrowAttempts || !std::isfinite(error.scaleNeeded)) throw;
+      if (attempt == 1) result.bandsWithoutRoom = error.bands;
       result.grown *= error.scaleNeeded;
       for (Point3& p : mesh.positions) p *= error.scaleNeeded;
       context.report({"geometry", "larger, for the fasteners", static_cast<size_t>(attempt), 0});

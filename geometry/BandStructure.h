@@ -45,6 +45,7 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
 struct GrownStructure {
   Structure structure;
   double grown = 1;
+  int bandsWithoutRoom = 0;  // at the size given
 };
 constexpr int kGrowAttempts = 3;
 GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,

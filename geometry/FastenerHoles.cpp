@@ -71,7 +71,8 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
                                        const ParameterNames& names)
     : std::invalid_argument(""),
       bandsWithoutRoom(firstBand + (bands > 1 ? fmt::format(" (nor have {} other bands)", bands - 1) : "")),
-      scaleNeeded(scaleNeeded_) {
+      scaleNeeded(scaleNeeded_),
+      bands(bands) {
   static_cast<std::invalid_argument&>(*this) = std::invalid_argument(
       bandsWithoutRoom +
       (std::isfinite(scaleNeeded)

@@ -68,6 +68,8 @@ class NoRoomForHoleError : public std::invalid_argument {
                      const ParameterNames& names = parameterInWords);
   std::string bandsWithoutRoom;  // "EDGE: its band (L x W in) has no room for ... (nor have N other bands)"
   double scaleNeeded;            // > 1; infinite when a band's middle is off its panel
+  int bands;                     // how many have no room
+  bool estimate = false;         // scaleNeeded may not be enough (a tab's room stops growing)
 };
 
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed

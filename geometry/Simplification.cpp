@@ -33,6 +33,11 @@ using TriMesh = OpenMesh::TriMesh_ArrayKernelT<DoubleTraits>;
 // A collapse may not turn a face's normal by more than this: a larger turn
 // folds the surface over (a flipped face) or bends a panel out of the shape.
 constexpr double kMaxNormalTurnDegrees = 60.0;
+// The turns of one collapse after another add up, and a surface can fold
+// onto itself (an octahedron asked for 4 faces became four points in a
+// plane, covered twice): two faces on one edge whose normals are more
+// opposed than this lie back to back.
+constexpr double kFoldedCosine = -0.95;
 // Nor leave a triangle longer than this many times its height: a sliver has
 // no room for a fastener hole at any scale the bed takes.
 constexpr float kMaxAspectRatio = 8.0f;
@@ -165,6 +170,22 @@ std::vector<std::array<int, 3>> faceTriangles(const PolygonMesh& mesh, int face)
   return triangles;
 }
 
+namespace {
+
+// The inner edges whose two faces lie back to back (kFoldedCosine).
+size_t foldedEdges(TriMesh& mesh) {
+  mesh.update_face_normals();
+  size_t folded = 0;
+  for (const auto edge : mesh.edges()) {
+    if (mesh.is_boundary(edge)) continue;
+    const auto a = mesh.face_handle(mesh.halfedge_handle(edge, 0)), b = mesh.face_handle(mesh.halfedge_handle(edge, 1));
+    if (OpenMesh::dot(mesh.normal(a), mesh.normal(b)) < kFoldedCosine) ++folded;
+  }
+  return folded;
+}
+
+}  // namespace
+
 Simplification simplifyMesh(PolygonMesh& mesh, int faces, const core::WorkContext& context) {
   if (faces < 1) throw std::invalid_argument("expected a panel count of at least 1");
   Simplification result;
@@ -206,6 +227,7 @@ Simplification simplifyMesh(PolygonMesh& mesh, int faces, const core::WorkContex
       if (tri.is_boundary(vertex)) tri.status(vertex).set_locked(true);
     }
     tri.update_face_normals();
+    const size_t foldedBefore = foldedEdges(tri);
     // Each collapse of an inner edge takes two triangles.
     const size_t collapses = (tri.n_faces() - static_cast<size_t>(faces) + 1) / 2;
     // A large mesh goes most of the way by multiple choice (Wu and Kobbelt,
@@ -220,6 +242,13 @@ Simplification simplifyMesh(PolygonMesh& mesh, int faces, const core::WorkContex
       tri.garbage_collection();
     }
     decimate<OpenMesh::Decimater::DecimaterT>(tri, static_cast<size_t>(faces), context, done, collapses);
+    if (const size_t folded = foldedEdges(tri); folded > foldedBefore) {
+      size_t left = 0;
+      for ([[maybe_unused]] const auto face : tri.faces()) ++left;
+      throw std::invalid_argument(fmt::format(
+          "at {} faces the surface would fold onto itself ({} edge{} with faces back to back); ask for more", left,
+          folded - foldedBefore, folded - foldedBefore == 1 ? "" : "s"));
+    }
     context.check();
     tri.garbage_collection();
   }

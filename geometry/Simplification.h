@@ -16,8 +16,8 @@
 //
 // Polygon faces are split into triangles first: a polygon whose vertex moves
 // is no longer planar, and a panel is cut for a planar face. The result is a
-// triangle mesh; the merge of coplanar faces (geometry/CoplanarMerge.h) is
-// what gives polygons back.
+// triangle mesh (`make` merges coplanar faces before, not after, so that the
+// count is the one asked).
 
 #include "core/WorkContext.h"
 #include "geometry/PolygonMesh.h"
@@ -36,7 +36,8 @@ struct Simplification {
 // to about `faces` faces; leaves it as it is when it has no more than that.
 // The faces left keep their source face (a triangle of a split polygon, the
 // polygon's), the vertices their source vertex. Reports progress as
-// "simplify"; throws core::Cancelled, std::invalid_argument when `faces` < 1.
+// "simplify"; throws core::Cancelled, std::invalid_argument when `faces` < 1
+// or when the surface would fold onto itself at that count.
 Simplification simplifyMesh(PolygonMesh& mesh, int faces, const core::WorkContext& context);
 
 // The triangles of one face (three vertex indices each, in the face's

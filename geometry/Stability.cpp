@@ -72,7 +72,9 @@ double signedMargin(const std::vector<Ground>& hull, const Ground& p) {
 // them until its centre of mass is below that line, and each string pulls
 // up only if the centre of mass, seen from above, lies between the two: so
 // the pair whose segment, seen from above, passes nearest the centre of mass,
-// and of those near the nearest the pair farthest apart (the steadiest).
+// and of those near the nearest the pair whose lower point is highest above
+// it (a steadier hang, and strings that reach it from above), a tenth of
+// their distance apart counted to it.
 std::vector<Point3> hangPoints(const std::vector<Point3>& points, const Point3& center, const Frame& frame) {
   std::vector<const Point3*> above;
   for (const Point3& p : points) {
@@ -101,13 +103,14 @@ std::vector<Point3> hangPoints(const std::vector<Point3>& points, const Point3& 
   }
   const double nearEnough = nearest + 0.01 * width;
   std::pair<const Point3*, const Point3*> best{above.front(), above.front()};
-  double widest = -1;
+  double bestScore = -std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < above.size(); ++i) {
     for (size_t j = i + 1; j < above.size(); ++j) {
       const Ground p = frame.ground(*above[i]), q = frame.ground(*above[j]);
       if (distanceToSegment(c, p, q) > nearEnough) continue;
-      if (const double apart = (p - q).norm(); apart > widest) {
-        widest = apart;
+      const double score = std::min((*above[i])[frame.up], (*above[j])[frame.up]) + 0.1 * (p - q).norm();
+      if (score > bestScore) {
+        bestScore = score;
         best = {above[i], above[j]};
       }
     }

@@ -61,7 +61,8 @@ geometry::Simplification simplifiedMesh(const MakeRequest& request, geometry::Po
   } catch (const geometry::InvalidMeshError& error) {
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{} {}: {}", request.names(Parameter::Panels), *request.panels, error.what()));
+    throw core::UserError(
+        fmt::format("{}: {} {}: {}", name, request.names(Parameter::Panels), *request.panels, error.what()));
   }
   if (!simplified.simplified()) {
     context.note(fmt::format("{}: {} faces, no more than the {} asked: not simplified", name, simplified.facesBefore,
@@ -133,10 +134,6 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
       }
     }
   }
-  std::optional<geometry::Simplification> simplified;
-  if (request.panels) {
-    simplified = simplifiedMesh(request, mesh, analysis, context);
-  }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {
       throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} keep or fill builds it", name,
@@ -153,6 +150,11 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
       }
       context.report({"import", "holes filled", static_cast<size_t>(loops), 0});
     }
+  }
+  // After the holes are filled, so that their caps are among the faces counted.
+  std::optional<geometry::Simplification> simplified;
+  if (request.panels) {
+    simplified = simplifiedMesh(request, mesh, analysis, context);
   }
   // The mesh as built (after --holes fill): one panel per face.
   const geometry::MeshTopology& topology = analysis.topology;
@@ -213,15 +215,23 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     if (grown > 1) {
       Eigen::AlignedBox3d box;
       for (const geometry::Point3& p : mesh.positions) box.extend(p);
+      const int narrow = built.bandsWithoutRoom;
       context.note(fmt::format(
           "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), the smallest size "
-          "at which every band has room for its {:.3f} in fastener hole {:g} diameter from every outline; {} or {} "
-          "sets the size",
+          "at which every band has room for its {:.3f} in fastener hole {:g} diameter from every outline ({} "
+          "band{} had none: narrow faces; {} N, fewer and evener faces, may need less); {} or {} sets the size",
           name, geometry::kMeanEdgeInches * grown, geometry::kMeanEdgeInches, box.sizes().maxCoeff(), band.fastener,
-          geometry::kLeastClearance, request.names(Parameter::Size), request.names(Parameter::Scale)));
+          geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s", request.names(Parameter::Panels),
+          request.names(Parameter::Size), request.names(Parameter::Scale)));
     }
     return std::move(built.structure);
   } catch (const geometry::NoRoomForHoleError& error) {
+    if (error.estimate) {
+      throw core::UserError(
+          fmt::format("{}: {}; a larger {} may give it room, or split that face in the mesh, or "
+                      "simplify the mesh ({} N)",
+                      name, error.bandsWithoutRoom, request.names(Parameter::Size), request.names(Parameter::Panels)));
+    }
     throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
                                       roomAdvice(request, mesh, band.fastener, error.scaleNeeded)));
   } catch (const std::invalid_argument& error) {
@@ -284,8 +294,8 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
     throw core::UserError(fmt::format(
         "{}: {}{}", name, error.what(),
         grown > 1 ? fmt::format(" at {:.2f} times the default size, the smallest at which every band has room for "
-                                "its fastener; a smaller {} needs a smaller size",
-                                grown, request.names(Parameter::Fastener))
+                                "its fastener; a smaller {}, or fewer and evener faces ({} N), needs less",
+                                grown, request.names(Parameter::Fastener), request.names(Parameter::Panels))
                   : ""));
   }
   job.seconds.nesting = lap();

@@ -333,10 +333,14 @@ std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
         return fmt::format("({:.2f}, {:.2f}, {:.2f})", p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
       };
       const auto& hang = stability.at("hang_points");
+      const std::string from =
+          hang.at(0) == hang.at(1) ? point(hang.at(0)) : point(hang.at(0)) + " and " + point(hang.at(1));
+      const std::string falls =
+          margin < -0.005
+              ? fmt::format("It will tip over: its centre of mass is {:.2f} in outside its footprint.", -margin)
+              : std::string("It balances on the edge of its footprint, and a touch tips it.");
       notes.push_back(
-          fmt::format("It will tip over: its centre of mass is {:.2f} in outside its footprint. Hang it from {} and {} "
-                      "(inches, as in structure.obj), or weight its base.{}",
-                      -margin, point(hang.at(0)), point(hang.at(1)), weighs));
+          fmt::format("{} Hang it from {} (inches, as in structure.obj), or weight its base.{}", falls, from, weighs));
     }
   }
   return notes;

@@ -393,13 +393,15 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   // With no size given, the ball grows until its bands have room, as long as its panels fit the bed.
   fails(mesh + " --structure band --fastener 2in", 1,
         "does not fit the usable area of 31.5 x 17.5 in any allowed rotation at 5.00 times the default size, the "
-        "smallest at which every band has room for its fastener; a smaller --fastener needs a smaller size");
+        "smallest at which every band has room for its fastener; a smaller --fastener, or fewer and evener faces "
+        "(--panels N), needs less");
   const CommandResult grown =
       run(kCli + " make " + mesh + " --structure band --fastener 1in --time 0 --out " + quoted(dir.path() / "grown"));
   EXPECT_EQ(grown.status, 0) << grown.err;
   EXPECT_NE(grown.err.find("scaled to a mean edge of 5.00 in, not 2 in (24.3 in at its largest side), the smallest "
                            "size at which every band has room for its 1.000 in fastener hole 1 diameter from every "
-                           "outline; --size or --scale sets the size"),
+                           "outline (90 bands had none: narrow faces; --panels N, fewer and evener faces, may need "
+                           "less); --size or --scale sets the size"),
             std::string::npos)
       << grown.err;
   // At a size the user fixed, the error says which --fastener or --size would do, and either one does.

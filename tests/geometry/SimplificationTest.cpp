@@ -153,6 +153,26 @@ TEST(Simplification, AMeshWithNoMoreFacesThanAskedIsLeftAsItIs) {
   EXPECT_THROW(simplifyMesh(mesh, 0, test::context()), std::invalid_argument);
 }
 
+TEST(Simplification, AClosedSurfaceThatWouldFoldFlatIsRefused) {
+  // An octahedron asked for 4 faces: the collapses, each within its limits,
+  // would leave four points in a plane, covered twice.
+  PolygonMesh mesh;
+  mesh.positions = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  mesh.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  ASSERT_TRUE(analyzeMesh(mesh).usable());
+  PolygonMesh asked = mesh;
+  try {
+    simplifyMesh(asked, 4, test::context());
+    ADD_FAILURE() << "simplified to " << asked.faceCount() << " faces";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("at 4 faces the surface would fold onto itself"), std::string::npos)
+        << error.what();
+  }
+  PolygonMesh six = mesh;
+  simplifyMesh(six, 6, test::context());
+  EXPECT_EQ(test::topologyOf(six).genus, 0);
+}
+
 TEST(Simplification, ACancelStopsIt) {
   PolygonMesh mesh = example("bunny.obj");
   test::TestContext context(1);
