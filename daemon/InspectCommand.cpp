@@ -8,9 +8,11 @@
 #include <nlohmann/json.hpp>
 
 #include "daemon/ExitCode.h"
+#include "geometry/CoplanarMerge.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
+#include "jobs/MakeJob.h"
 #include "jobs/Manifest.h"
 
 namespace rotafab::cli {
@@ -50,6 +52,18 @@ void printRepairPreview(const geometry::RepairPreview& preview) {
   }
 }
 
+// What make's default coplanar merge does to the mesh (an STL's), if anything.
+void printMergePreview(const std::string& name, geometry::PolygonMesh mesh) {
+  const double degrees = jobs::defaultMergeDegrees(name);
+  if (!(degrees > 0)) return;
+  const geometry::CoplanarMerge merged = geometry::mergeCoplanarFaces(mesh, degrees);
+  if (merged.regions == 0) return;
+  fmt::print(
+      "`rotafab make` merges its {} faces into {} (adjacent faces within {:g} degree of one plane become one "
+      "panel; --merge-coplanar 0 keeps them apart)\n",
+      merged.facesBefore, merged.facesAfter, degrees);
+}
+
 void printText(const std::string& name, const geometry::PolygonMesh& mesh, const geometry::MeshAnalysis& analysis,
                const geometry::RepairPreview& preview) {
   const auto& t = analysis.topology;
@@ -73,6 +87,7 @@ void printText(const std::string& name, const geometry::PolygonMesh& mesh, const
   for (const auto& note : analysis.notes) fmt::print("  repaired: {}\n", note);
   if (analysis.usable()) {
     fmt::print("usable for `rotafab make`\n");
+    printMergePreview(name, mesh);
     return;
   }
   constexpr size_t kShown = 20;

@@ -9,6 +9,7 @@
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
 #include <OpenMesh/Tools/Decimater/Observer.hh>
 #include <array>
+#include <cstdlib>
 #include <mutex>
 #include <stdexcept>
 #include <type_traits>
@@ -47,6 +48,7 @@ constexpr size_t kStepsPerReport = 256;
 // (the queue does the rest), choosing the best of this many edges a step.
 constexpr size_t kQueueShare = 2;
 constexpr size_t kChoices = 8;
+constexpr unsigned kChoiceSeed = 1;
 
 // Reports the collapses so far (`before` of them by an earlier decimater) and stops at a cancel.
 class Progress final : public OpenMesh::Decimater::Observer {
@@ -238,6 +240,10 @@ Simplification simplifyMesh(PolygonMesh& mesh, int faces, const core::WorkContex
     const size_t byChoiceTo = static_cast<size_t>(faces) * kQueueShare;
     size_t done = 0;
     if (tri.n_faces() > 2 * byChoiceTo) {
+      // OpenMesh picks its edges with rand(): seeded the same every time (one
+      // simplification at a time, QuietOpenMesh), the same mesh and count
+      // give the same panels in every run and in a daemon's every job.
+      std::srand(kChoiceSeed);
       done += decimate<OpenMesh::Decimater::McDecimaterT>(tri, byChoiceTo, context, done, collapses);
       tri.garbage_collection();
     }

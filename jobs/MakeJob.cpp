@@ -48,6 +48,17 @@ const char* plural(int n) { return n == 1 ? "" : "s"; }
 // when their triangles lie within this angle of one plane.
 constexpr double kStlMergeDegrees = 1.0;
 
+}  // namespace
+
+double defaultMergeDegrees(const std::filesystem::path& mesh) {
+  std::string extension = mesh.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  return extension == ".stl" ? kStlMergeDegrees : 0.0;
+}
+
+namespace {
+
 // --panels N: the mesh simplified to about N faces (after the merge of
 // coplanar faces, so that flat regions are taken first and nothing merges
 // the count down after), its topology checked to be the same.
@@ -108,10 +119,7 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
         request.repair ? "" : fmt::format("; {} auto repairs it where it can", request.names(Parameter::Repair))));
   }
   std::optional<int> start = request.start;
-  std::string extension = request.mesh.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return std::tolower(c); });
-  const double mergeDegrees = request.mergeCoplanar.value_or(extension == ".stl" ? kStlMergeDegrees : 0.0);
+  const double mergeDegrees = request.mergeCoplanar.value_or(defaultMergeDegrees(request.mesh));
   if (mergeDegrees > 0) {
     const geometry::CoplanarMerge merged = geometry::mergeCoplanarFaces(mesh, mergeDegrees);
     if (const auto into = merged.mergedInto.find(request.start.value_or(-1)); into != merged.mergedInto.end()) {

@@ -80,6 +80,10 @@ struct PlannedJob {
   PhaseSeconds seconds;
 };
 
+// The coplanar merge's angle when --merge-coplanar is not given: 1 degree for
+// an STL file (triangles only), 0 (none) for every other format.
+double defaultMergeDegrees(const std::filesystem::path& mesh);
+
 // The output folder when none is given: MESHNAME-band beside where the command runs.
 std::filesystem::path defaultOutputFolder(const MakeRequest& request);
 

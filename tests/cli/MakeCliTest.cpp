@@ -490,6 +490,11 @@ TEST(MakeCli, AnStlCubeIsSixPanels) {
   ASSERT_EQ(merged.status, 0) << merged.err;
   EXPECT_EQ(nlohmann::json::parse(merged.out).at("panels"), 6);
   EXPECT_NE(merged.err.find("merged its 12 faces into 6"), std::string::npos) << merged.err;
+  const CommandResult inspected = run(kCli + " inspect " + mesh);
+  EXPECT_NE(inspected.out.find("usable for `rotafab make`\n`rotafab make` merges its 12 faces into 6 (adjacent "
+                               "faces within 1 degree of one plane become one panel"),
+            std::string::npos)
+      << inspected.out;
   const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
   EXPECT_EQ(manifest.at("mesh"), nlohmann::json({{"vertices", 8}, {"edges", 12}, {"faces", 6}, {"genus", 0}}));
   const CommandResult kept = run(kCli + " make " + mesh + " --structure band --size 8in --time 0 --json " +
