@@ -15,14 +15,16 @@ double signedArea(const Polygon2& polygon) {
   return twice / 2;
 }
 
+double distanceToSegment(const Point2& p, const Point2& a, const Point2& b) {
+  const Point2 ab = b - a;
+  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
 double distanceToOutline(const Polygon2& polygon, const Point2& p) {
   double nearest = std::numeric_limits<double>::max();
   for (size_t i = 0; i < polygon.size(); ++i) {
-    const Point2& a = polygon[i];
-    const Point2& b = polygon[(i + 1) % polygon.size()];
-    const Point2 ab = b - a;
-    const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-    nearest = std::min(nearest, (a + t * ab - p).norm());
+    nearest = std::min(nearest, distanceToSegment(p, polygon[i], polygon[(i + 1) % polygon.size()]));
   }
   return nearest;
 }

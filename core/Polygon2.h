@@ -19,6 +19,9 @@ inline double turn(const Point2& o, const Point2& a, const Point2& b) { return c
 // Signed area (positive counter-clockwise).
 double signedArea(const Polygon2& polygon);
 
+// The distance from `p` to the segment ab (to a when a == b).
+double distanceToSegment(const Point2& p, const Point2& a, const Point2& b);
+
 // The distance from `p` to the nearest side of a closed polygon.
 double distanceToOutline(const Polygon2& polygon, const Point2& p);
 

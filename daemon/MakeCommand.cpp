@@ -26,7 +26,7 @@ std::string stabilityLine(const geometry::Stability& stability) {
   const geometry::Point3 &p = stability.hangPoints.at(0), &q = stability.hangPoints.at(1);
   const std::string hang =
       p == q ? geometry::formatPoint(p) : fmt::format("{} and {}", geometry::formatPoint(p), geometry::formatPoint(q));
-  if (!(stability.margin < -0.005)) {
+  if (!(stability.margin < -geometry::kBalanceInches)) {
     return fmt::format("balances on the edge of its footprint, and a touch tips it{}; hang it from {}", mass, hang);
   }
   return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {}",

@@ -21,15 +21,17 @@ double fanArea(const PolygonMesh& mesh, int face) {
   return 0.5 * area;
 }
 
-double boundingBoxDiagonal(const PolygonMesh& mesh) {
-  if (mesh.positions.empty()) return 0.0;
+Point3 boundingBoxSize(const PolygonMesh& mesh) {
+  if (mesh.positions.empty()) return Point3::Zero();
   Point3 lo = mesh.positions.front(), hi = lo;
   for (const Point3& p : mesh.positions) {
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
-  return (hi - lo).norm();
+  return hi - lo;
 }
+
+double boundingBoxDiagonal(const PolygonMesh& mesh) { return boundingBoxSize(mesh).norm(); }
 
 std::string formatPoint(const Point3& p) { return fmt::format("({:.6g}, {:.6g}, {:.6g})", p.x(), p.y(), p.z()); }
 

@@ -43,6 +43,9 @@ Point3 faceCentroid(const PolygonMesh& mesh, int face);
 // first corner. Zero exactly when all corners are collinear.
 double fanArea(const PolygonMesh& mesh, int face);
 
+// The sides of the axis-aligned bounding box (zero when empty).
+Point3 boundingBoxSize(const PolygonMesh& mesh);
+
 // Length of the diagonal of the axis-aligned bounding box (0 when empty).
 double boundingBoxDiagonal(const PolygonMesh& mesh);
 

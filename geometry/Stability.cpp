@@ -45,25 +45,12 @@ std::vector<Ground> convexHull(std::vector<Ground> points) {
   return hull;
 }
 
-double distanceToSegment(const Ground& p, const Ground& a, const Ground& b) {
-  const Ground ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double t = length2 > 0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
 // Positive inside the footprint (the distance to its outline), negative
 // outside; a footprint of one or two points has no inside.
 double signedMargin(const std::vector<Ground>& hull, const Ground& p) {
-  if (hull.size() == 1) return -(hull[0] - p).norm();
-  double nearest = std::numeric_limits<double>::infinity();
   bool inside = hull.size() >= 3;
-  for (size_t i = 0; i < hull.size(); ++i) {
-    const Ground& a = hull[i];
-    const Ground& b = hull[(i + 1) % hull.size()];
-    nearest = std::min(nearest, distanceToSegment(p, a, b));
-    if (turn(a, b, p) <= 0) inside = false;
-  }
+  for (size_t i = 0; i < hull.size() && inside; ++i) inside = turn(hull[i], hull[(i + 1) % hull.size()], p) > 0;
+  const double nearest = core::distanceToOutline(hull, p);
   return inside ? nearest : -nearest;
 }
 
@@ -98,7 +85,7 @@ std::vector<Point3> hangPoints(const std::vector<Point3>& points, const Point3& 
   double nearest = std::numeric_limits<double>::infinity();
   for (size_t i = 0; i < above.size(); ++i) {
     for (size_t j = i + 1; j < above.size(); ++j) {
-      nearest = std::min(nearest, distanceToSegment(c, frame.ground(*above[i]), frame.ground(*above[j])));
+      nearest = std::min(nearest, core::distanceToSegment(c, frame.ground(*above[i]), frame.ground(*above[j])));
     }
   }
   const double nearEnough = nearest + 0.01 * width;
@@ -107,7 +94,7 @@ std::vector<Point3> hangPoints(const std::vector<Point3>& points, const Point3& 
   for (size_t i = 0; i < above.size(); ++i) {
     for (size_t j = i + 1; j < above.size(); ++j) {
       const Ground p = frame.ground(*above[i]), q = frame.ground(*above[j]);
-      if (distanceToSegment(c, p, q) > nearEnough) continue;
+      if (core::distanceToSegment(c, p, q) > nearEnough) continue;
       const double score = std::min((*above[i])[frame.up], (*above[j])[frame.up]) + 0.1 * (p - q).norm();
       if (score > bestScore) {
         bestScore = score;

@@ -44,6 +44,10 @@ struct Stability {
 constexpr double kGroundToleranceShare = 0.01;
 constexpr double kGroundToleranceInches = 1.0 / 32;
 
+// A structure that does not stand but whose centre of mass is within this of
+// its footprint's outline (inches) balances on it: a touch tips it.
+constexpr double kBalanceInches = 0.005;
+
 // Throws std::invalid_argument for an empty structure or an axis not 0-2.
 Stability structureStability(const Structure& structure, const StabilityOptions& options);
 

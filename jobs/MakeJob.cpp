@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -189,12 +188,10 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
   if (!std::isfinite(scaleNeeded)) {
     return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
   }
-  Eigen::AlignedBox3d box;
-  for (const geometry::Point3& p : mesh.positions) box.extend(p);
+  const geometry::Point3 box = geometry::boundingBoxSize(mesh);
   const std::string larger =
-      request.scale
-          ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
-          : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(box.sizes().maxCoeff() * scaleNeeded));
+      request.scale ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
+                    : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(box.maxCoeff() * scaleNeeded));
   const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
   return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every band room",
                                    names(Parameter::Fastener), smaller, larger)
@@ -221,16 +218,15 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     geometry::GrownStructure built = geometry::buildBandStructureWithRoom(mesh, band, context);
     grown = built.grown;
     if (grown > 1) {
-      Eigen::AlignedBox3d box;
-      for (const geometry::Point3& p : mesh.positions) box.extend(p);
       const int narrow = built.bandsWithoutRoom;
       context.note(fmt::format(
           "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), the smallest size "
           "at which every band has room for its {:.3f} in fastener hole {:g} diameter from every outline ({} "
           "band{} had none: narrow faces; {} N, fewer and evener faces, may need less); {} or {} sets the size",
-          name, geometry::kMeanEdgeInches * grown, geometry::kMeanEdgeInches, box.sizes().maxCoeff(), band.fastener,
-          geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s", request.names(Parameter::Panels),
-          request.names(Parameter::Size), request.names(Parameter::Scale)));
+          name, geometry::kMeanEdgeInches * grown, geometry::kMeanEdgeInches,
+          geometry::boundingBoxSize(mesh).maxCoeff(), band.fastener, geometry::kLeastClearance, narrow,
+          narrow == 1 ? "" : "s", request.names(Parameter::Panels), request.names(Parameter::Size),
+          request.names(Parameter::Scale)));
     }
     return std::move(built.structure);
   } catch (const geometry::NoRoomForHoleError& error) {
@@ -282,9 +278,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.structure = builtStructure(request, mesh, job.mesh.start, grown, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
-  Eigen::AlignedBox3d box;
-  for (const geometry::Point3& p : mesh.positions) box.extend(p);
-  job.size = box.sizes();
+  job.size = geometry::boundingBoxSize(mesh);
   job.seconds.geometry = lap();
 
   PlanOptions plan;

@@ -336,7 +336,7 @@ std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
       const std::string from =
           hang.at(0) == hang.at(1) ? point(hang.at(0)) : point(hang.at(0)) + " and " + point(hang.at(1));
       const std::string falls =
-          margin < -0.005
+          margin < -geometry::kBalanceInches
               ? fmt::format("It will tip over: its centre of mass is {:.2f} in outside its footprint.", -margin)
               : std::string("It balances on the edge of its footprint, and a touch tips it.");
       notes.push_back(
