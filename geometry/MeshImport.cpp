@@ -48,8 +48,10 @@ constexpr const char* kLargePages = "GLIBC_TUNABLES=glibc.malloc.hugetlb=1";
 // rotafab, or a daemon with other people's jobs in it, down.
 PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& extension,
                                  const std::filesystem::path* path, const core::Cancellation* cancellation) {
-  // Generous: Assimp reads 200k faces of OBJ in about 0.15 s.
-  const auto timeout = std::chrono::seconds(120 + bytes.size() / 1'000'000);
+  // Generous, and in proportion to the file: Assimp reads 200k faces of OBJ
+  // (11 MB) in about 0.15 s, yet it loops on some malformed files, and a
+  // user should not wait minutes to hear that a small file is broken.
+  const auto timeout = std::chrono::seconds(5 + 4 * (bytes.size() / 1'000'000));
   // The reader dies with this process (it is told which one to watch).
   std::vector<std::string> argv{core::helperProgram(kMeshReader), std::to_string(::getpid()), extension};
   if (path) argv.push_back(std::filesystem::absolute(*path).string());
@@ -62,8 +64,10 @@ PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& exte
   std::string format = extension;
   std::transform(format.begin(), format.end(), format.begin(), [](unsigned char c) { return std::toupper(c); });
   if (result.status == core::ChildResult::Status::TimedOut) {
-    throw InvalidMeshError(fmt::format("the {} reader (Assimp) did not finish within {} s", format,
-                                       std::chrono::duration_cast<std::chrono::seconds>(timeout).count()));
+    throw InvalidMeshError(fmt::format(
+        "the {} reader (Assimp) did not finish within {} s, many times what a file of this size takes: the file is "
+        "malformed",
+        format, std::chrono::duration_cast<std::chrono::seconds>(timeout).count()));
   }
   if (result.status == core::ChildResult::Status::Crashed && result.signal != 0) {
     throw InvalidMeshError(fmt::format("the {} reader (Assimp) crashed on this file ({}): the file is malformed",
@@ -85,6 +89,14 @@ PolygonMesh readAny(std::string_view bytes, const std::string& extension, const 
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
   if (extension == "off") return readOff(bytes);
   if (extension == "ply") return readPly(bytes);
+  // Assimp 5.2's glTF reader loops on text that is not JSON at all.
+  if (extension == "gltf") {
+    const size_t start = bytes.find_first_not_of(" \t\r\n");
+    const bool bom = bytes.starts_with("\xEF\xBB\xBF");
+    if (!bom && (start == std::string_view::npos || bytes[start] != '{')) {
+      throw InvalidMeshError("the file is not glTF: a .gltf file is a JSON object, starting with '{'");
+    }
+  }
   return readWithAssimpHelper(bytes, extension, path, cancellation);
 }
 

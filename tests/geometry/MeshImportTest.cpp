@@ -348,6 +348,15 @@ TEST(MeshImport, GltfNodeTransformsPlaceEveryInstance) {
   EXPECT_NE(refusal(huge).find("the scene's node transform makes it non-finite"), std::string::npos) << refusal(huge);
 }
 
+// Found by the fuzzer: Assimp 5.2's glTF reader never returns on these 39
+// bytes. Refused at once, saying what a .gltf file must be.
+TEST(MeshImport, AGltfThatIsNotJsonIsRefusedAtOnce) {
+  TempDir dir;
+  const auto path = dir.write("scan.gltf", "ply\nformat binary_little_endian 1.0\ncom");
+  const std::string why = refusal(path);
+  EXPECT_NE(why.find("scan.gltf: the file is not glTF: a .gltf file is a JSON object"), std::string::npos) << why;
+}
+
 // Whatever the bytes, import ends in a mesh or an InvalidMeshError: never a
 // crash, a hang or another exception. (The fuzz target goes much further.)
 TEST(MeshImport, RandomAndCorruptedBytesNeverEscapeAsAnythingButInvalidMesh) {
