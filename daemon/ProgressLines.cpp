@@ -19,8 +19,14 @@ void ProgressLines::operator()(const core::Progress& p) {
   } else if (p.phase == "geometry") {
     if (p.step == "band decomposition") line = fmt::format("band decomposition of {} faces", p.total);
     if (p.step == "panels split") {
-      line = fmt::format("{} band{} cut off {} panel{} that would overlap themselves, each fastened back by a tab",
-                         p.done, plural(p.done), p.done == 1 ? "a" : "the", plural(p.done));
+      // done: bands cut off with a tab; total: those and the bands cut across their middle
+      const size_t across = p.total > p.done ? p.total - p.done : 0;
+      line =
+          fmt::format("{} band{} cut off {} panel{} that would overlap themselves, {}", p.total, plural(p.total),
+                      p.total == 1 ? "a" : "the", plural(p.total),
+                      across == 0 ? std::string(p.total == 1 ? "fastened back by a tab" : "each fastened back by a tab")
+                      : p.done == 0 ? std::string("cut across the middle, the other copy holding both halves")
+                                    : fmt::format("{} with a tab, {} cut across the middle", p.done, across));
     }
     if (p.step == "fastener holes") line = fmt::format("fastener holes on {} bands", p.total);
     if (p.step == "labels") line = fmt::format("labels on {} panels", p.total);

@@ -46,6 +46,83 @@ std::pair<Point2, double> mostRoomIn(const std::vector<Point2>& polygon, const R
   return {best, most};
 }
 
+// Faces whose panels would overlap themselves however their bands are cut
+// (buildOnce()): each is split in two and the structure built again.
+struct FacesToSplit {
+  std::vector<int> faces;
+  std::string firstError;
+};
+
+// Splits `face` in two along the diagonal that leaves the parts most nearly
+// convex (the fewest reflex corners, then the most even areas), in the
+// face's own plane (Newell's normal): the last remedy of a panel that would
+// overlap itself (V.4), the vertex band in two parts, joined again by the
+// band of the new edge and its fasteners. The second part is a new face from
+// the same face of the file. False when the face has no such diagonal (a
+// triangle, or a face crossing itself).
+bool splitFaceInTwo(PolygonMesh& mesh, int face) {
+  const std::vector<int> corners = mesh.faces[face];
+  const int n = static_cast<int>(corners.size());
+  if (n < 4) return false;
+  Point3 normal = Point3::Zero();
+  for (int i = 0; i < n; ++i) {
+    normal += mesh.positions[corners[i]].cross(mesh.positions[corners[(i + 1) % n]]);
+  }
+  if (!(normal.norm() > 0)) return false;
+  normal.normalize();
+  const Point3 x = (std::abs(normal.x()) < 0.9 ? Point3::UnitX() : Point3::UnitY()).cross(normal).normalized();
+  const Point3 y = normal.cross(x);
+  std::vector<core::Point2> flat;
+  for (int v : corners) flat.emplace_back(mesh.positions[v].dot(x), mesh.positions[v].dot(y));
+  const auto part = [&](int from, int to) {
+    std::vector<core::Point2> polygon;
+    for (int i = from;; i = (i + 1) % n) {
+      polygon.push_back(flat[i]);
+      if (i == to) break;
+    }
+    return polygon;
+  };
+  const auto reflex = [](const std::vector<core::Point2>& polygon) {
+    int count = 0;
+    const size_t m = polygon.size();
+    for (size_t i = 0; i < m; ++i) count += core::turn(polygon[i], polygon[(i + 1) % m], polygon[(i + 2) % m]) < 0;
+    return count;
+  };
+  int bestFrom = -1, bestTo = -1, fewest = 0;
+  double mostEven = 0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 2; j < n; ++j) {
+      if (i == 0 && j == n - 1) continue;  // a side, not a diagonal
+      const auto first = part(i, j), second = part(j, i);
+      // Inside the face: both parts turn the face's way and neither crosses itself.
+      const double a = core::signedArea(first), b = core::signedArea(second);
+      if (!(a > 0 && b > 0) || core::crossesItself(first) || core::crossesItself(second)) continue;
+      const int reflexCorners = reflex(first) + reflex(second);
+      const double even = std::min(a, b) / std::max(a, b);
+      if (bestFrom < 0 || reflexCorners < fewest || (reflexCorners == fewest && even > mostEven)) {
+        bestFrom = i, bestTo = j, fewest = reflexCorners, mostEven = even;
+      }
+    }
+  }
+  if (bestFrom < 0) return false;
+  std::vector<int> first, second;
+  for (int i = bestFrom;; i = (i + 1) % n) {
+    first.push_back(corners[i]);
+    if (i == bestTo) break;
+  }
+  for (int i = bestTo;; i = (i + 1) % n) {
+    second.push_back(corners[i]);
+    if (i == bestFrom) break;
+  }
+  if (mesh.sourceFace.empty()) {
+    for (int f = 0; f < mesh.faceCount(); ++f) mesh.sourceFace.push_back(f);
+  }
+  mesh.faces[face] = std::move(first);
+  mesh.faces.push_back(std::move(second));
+  mesh.sourceFace.push_back(mesh.sourceFace[face]);
+  return true;
+}
+
 double polygonArea3(const std::vector<Point3>& polygon) {
   Point3 sum = Point3::Zero();
   for (size_t i = 0; i < polygon.size(); ++i) sum += polygon[i].cross(polygon[(i + 1) % polygon.size()]);
@@ -54,7 +131,9 @@ double polygonArea3(const std::vector<Point3>& polygon) {
 
 }  // namespace
 
-Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
+namespace {
+
+Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
   const ParameterNames& names = options.names;
   if (!(options.fastener > 0)) {
     throw ParameterError(Parameter::Fastener, names(Parameter::Fastener) + ": the hole diameter must be positive");
@@ -100,9 +179,11 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
                        mesh.sourceVertexIndex(rs.target(2 * e)));
   };
   // A panel that would overlap itself (V.4) is split: one band at a time,
-  // the later of two that overlap, is cut off with a tab, until none do.
+  // the later of two that overlap, is cut off with a tab (or, where no tab
+  // has room, across its middle), until none do.
   // A piece crossing itself cannot be mended so.
-  int split = 0;
+  int split = 0, halved = 0;
+  FacesToSplit toSplit;
   for (int f = 0; f < mesh.faceCount(); ++f) {
     context.check();
     for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
@@ -125,6 +206,7 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
       std::string why;
       double mostRoom = 0;  // of the tabs tried, the best share of the clearance needed
       const auto cutOff = [&](int index) {
+        if (flat[f].bands[index].halved) return false;
         FlatPanel trial = flat[f];
         try {
           detachBand(trial, index, 2 * kClearance * options.fastener);
@@ -161,10 +243,29 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
         flat[f] = std::move(trial);
         return true;
       };
+      // Where no tab has room: the band cut across its middle, so that the
+      // other copy, whole, holds both halves (its holes are checked with
+      // the others', below). Not both copies of a band: the halves would
+      // then hold only each other's panel.
+      const auto cutAcross = [&](int index) {
+        const FlatBand& copy = flat[f].bands[index];
+        const EdgeBand& band = bands[copy.edge];
+        const FlatBand* other = bandCopy(flat[copy.fromA ? band.faceB : band.faceA], copy.edge);
+        if (copy.halved || (other && other->halved)) return false;
+        FlatPanel trial = flat[f];
+        try {
+          halveBand(trial, index);
+        } catch (const std::invalid_argument&) {
+          return false;
+        }
+        flat[f] = std::move(trial);
+        ++halved;
+        return true;
+      };
       if (!cutOff(j) && (i < 0 || !cutOff(i))) {
         const std::string what =
             fmt::format("{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}", where(),
-                        edgeName(flat[f].bands[j].edge), why);
+                        edgeName(flat[f].bands[j].edge), why.empty() ? "it is cut across already" : why);
         // The tab's room grows with the mesh, but only until the tab is as
         // deep as it may be, and other tabs may be in the way: an estimate.
         if (mostRoom > 0) {
@@ -172,13 +273,25 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
           error.estimate = true;
           throw error;
         }
-        throw std::invalid_argument(fmt::format("{}; split that face in the mesh, or simplify the mesh ({} N)", what,
-                                                names(Parameter::Panels)));
+        // No tab at any size: the band across its middle; else the face itself in two.
+        if (cutAcross(j) || (i >= 0 && cutAcross(i))) continue;
+        if (mesh.faces[f].size() > 3) {
+          if (toSplit.faces.empty()) toSplit.firstError = what + "; nor can it be cut across its middle";
+          toSplit.faces.push_back(f);
+          break;
+        }
+        throw std::invalid_argument(fmt::format(
+            "{}; nor can it be cut across its middle; split that face in the mesh, or simplify the mesh ({} N)", what,
+            names(Parameter::Panels)));
       }
       ++split;
     }
   }
-  if (split > 0) context.report({"geometry", "panels split", static_cast<size_t>(split), 0});
+  if (!toSplit.faces.empty()) throw toSplit;
+  // (done: the bands cut off with a tab; total: those and the bands cut across)
+  if (split + halved > 0) {
+    context.report({"geometry", "panels split", static_cast<size_t>(split), static_cast<size_t>(split + halved)});
+  }
 
   // Edge numbers in the order the flood fill meets the edges, so that the
   // numbers a builder looks for next are close to the ones in hand.
@@ -235,23 +348,24 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
     for (const FlatBand& copy : fp.bands) {
       const EdgeBand& band = bands[copy.edge];
       PanelPiece* piece = nullptr;
-      if (copy.detached) {
+      if (copy.detached || copy.halved) {
         panel.pieces.push_back({fmt::format("{}{}", panel.id, static_cast<char>('a' + panel.pieces.size() % 26)),
                                 edgeNumber[copy.edge],
                                 copy.pieceOutline,
                                 {},
                                 {},
-                                0.0});
+                                0.0,
+                                copy.halved ? PieceFastening::Band : PieceFastening::Tab});
         piece = &panel.pieces.back();
         pieceCircles.emplace_back();
       }
-      auto& holesHere = piece ? piece->holes : panel.holes;
-      auto& circlesHere = piece ? pieceCircles.back() : circles;
       for (const BandPoint& hole : holes[copy.edge].holes) {
-        holesHere.push_back({edgeNumber[copy.edge], hole.onPanel(copy), options.fastener});
-        circlesHere.push_back({holesHere.back().xy, options.fastener / 2});
+        const Point2 at = hole.onPanel(copy);
+        const bool onPiece = copy.onPiece(at);
+        (onPiece ? piece->holes : panel.holes).push_back({edgeNumber[copy.edge], at, options.fastener});
+        (onPiece ? pieceCircles.back() : circles).push_back({at, options.fastener / 2});
       }
-      if (piece) {
+      if (copy.detached) {
         piece->holes.push_back({0, copy.tab, options.fastener});
         pieceCircles.back().push_back({copy.tab, options.fastener / 2});
         panel.holes.push_back({0, copy.tab, options.fastener});
@@ -262,7 +376,10 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
         panel.surface.push_back({band.point(t[0]), band.point(t[1]), band.point(t[2])});
         bandArea += polygonArea3(panel.surface.back());
       }
-      (piece ? piece->area : panel.area) += bandArea;
+      // Laid flat without stretching: the far half's area is its outline's.
+      const double pieceArea = copy.halved ? signedArea(copy.pieceOutline) : copy.detached ? bandArea : 0.0;
+      if (piece) piece->area += pieceArea;
+      panel.area += bandArea - pieceArea;
       panel.joins.push_back({order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1, edgeNumber[copy.edge]});
     }
     // Labels: each band's edge number near its holes, reading out from the
@@ -271,13 +388,17 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
     std::vector<TextBox> taken;
     size_t pieceIndex = 0;
     for (const FlatBand& copy : fp.bands) {
-      PanelPiece* piece = copy.detached ? &panel.pieces[pieceIndex] : nullptr;
-      const std::vector<Circle>& circlesHere = piece ? pieceCircles[pieceIndex] : circles;
+      // The edge number goes where the band's near end is: on the piece of
+      // a band cut off, on the panel of a band cut across.
+      PanelPiece* cut = copy.detached || copy.halved ? &panel.pieces[pieceIndex] : nullptr;
+      const std::vector<Circle>* cutCircles = cut ? &pieceCircles[pieceIndex] : nullptr;
+      if (cut) ++pieceIndex;
+      PanelPiece* piece = copy.detached ? cut : nullptr;
+      const std::vector<Circle>& circlesHere = piece ? *cutCircles : circles;
       std::vector<TextBox> pieceTaken;
       std::vector<TextBox>& takenHere = piece ? pieceTaken : taken;
       auto& labelsHere = piece ? piece->labels : panel.labels;
       const auto& outlineHere = piece ? copy.pieceOutline : fp.outline;
-      if (piece) ++pieceIndex;
       const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
       const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
       Point2 holesAt = Point2::Zero();
@@ -317,6 +438,24 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
                                    font.strokes(piece->name, box->origin, box->height, box->angle)});
         } else {
           unfitted.push_back(fmt::format("piece {}", piece->name));
+        }
+      } else if (cut) {
+        // The far half's name on it, reading out along the band, nearest its middle.
+        std::vector<Point2> onHalf;
+        for (double u = 0.65; u <= 0.951; u += 0.05) {
+          for (double t = 0.3; t <= 0.701; t += 0.1) onHalf.push_back(copy.at(near + (far - near) * u, t));
+        }
+        const Point2 middle = copy.at(near + (far - near) * 0.75, 0.5);
+        std::stable_sort(onHalf.begin(), onHalf.end(), [&](const Point2& a, const Point2& b) {
+          return (a - middle).squaredNorm() < (b - middle).squaredNorm();
+        });
+        std::vector<TextBox> halfTaken;
+        if (const auto box = fitText(font, cut->name, std::atan2(out.y(), out.x()), copy.pieceOutline,
+                                     copy.pieceOutline, *cutCircles, halfTaken, onHalf)) {
+          cut->labels.push_back(
+              {cut->name, 0, LabelRole::Piece, *box, font.strokes(cut->name, box->origin, box->height, box->angle)});
+        } else {
+          unfitted.push_back(fmt::format("piece {}", cut->name));
         }
       }
     }
@@ -363,6 +502,44 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
   }
   result.steps = stepsInPanelOrder(result.panels);
   return result;
+}
+
+}  // namespace
+
+Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
+  // A split face's parts may still overlap: split again, a few times at most.
+  constexpr int kSplitRounds = 3;
+  PolygonMesh split;
+  const PolygonMesh* current = &mesh;
+  int faces = 0;
+  std::string first;
+  for (int round = 1;; ++round) {
+    try {
+      Structure structure = buildOnce(*current, options, context);
+      if (faces > 0) {
+        structure.warnings.push_back(
+            fmt::format("{} face{} split in two along a diagonal (the first: {}), as {} panel{} would overlap {} when "
+                        "unfolded; the new edge{} {} fastened like any other",
+                        faces, faces == 1 ? "" : "s", first, faces == 1 ? "its" : "their", faces == 1 ? "" : "s",
+                        faces == 1 ? "itself" : "themselves", faces == 1 ? "" : "s", faces == 1 ? "is" : "are"));
+      }
+      return structure;
+    } catch (const FacesToSplit& overlapping) {
+      const auto refuse = [&] {
+        return std::invalid_argument(fmt::format("{}; split that face in the mesh, or simplify the mesh ({} N)",
+                                                 overlapping.firstError, options.names(Parameter::Panels)));
+      };
+      if (round == kSplitRounds) throw refuse();
+      if (current == &mesh) split = mesh, current = &split;
+      for (int f : overlapping.faces) {
+        if (!splitFaceInTwo(split, f)) throw refuse();
+        if (first.empty()) {
+          first = split.sourceFaceIndex(f) >= 0 ? fmt::format("face {}", split.sourceFaceIndex(f)) : "a hole's cap";
+        }
+        ++faces;
+      }
+    }
+  }
 }
 
 GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,

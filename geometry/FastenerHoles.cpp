@@ -53,8 +53,8 @@ std::optional<BandPoint> locate(const EdgeBand& band, const FlatBand& copy, doub
 
 }  // namespace
 
-const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy) {
-  return copy.detached ? copy.pieceOutline : panel.outline;
+const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy, const Point2& at) {
+  return copy.onPiece(at) ? copy.pieceOutline : panel.outline;
 }
 
 namespace {
@@ -92,7 +92,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   // band cut off it (key (face, edge)) are parts of their own, only sharing
   // the panel's frame; a tab's hole is on both.
   using Placed = std::map<std::pair<int, int>, std::vector<Point2>>;
-  const auto partOf = [](int face, const FlatBand& copy) { return std::pair{face, copy.detached ? copy.edge : -1}; };
+  const auto partOf = [](int face, const FlatBand& copy, const Point2& at) {
+    return std::pair{face, copy.onPiece(at) ? copy.edge : -1};
+  };
   const auto near = [](const Placed& placed, const std::pair<int, int>& part) -> const std::vector<Point2>& {
     static const std::vector<Point2> none;
     const auto it = placed.find(part);
@@ -113,15 +115,20 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     const auto clearance = [&](const std::vector<BandPoint>& holes) {
       double least = std::numeric_limits<double>::max();
       for (int c = 0; c < 2; ++c) {
-        const std::vector<Point2>& outline = cutOutline(panels[faces[c]], *copies[c]);
         for (size_t h = 0; h < holes.size(); ++h) {
           const Point2 at = holes[h].onPanel(*copies[c]);
+          const std::vector<Point2>& outline = cutOutline(panels[faces[c]], *copies[c], at);
           if (!insidePolygon(outline, at)) return -1.0;
           least = std::min(least, distanceToOutline(outline, at) / fromOutline);
-          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c]))) {
+          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c], at))) {
             least = std::min(least, (other - at).norm() / fromHole);
           }
           for (size_t g = 0; g < h; ++g) least = std::min(least, (holes[g].onPanel(*copies[c]) - at).norm() / fromHole);
+        }
+        // A halved copy: a hole on each half, or one half would hang loose.
+        if (copies[c]->halved && (holes.size() != 2 || copies[c]->onPiece(holes[0].onPanel(*copies[c])) ==
+                                                           copies[c]->onPiece(holes[1].onPanel(*copies[c])))) {
+          return -1.0;
         }
       }
       return least;  // >= 1: every distance kept
@@ -156,6 +163,34 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       }
       if (!placed.holes.empty()) break;
     }
+    const bool halved = copies[0]->halved || copies[1]->halved;
+    if (placed.holes.empty() && halved) {
+      // Two holes along the band, one on each half, with the most clearance
+      // there is (the middle of the band is an outline now).
+      double most = -1;
+      for (double spread = 0.05; spread < 0.451; spread += 0.025) {
+        auto holes = layout(HoleLayout::Along, spread);
+        if (const double c = holes.size() == 2 ? clearance(holes) : -1; c > most) most = c, placed.holes = holes;
+      }
+      placed.layout = HoleLayout::Along;
+      double fromOutlines = std::numeric_limits<double>::max();
+      for (int c = 0; c < 2; ++c) {
+        for (const BandPoint& hole : placed.holes) {
+          const Point2 at = hole.onPanel(*copies[c]);
+          fromOutlines =
+              std::min(fromOutlines, distanceToOutline(cutOutline(panels[faces[c]], *copies[c], at), at) / diameter);
+        }
+      }
+      placed.clearance = std::min(kClearance, fromOutlines);
+      if (most < kLeastClearance / kClearance) {
+        throw BandTooSmall{
+            fmt::format(
+                "{}: its band ({:.3f} x {:.3f} in), cut across its middle, has no room for a {:.3f} in fastener "
+                "hole on each half {:g} diameter{} from every outline (centre to edge)",
+                edgeName(band.edge), length, width, diameter, kLeastClearance, kLeastClearance == 1 ? "" : "s"),
+            most > 0 ? 1.02 * kLeastClearance / kClearance / most : std::numeric_limits<double>::infinity()};
+      }
+    }
     if (placed.holes.empty()) {
       // One hole: the point of most clearance, found on a coarse grid over
       // the band and then by a pattern search around the best (the middle on a tie).
@@ -180,9 +215,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       // What it keeps from the outlines alone, in diameters (the ratio above also weighs the other holes).
       double fromOutlines = std::numeric_limits<double>::max();
       for (int c = 0; c < 2 && !placed.holes.empty(); ++c) {
-        fromOutlines = std::min(fromOutlines, distanceToOutline(cutOutline(panels[faces[c]], *copies[c]),
-                                                                placed.holes.front().onPanel(*copies[c])) /
-                                                  diameter);
+        const Point2 at = placed.holes.front().onPanel(*copies[c]);
+        fromOutlines =
+            std::min(fromOutlines, distanceToOutline(cutOutline(panels[faces[c]], *copies[c], at), at) / diameter);
       }
       placed.clearance = std::min(kClearance, fromOutlines);
       if (most < kLeastClearance / kClearance) {
@@ -226,8 +261,8 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {
       if (!copy.detached) continue;
-      holesOn[{static_cast<int>(f), -1}].push_back(copy.tab);          // the tab's fastener, on the panel
-      holesOn[partOf(static_cast<int>(f), copy)].push_back(copy.tab);  // and on the piece
+      holesOn[{static_cast<int>(f), -1}].push_back(copy.tab);                    // the tab's fastener, on the panel
+      holesOn[partOf(static_cast<int>(f), copy, copy.tab)].push_back(copy.tab);  // and on the piece
     }
   }
   for (const EdgeBand& band : bands) {
@@ -237,8 +272,9 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     const auto tooNear = [&] {
       for (int c = 0; c < 2; ++c) {
         for (const BandPoint& h : result[band.edge].holes) {
-          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c]))) {
-            if ((other - h.onPanel(*copies[c])).norm() < fromHole) return true;
+          const Point2 at = h.onPanel(*copies[c]);
+          for (const Point2& other : near(holesOn, partOf(faces[c], *copies[c], at))) {
+            if ((other - at).norm() < fromHole) return true;
           }
         }
       }
@@ -253,7 +289,8 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
     }
     for (int c = 0; c < 2; ++c) {
       for (const BandPoint& h : result[band.edge].holes) {
-        holesOn[partOf(faces[c], *copies[c])].push_back(h.onPanel(*copies[c]));
+        const Point2 at = h.onPanel(*copies[c]);
+        holesOn[partOf(faces[c], *copies[c], at)].push_back(at);
       }
     }
   }

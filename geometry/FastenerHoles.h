@@ -22,7 +22,9 @@
 // scale against outlines and other holes: from another hole's centre, at
 // least kLeastClearance / kClearance of (kClearance + 1) diameters.
 // "Each part it is on": a band cut off its panel (detachBand()) is a part
-// of its own, with its piece's outline and its tab's hole.
+// of its own, with its piece's outline and its tab's hole. A band cut
+// across its middle (halveBand()) has one hole of its length on each half,
+// or none at all.
 
 #include <array>
 #include <functional>
@@ -83,8 +85,9 @@ std::vector<BandHoles> placeFastenerHoles(
     const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); },
     const ParameterNames& names = parameterInWords);
 
-// The outline a copy of a band is cut with: its panel's, or its own piece's when detached.
-const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy);
+// The outline that point `at` of a copy of a band is cut with: its panel's,
+// or that of the piece it is on (FlatBand::onPiece()).
+const std::vector<Point2>& cutOutline(const FlatPanel& panel, const FlatBand& copy, const Point2& at);
 
 // The copy of edge `edge`'s band on `panel`, or nullptr.
 const FlatBand* bandCopy(const FlatPanel& panel, int edge);

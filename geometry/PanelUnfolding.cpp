@@ -96,6 +96,37 @@ void detachBand(FlatPanel& panel, int index, double depth) {
   rebuildOutline(panel);
 }
 
+void halveBand(FlatPanel& panel, int index) {
+  FlatBand& band = panel.bands[index];
+  if (band.detached || band.halved) throw std::invalid_argument("the band is already cut off");
+  const int segments = static_cast<int>(band.points.size()) / 2 - 1;
+  // Along the rail the outline leaves the vertex band by (t = out), then back
+  // along the other: s runs from this copy's end (near) to the other's.
+  const double near = band.fromA ? 0.0 : 1.0, far = 1.0 - near, middle = 0.5, out = band.fromA ? 0.0 : 1.0;
+  const auto stretch = [&](double from, double to) {
+    std::vector<double> s{from};
+    for (int i = 1; i < segments; ++i) {
+      const double at = band.fromA ? static_cast<double>(i) / segments : 1.0 - static_cast<double>(i) / segments;
+      if ((at - from) * (to - at) > 0) s.push_back(at);
+    }
+    s.push_back(to);
+    return s;
+  };
+  const auto around = [&](double from, double to) {
+    std::vector<Point2> outline;
+    const std::vector<double> s = stretch(from, to);
+    for (double x : s) outline.push_back(band.at(x, out));
+    for (auto x = s.rbegin(); x != s.rend(); ++x) outline.push_back(band.at(*x, 1 - out));
+    return outline;
+  };
+  std::vector<Point2> nearHalf = around(near, middle), farHalf = around(middle, far);
+  if (crossesItself(farHalf) || !(signedArea(farHalf) > 0)) throw std::invalid_argument("its far half crosses itself");
+  band.halved = true;
+  band.outline = std::move(nearHalf);
+  band.pieceOutline = std::move(farHalf);
+  rebuildOutline(panel);
+}
+
 FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decomposition,
                       const std::vector<EdgeBand>& bands, int face) {
   FlatPanel panel;

@@ -34,6 +34,14 @@ struct FlatBand {
   std::vector<Point2> pieceOutline;  // counter-clockwise, in the panel's frame
   std::vector<Point2> tabOutline;    // the tab alone: the band's side (from, to), then over the vertex band
   Point2 tab = Point2::Zero();       // the extra fastener's hole, on the piece and on the vertex band
+  // Cut across its middle (halveBand()): `outline` is then the near half,
+  // which stays on the panel, and `pieceOutline` the far half, a piece of
+  // its own. Each half carries one of the band's holes, and the other copy,
+  // whole, holds both: it bridges the cut.
+  bool halved = false;
+
+  // Whether a point of this copy is on a piece cut from its panel.
+  [[nodiscard]] bool onPiece(const Point2& p) const { return detached || (halved && insidePolygon(pieceOutline, p)); }
 
   // The point (s, t) of this copy: s from face A's side (0) to face B's (1)
   // along the rails, t from rail U (0) to rail V (1), bilinear in each segment.
@@ -63,6 +71,14 @@ FlatPanel unfoldPanel(const RotationSystem& rs, const BandDecomposition& decompo
 // when the vertex band is not convex or the piece would cross itself; the
 // panel is then left half changed (detach a copy).
 void detachBand(FlatPanel& panel, int index, double depth);
+
+// The other remedy, for a band whose tab has no room (V.4 leaves the cut
+// open): band `index` is cut across at its middle, s = 1/2, between the two
+// holes of its length; the near half stays on the panel and the far half
+// becomes a piece. The other copy of the band must stay whole. Throws
+// std::invalid_argument when the far half would cross itself; the panel is
+// then left half changed (halve a copy).
+void halveBand(FlatPanel& panel, int index);
 
 // Pairs of the panel's pieces that overlap: -1 for the vertex band, else an
 // index into bands; (i, i) for a piece that crosses itself. Empty when no

@@ -24,7 +24,16 @@ std::string_view roleName(LabelRole role) {
   return "edge";
 }
 
+std::string_view fasteningName(PieceFastening fastening) { return fastening == PieceFastening::Band ? "band" : "tab"; }
+
 std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
+  // A band's half cut off (of either panel's copy) goes on when its edge is joined.
+  std::map<int, std::vector<std::string>> halvesOfEdge;
+  for (const Panel& panel : panels) {
+    for (const PanelPiece& piece : panel.pieces) {
+      if (piece.fastening == PieceFastening::Band) halvesOfEdge[piece.edge].push_back(piece.name);
+    }
+  }
   std::vector<AssemblyStep> steps;
   for (const Panel& panel : panels) {
     // A band's holes are on the panel, or on the piece it was cut off as.
@@ -33,11 +42,11 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
     AssemblyStep step{panel.id, {}, {}};
     for (const PanelPiece& piece : panel.pieces) {
       for (const PanelHole& hole : piece.holes) ++holesOfEdge[hole.edge];
-      step.pieces.push_back(piece.name);
+      if (piece.fastening == PieceFastening::Tab) step.pieces.push_back(piece.name);
     }
     for (const PanelJoin& join : panel.joins) {
       if (join.panel >= panel.id) continue;
-      step.joins.push_back({join.panel, join.edge, holesOfEdge[join.edge]});
+      step.joins.push_back({join.panel, join.edge, holesOfEdge[join.edge], halvesOfEdge[join.edge]});
     }
     steps.push_back(std::move(step));
   }

@@ -56,6 +56,12 @@ struct PanelSource {
 
 // A part cut off its panel (a band that would make the panel overlap
 // itself, V.4), cut as a part of its own and fastened back to the panel.
+// How a piece cut off a panel is held: by a tab over the panel's vertex
+// band, with one fastener of its own (the whole band cut off), or by the
+// other copy of its band, through that band's holes (the far half of a band
+// cut across its middle).
+enum class PieceFastening { Tab, Band };
+
 struct PanelPiece {
   std::string name;   // "17a": its panel's number and a letter
   int edge = 0;       // the edge number of its band
@@ -63,7 +69,10 @@ struct PanelPiece {
   std::vector<PanelHole> holes;
   std::vector<PanelLabel> labels;
   double area = 0;  // in 3D
+  PieceFastening fastening = PieceFastening::Tab;
 };
+
+std::string_view fasteningName(PieceFastening fastening);  // "tab", "band"
 
 // A neighbouring panel, and the edge number along which the two are joined.
 struct PanelJoin {
@@ -88,10 +97,11 @@ struct Panel {
 // panels placed before it that it joins, with the fasteners of each join.
 struct AssemblyJoin {
   int panel = 0, edge = 0, fasteners = 0;
+  std::vector<std::string> pieces;  // the halves of the edge's band cut across, fastened with it
 };
 struct AssemblyStep {
   int panel = 0;
-  std::vector<std::string> pieces;
+  std::vector<std::string> pieces;  // held by a tab: one fastener each
   std::vector<AssemblyJoin> joins;
 };
 
@@ -106,7 +116,8 @@ struct Structure {
 
 // The steps of building panel by panel in id order (the flood fill's, V.5,
 // or a weave's cycle by cycle): each panel joined to those before it; a
-// join's fasteners are the holes of its edge on the panel and its pieces.
+// join's fasteners are the holes of its edge on the panel and its pieces,
+// and a band's half cut off either panel goes on with the join of its edge.
 std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
 
 // The panels' 3D surfaces as one mesh, polygon by polygon.

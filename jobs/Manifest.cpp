@@ -180,7 +180,8 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
     entry["edges"] = edges;
     entry["moved"] = placed.moved;
     // Extension: the bands cut off a panel that would overlap itself (V.4),
-    // each a part of its own with a tab fastened to the vertex band.
+    // each a part of its own with a tab fastened to the vertex band, or the
+    // far half of a band cut across, held by the band's other copy.
     if (!panel.pieces.empty()) {
       entry["pieces"] = nlohmann::ordered_json::array();
       for (size_t k = 0; k < panel.pieces.size(); ++k) {
@@ -199,6 +200,7 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
           p["holes"].push_back({{"edge", hole.edge}, {"xy", point(hole.xy)}, {"diameter", hole.diameter}});
         }
         p["area"] = piece.area;
+        p["fastened"] = geometry::fasteningName(piece.fastening);  // extension: by a tab, or by its band
         entry["pieces"].push_back(p);
       }
     }
@@ -214,7 +216,7 @@ namespace {
 struct Step {
   geometry::AssemblyStep step;
   int sheet = 0;
-  std::vector<int> pieceSheets;
+  std::map<std::string, int> sheetOfPiece;  // of the pieces the step names
 };
 
 // The steps of a manifest read back: its panels in id order, as far as the
@@ -224,6 +226,7 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
   for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
   std::vector<geometry::Panel> panels;
   std::vector<Step> steps;
+  std::map<std::string, int> sheetOfPiece;
   for (const auto& [id, panel] : byId) {
     geometry::Panel read;
     read.id = id;
@@ -238,11 +241,15 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
       for (const auto& piece : panel->at("pieces")) {
         geometry::PanelPiece& p = read.pieces.emplace_back();
         p.name = piece.at("name").get<std::string>();
+        p.edge = piece.at("edge").get<int>();
+        if (piece.value("fastened", "tab") == geometry::fasteningName(geometry::PieceFastening::Band)) {
+          p.fastening = geometry::PieceFastening::Band;
+        }
         for (const auto& hole : piece.at("holes")) {
           p.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
           edgesHere.insert(p.holes.back().edge);
         }
-        step.pieceSheets.push_back(piece.at("sheet").get<int>());
+        sheetOfPiece[p.name] = piece.at("sheet").get<int>();
       }
     }
     const auto& neighbors = panel->at("neighbors");
@@ -271,7 +278,13 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
     steps.push_back(std::move(step));
   }
   const std::vector<geometry::AssemblyStep> assembly = geometry::stepsInPanelOrder(panels);
-  for (size_t i = 0; i < steps.size(); ++i) steps[i].step = assembly[i];
+  for (size_t i = 0; i < steps.size(); ++i) {
+    steps[i].step = assembly[i];
+    for (const std::string& piece : assembly[i].pieces) steps[i].sheetOfPiece[piece] = sheetOfPiece.at(piece);
+    for (const geometry::AssemblyJoin& join : assembly[i].joins) {
+      for (const std::string& piece : join.pieces) steps[i].sheetOfPiece[piece] = sheetOfPiece.at(piece);
+    }
+  }
   return steps;
 }
 
@@ -283,16 +296,21 @@ int fastenersOf(const Step& step) {
 
 std::string describeJoins(const Step& step) {
   std::string text;
-  for (size_t k = 0; k < step.step.pieces.size(); ++k) {
-    text +=
-        fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", step.step.pieces[k], step.pieceSheets[k]);
+  for (const std::string& piece : step.step.pieces) {
+    text += fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", piece, step.sheetOfPiece.at(piece));
   }
   if (step.step.joins.empty()) return text + "start here, the base";
   text += "join to ";
   for (size_t j = 0; j < step.step.joins.size(); ++j) {
     const geometry::AssemblyJoin& join = step.step.joins[j];
-    text += fmt::format("{}panel {} at edge {} ({} fastener{})", j ? ", " : "", join.panel, join.edge, join.fasteners,
+    text += fmt::format("{}panel {} at edge {} ({} fastener{}", j ? ", " : "", join.panel, join.edge, join.fasteners,
                         join.fasteners == 1 ? "" : "s");
+    // The band cut across its middle: its far half goes on with the others.
+    for (const std::string& piece : join.pieces) {
+      text +=
+          fmt::format(", through piece {} (sheet {}), the cut half of the band", piece, step.sheetOfPiece.at(piece));
+    }
+    text += ")";
   }
   return text;
 }

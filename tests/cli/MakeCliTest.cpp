@@ -97,16 +97,18 @@ void expectHolesADiameterIn(const nlohmann::json& part, const std::string& name)
 // exactly two panels (with the pieces cut off them), as many on each;
 // `interiorEdges` < 0: as many as the panels name. Every side's edge number
 // is etched but for at most `unlabelled` (make warns of each it could not fit).
-void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges, int unlabelled = 0) {
+// (`splitFaces`: faces split in two, each two panels of one face)
+void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges, int unlabelled = 0,
+                      int splitFaces = 0) {
   const auto& panels = m.at("panels");
-  ASSERT_EQ(panels.size(), static_cast<size_t>(faceCount));
+  ASSERT_EQ(panels.size(), static_cast<size_t>(faceCount + splitFaces));
   std::map<int, std::vector<int>> holesOfEdge;  // edge -> hole count per panel
   std::set<int> faces, onSheets, namedEdges;
   int missingLabels = 0;
   for (const auto& sheet : m.at("sheets")) {
     for (const auto& id : sheet.at("panels")) onSheets.insert(id.get<int>());
   }
-  EXPECT_EQ(onSheets.size(), static_cast<size_t>(faceCount));
+  EXPECT_EQ(onSheets.size(), static_cast<size_t>(faceCount + splitFaces));
   for (size_t i = 0; i < panels.size(); ++i) {
     const auto& p = panels[i];
     EXPECT_EQ(p.at("id"), static_cast<int>(i) + 1);
@@ -217,7 +219,8 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 // and through every invariant of SPEC's manifest: CGAL's cow (a bow-tie
 // vertex, and a panel that would overlap itself with a shallow vertex band),
 // pig, triple torus, elephant (106 holes) and mushroom (open); the npm
-// teapot (open, a bow-tie); STLs OpenSCAD and another program wrote. The
+// teapot (open, a bow-tie); STLs OpenSCAD and another program wrote; CGAL's
+// L-shaped prism (a panel that overlaps itself at a reflex corner). The
 // layout in rows, at once: how fast nesting is does not matter here.
 TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
   const std::vector<std::string> meshes = {cgalMesh("cow.off"),
@@ -227,7 +230,8 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
                                            cgalMesh("mushroom.off"),
                                            (kSource / "tests/data/external/teapot.obj").string(),
                                            "/usr/share/openscad/testdata/scad/3D/features/import.stl",
-                                           "/usr/share/assimp/models/STL/sphereWithHole.stl"};
+                                           "/usr/share/assimp/models/STL/sphereWithHole.stl",
+                                           cgalMesh("corner_poly.off")};
   for (const std::string& where : meshes) {
     SCOPED_TRACE(where);
     TempDir dir;
@@ -239,7 +243,10 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
     const int unlabelled = std::regex_search(made.err, warned, std::regex(R"((\d+) labels? (is|are) not etched)"))
                                ? std::stoi(warned[1].str())
                                : 0;
-    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled);
+    const int split = std::regex_search(made.err, warned, std::regex(R"((\d+) faces? split in two)"))
+                          ? std::stoi(warned[1].str())
+                          : 0;
+    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split);
     EXPECT_TRUE(m.at("stability").contains("stands"));
     EXPECT_TRUE(m.at("mesh").at("genus").is_number()) << "repaired into an orientable manifold";
     if (where.ends_with("cow.off")) {
@@ -247,6 +254,17 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
       bool pieces = false;
       for (const auto& panel : m.at("panels")) pieces = pieces || panel.contains("pieces");
       EXPECT_TRUE(pieces) << "the cow's panel that would overlap itself has a band cut off";
+    }
+    if (where.ends_with("corner_poly.off")) {
+      // An L-shaped face: the bands at its reflex corner overlap, and no
+      // tab can be cut from a vertex band that is not convex. The face is
+      // split in two along a diagonal, and the parts are joined by the new
+      // edge's band, fastened as any other (each edge's holes, both panels).
+      EXPECT_EQ(split, 1) << made.err;
+      EXPECT_NE(made.err.find("(the first: face 1)"), std::string::npos) << made.err;
+      int ofFaceOne = 0;
+      for (const auto& panel : m.at("panels")) ofFaceOne += panel.at("source").at("face") == 1;
+      EXPECT_EQ(ofFaceOne, 2);
     }
   }
 }
