@@ -22,11 +22,17 @@ void ProgressLines::operator()(const core::Progress& p) {
       // done: bands cut off with a tab; total: those and the bands cut across their middle
       const size_t across = p.total > p.done ? p.total - p.done : 0;
       line =
-          fmt::format("{} band{} cut off {} panel{} that would overlap themselves, {}", p.total, plural(p.total),
-                      p.total == 1 ? "a" : "the", plural(p.total),
+          fmt::format("{} band{} cut off {} panel{} that would overlap {}, {}", p.total, plural(p.total),
+                      p.total == 1 ? "a" : "the", plural(p.total), p.total == 1 ? "itself" : "themselves",
                       across == 0 ? std::string(p.total == 1 ? "fastened back by a tab" : "each fastened back by a tab")
                       : p.done == 0 ? std::string("cut across the middle, the other copy holding both halves")
                                     : fmt::format("{} with a tab, {} cut across the middle", p.done, across));
+    }
+    if (p.step == "larger, for the fasteners") {
+      line = fmt::format("building again, larger, so that every band has room for its fastener (try {})", p.done);
+    }
+    if (p.step == "smaller, for the bed") {
+      line = fmt::format("building again, smaller, so that every part fits the bed (try {})", p.done);
     }
     if (p.step == "fastener holes") line = fmt::format("fastener holes on {} bands", p.total);
     if (p.step == "labels") line = fmt::format("labels on {} panels", p.total);

@@ -182,18 +182,25 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
   // the later of two that overlap, is cut off with a tab (or, where no tab
   // has room, across its middle), until none do.
   // A piece crossing itself cannot be mended so.
-  int split = 0, halved = 0;
+  int split = 0, halved = 0, gluedTabs = 0;
   FacesToSplit toSplit;
   for (int f = 0; f < mesh.faceCount(); ++f) {
     context.check();
     for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
       const auto [i, j] = overlaps.front();
       const auto where = [&] { return fmt::format("panel {} ({})", order.panelOfFace[f] + 1, faceName(f)); };
+      // The last remedy, the face itself in two (after this pass), where it has corners enough.
+      const auto splitLater = [&](const std::string& why) {
+        if (mesh.faces[f].size() < 4) return false;
+        if (toSplit.faces.empty()) toSplit.firstError = why;
+        toSplit.faces.push_back(f);
+        return true;
+      };
       if (j < 0) {
-        throw std::invalid_argument(fmt::format(
-            "{}: its vertex band crosses itself when laid flat (the face is far from planar); split the face in "
-            "the mesh",
-            where()));
+        const std::string what =
+            fmt::format("{}: its vertex band crosses itself when laid flat (the face is far from planar)", where());
+        if (splitLater(what)) break;
+        throw std::invalid_argument(what + "; split the face in the mesh");
       }
       if (i == j) {
         throw std::invalid_argument(
@@ -205,7 +212,8 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
       // tabs' holes; at the point of most clearance.
       std::string why;
       double mostRoom = 0;  // of the tabs tried, the best share of the clearance needed
-      const auto cutOff = [&](int index) {
+      // `glued`: a tab with no room for its hole is glued (BandOptions::glueBandsWithoutRoom).
+      const auto cutOff = [&](int index, bool glued = false) {
         if (flat[f].bands[index].halved) return false;
         FlatPanel trial = flat[f];
         try {
@@ -217,7 +225,7 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
         FlatBand& cut = trial.bands[index];
         // Tabs of one panel may lie on each other, but none over another's hole.
         for (const FlatBand& other : trial.bands) {
-          if (&other != &cut && other.detached && insidePolygon(cut.tabOutline, other.tab)) {
+          if (&other != &cut && other.detached && !other.tabGlued && insidePolygon(cut.tabOutline, other.tab)) {
             why = "its tab would cover the hole of another band's tab";
             return false;
           }
@@ -226,7 +234,7 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
           if (!insidePolygon(cut.tabOutline, p) || !insidePolygon(trial.outline, p)) return -1.0;
           double least = std::min(distanceToOutline(cut.pieceOutline, p), distanceToOutline(trial.outline, p));
           for (const FlatBand& other : trial.bands) {
-            if (&other == &cut || !other.detached) continue;
+            if (&other == &cut || !other.detached || other.tabGlued) continue;
             least = std::min(least, (other.tab - p).norm() - options.fastener);
             if (insidePolygon(other.tabOutline, p)) return -1.0;  // under another tab
           }
@@ -234,6 +242,12 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
         };
         const auto [hole, clearance] = mostRoomIn(cut.tabOutline, room);
         mostRoom = std::max(mostRoom, clearance / kLeastClearance);
+        if (clearance < kLeastClearance && glued) {
+          cut.tabGlued = true;
+          ++gluedTabs;
+          flat[f] = std::move(trial);
+          return true;
+        }
         if (clearance < kLeastClearance) {
           why = fmt::format("its tab has no room for a {:.3f} in fastener hole {:g} diameter{} from every outline",
                             options.fastener, kLeastClearance, kLeastClearance == 1 ? "" : "s");
@@ -268,18 +282,19 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
                         edgeName(flat[f].bands[j].edge), why.empty() ? "it is cut across already" : why);
         // The tab's room grows with the mesh, but only until the tab is as
         // deep as it may be, and other tabs may be in the way: an estimate.
-        if (mostRoom > 0) {
+        if (mostRoom > 0 && !options.glueBandsWithoutRoom) {
           NoRoomForHoleError error(what, 1, 1.02 / mostRoom, options.fastener, names);
           error.estimate = true;
           throw error;
         }
+        // A tab glued where it has no room for its hole and bands may be glued.
+        if (options.glueBandsWithoutRoom && (cutOff(j, true) || (i >= 0 && cutOff(i, true)))) {
+          ++split;
+          continue;
+        }
         // No tab at any size: the band across its middle; else the face itself in two.
         if (cutAcross(j) || (i >= 0 && cutAcross(i))) continue;
-        if (mesh.faces[f].size() > 3) {
-          if (toSplit.faces.empty()) toSplit.firstError = what + "; nor can it be cut across its middle";
-          toSplit.faces.push_back(f);
-          break;
-        }
+        if (splitLater(what + "; nor can it be cut across its middle")) break;
         throw std::invalid_argument(fmt::format(
             "{}; nor can it be cut across its middle; split that face in the mesh, or simplify the mesh ({} N)", what,
             names(Parameter::Panels)));
@@ -307,14 +322,37 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
   }
 
   context.report({"geometry", "fastener holes", 0, static_cast<size_t>(result.edges)});
-  const std::vector<BandHoles> holes = placeFastenerHoles(bands, flat, options.fastener, context, edgeName, names);
+  const std::vector<BandHoles> holes =
+      placeFastenerHoles(bands, flat, options.fastener, context, edgeName, names, options.glueBandsWithoutRoom);
   int narrow = 0, narrowest = -1;
-  result.fasteners = split;  // the tabs'
+  result.fasteners = split - gluedTabs;  // the tabs'
   for (const BandHoles& h : holes) {
     result.fasteners += static_cast<int>(h.holes.size());
-    if (h.edge < 0 || h.clearance >= kClearance) continue;
+    if (h.glued) result.glued.push_back(edgeNumber[h.edge]);
+    if (h.edge < 0 || h.glued || h.clearance >= kClearance) continue;
     ++narrow;
     if (narrowest < 0 || h.clearance < holes[narrowest].clearance) narrowest = h.edge;
+  }
+  if (gluedTabs > 0) {
+    result.warnings.push_back(fmt::format(
+        "{} band{} cut off {} panel{} that would overlap {}: no room for {} tab's {:.3f} in fastener hole, so {} "
+        "tab{} {} glued",
+        gluedTabs, gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "a" : "the", gluedTabs == 1 ? "" : "s",
+        gluedTabs == 1 ? "itself" : "themselves", gluedTabs == 1 ? "its" : "their", options.fastener,
+        gluedTabs == 1 ? "its" : "their", gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "is" : "are"));
+  }
+  if (!result.glued.empty()) {
+    std::sort(result.glued.begin(), result.glued.end());
+    std::string some;
+    for (size_t i = 0; i < std::min<size_t>(result.glued.size(), 5); ++i) {
+      some += fmt::format("{}{}", i ? ", " : "", result.glued[i]);
+    }
+    const size_t n = result.glued.size();
+    result.warnings.push_back(fmt::format(
+        "{} band{} no room for a {:.3f} in fastener hole {:g} diameter from every outline, so no hole: glue {} "
+        "(edge{} {}{})",
+        n, n == 1 ? " has" : "s have", options.fastener, kLeastClearance, n == 1 ? "it" : "them", n == 1 ? "" : "s",
+        some, n > 5 ? ", ..." : ""));
   }
   if (narrow > 0) {
     result.warnings.push_back(fmt::format(
@@ -355,7 +393,9 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
                                 {},
                                 {},
                                 0.0,
-                                copy.halved ? PieceFastening::Band : PieceFastening::Tab});
+                                copy.halved     ? PieceFastening::Band
+                                : copy.tabGlued ? PieceFastening::Glue
+                                                : PieceFastening::Tab});
         piece = &panel.pieces.back();
         pieceCircles.emplace_back();
       }
@@ -365,7 +405,7 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
         (onPiece ? piece->holes : panel.holes).push_back({edgeNumber[copy.edge], at, options.fastener});
         (onPiece ? pieceCircles.back() : circles).push_back({at, options.fastener / 2});
       }
-      if (copy.detached) {
+      if (copy.detached && !copy.tabGlued) {
         piece->holes.push_back({0, copy.tab, options.fastener});
         pieceCircles.back().push_back({copy.tab, options.fastener / 2});
         panel.holes.push_back({0, copy.tab, options.fastener});
@@ -508,7 +548,7 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
 
 Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
   // A split face's parts may still overlap: split again, a few times at most.
-  constexpr int kSplitRounds = 3;
+  constexpr int kSplitRounds = 8;
   PolygonMesh split;
   const PolygonMesh* current = &mesh;
   int faces = 0;

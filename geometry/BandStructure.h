@@ -22,6 +22,10 @@ struct BandOptions {
   std::optional<int> start;       // flood-fill start face (file index); the lowest face when empty
   int up = 1;                     // the vertical axis for "lowest": 0 x, 1 y, 2 z
   bool scoreFolds = false;
+  // A band without room for a fastener hole gets none and is glued
+  // (Structure::glued), instead of NoRoomForHoleError: for when the size at
+  // which every band would have room does not fit the bed.
+  bool glueBandsWithoutRoom = false;
   ParameterNames names = parameterInWords;  // how messages name the parameters
 };
 

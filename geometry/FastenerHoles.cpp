@@ -84,8 +84,8 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
 
 std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels,
                                           double diameter, const core::WorkContext& context,
-                                          const std::function<std::string(int)>& edgeName,
-                                          const ParameterNames& names) {
+                                          const std::function<std::string(int)>& edgeName, const ParameterNames& names,
+                                          bool glueWithoutRoom) {
   std::vector<BandHoles> result(bands.size());
   const double fromOutline = kClearance * diameter, fromHole = (kClearance + 1) * diameter;
   // Holes already placed, per part cut: a panel (key (face, -1)) and each
@@ -245,6 +245,15 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       tooSmall[e] = small;
     }
   });
+  const auto glue = [&](size_t e) {
+    result[e] = BandHoles{};
+    result[e].edge = bands[e].edge, result[e].clearance = 0, result[e].glued = true;
+  };
+  if (glueWithoutRoom) {
+    for (size_t e = 0; e < bands.size(); ++e) {
+      if (tooSmall[e]) glue(e), tooSmall[e].reset();
+    }
+  }
   // Every band without room, in one error: the first by edge, how many, and
   // the scale that gives the smallest of them room.
   const BandTooSmall* first = nullptr;
@@ -260,7 +269,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   Placed holesOn;
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {
-      if (!copy.detached) continue;
+      if (!copy.detached || copy.tabGlued) continue;
       holesOn[{static_cast<int>(f), -1}].push_back(copy.tab);                    // the tab's fastener, on the panel
       holesOn[partOf(static_cast<int>(f), copy, copy.tab)].push_back(copy.tab);  // and on the piece
     }
@@ -284,7 +293,8 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       try {
         result[band.edge] = placeBand(band, holesOn);
       } catch (const BandTooSmall& small) {
-        throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter, names);
+        if (!glueWithoutRoom) throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter, names);
+        glue(static_cast<size_t>(band.edge));
       }
     }
     for (int c = 0; c < 2; ++c) {

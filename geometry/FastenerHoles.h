@@ -58,6 +58,7 @@ struct BandHoles {
   HoleLayout layout = HoleLayout::Single;
   std::vector<BandPoint> holes;   // one fastener each
   double clearance = kClearance;  // diameters kept from the outlines, when less than kClearance
+  bool glued = false;             // no room for a hole (placeFastenerHoles()'s `glueWithoutRoom`): no holes
 };
 
 // Bands too small for even one hole kLeastClearance from their outlines.
@@ -77,13 +78,14 @@ class NoRoomForHoleError : public std::invalid_argument {
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed
 // by face. Throws NoRoomForHoleError naming the first edge (by `edgeName`)
 // when some band has no room for even one hole kLeastClearance from its
-// outlines, and core::Cancelled. The bands are shared out on the context's
+// outlines (with `glueWithoutRoom`, such a band has no holes and is marked
+// glued instead), and core::Cancelled. The bands are shared out on the context's
 // executor; the result does not depend on how many threads it has.
 std::vector<BandHoles> placeFastenerHoles(
     const std::vector<EdgeBand>& bands, const std::vector<FlatPanel>& panels, double diameter,
     const core::WorkContext& context,
     const std::function<std::string(int)>& edgeName = [](int e) { return "edge " + std::to_string(e); },
-    const ParameterNames& names = parameterInWords);
+    const ParameterNames& names = parameterInWords, bool glueWithoutRoom = false);
 
 // The outline that point `at` of a copy of a band is cut with: its panel's,
 // or that of the piece it is on (FlatBand::onPiece()).

@@ -34,6 +34,7 @@ struct FlatBand {
   std::vector<Point2> pieceOutline;  // counter-clockwise, in the panel's frame
   std::vector<Point2> tabOutline;    // the tab alone: the band's side (from, to), then over the vertex band
   Point2 tab = Point2::Zero();       // the extra fastener's hole, on the piece and on the vertex band
+  bool tabGlued = false;             // the tab has no room for that hole and is glued instead
   // Cut across its middle (halveBand()): `outline` is then the near half,
   // which stays on the panel, and `pieceOutline` the far half, a piece of
   // its own. Each half carries one of the band's holes, and the other copy,

@@ -24,7 +24,17 @@ std::string_view roleName(LabelRole role) {
   return "edge";
 }
 
-std::string_view fasteningName(PieceFastening fastening) { return fastening == PieceFastening::Band ? "band" : "tab"; }
+std::string_view fasteningName(PieceFastening fastening) {
+  switch (fastening) {
+    case PieceFastening::Band:
+      return "band";
+    case PieceFastening::Glue:
+      return "glue";
+    case PieceFastening::Tab:
+      break;
+  }
+  return "tab";
+}
 
 std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
   // A band's half cut off (of either panel's copy) goes on when its edge is joined.
@@ -39,10 +49,11 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
     // A band's holes are on the panel, or on the piece it was cut off as.
     std::map<int, int> holesOfEdge;
     for (const PanelHole& hole : panel.holes) ++holesOfEdge[hole.edge];
-    AssemblyStep step{panel.id, {}, {}};
+    AssemblyStep step{panel.id, {}, {}, {}};
     for (const PanelPiece& piece : panel.pieces) {
       for (const PanelHole& hole : piece.holes) ++holesOfEdge[hole.edge];
       if (piece.fastening == PieceFastening::Tab) step.pieces.push_back(piece.name);
+      if (piece.fastening == PieceFastening::Glue) step.gluedPieces.push_back(piece.name);
     }
     for (const PanelJoin& join : panel.joins) {
       if (join.panel >= panel.id) continue;

@@ -59,8 +59,8 @@ struct PanelSource {
 // How a piece cut off a panel is held: by a tab over the panel's vertex
 // band, with one fastener of its own (the whole band cut off), or by the
 // other copy of its band, through that band's holes (the far half of a band
-// cut across its middle).
-enum class PieceFastening { Tab, Band };
+// cut across its middle), or by a tab glued, with no room for a hole.
+enum class PieceFastening { Tab, Band, Glue };
 
 struct PanelPiece {
   std::string name;   // "17a": its panel's number and a letter
@@ -72,7 +72,7 @@ struct PanelPiece {
   PieceFastening fastening = PieceFastening::Tab;
 };
 
-std::string_view fasteningName(PieceFastening fastening);  // "tab", "band"
+std::string_view fasteningName(PieceFastening fastening);  // "tab", "band", "glue"
 
 // A neighbouring panel, and the edge number along which the two are joined.
 struct PanelJoin {
@@ -103,6 +103,7 @@ struct AssemblyStep {
   int panel = 0;
   std::vector<std::string> pieces;  // held by a tab: one fastener each
   std::vector<AssemblyJoin> joins;
+  std::vector<std::string> gluedPieces;  // held by a tab glued
 };
 
 struct Structure {
@@ -111,6 +112,7 @@ struct Structure {
   std::vector<AssemblyStep> steps;
   int edges = 0;                      // edge numbers run 1..edges
   int fasteners = 0;                  // one per pair of holes that meet, one per piece's tab
+  std::vector<int> glued;             // edge numbers of the bands with no room for a hole, to be glued
   std::vector<std::string> warnings;  // one line each (labels that did not fit, ...)
 };
 

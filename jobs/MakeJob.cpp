@@ -198,10 +198,15 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
                      : fmt::format("{} or larger would give every band room", larger);
 }
 
-// `grown`: how many times the default size the structure had to become for its fasteners (1: as it was).
+// How the structure's size was chosen, when make chose it.
+struct Sizing {
+  double grown = 1;         // times the default size (1: as it was)
+  bool bedLimited = false;  // the largest size that fits the bed, some bands glued
+};
+
 // `start`: the flood fill's first face in the mesh as built.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
-                                   double& grown, const core::WorkContext& context) {
+                                   Sizing& sizing, const core::WorkContext& context) {
   const std::string name = request.mesh.string();
   geometry::BandOptions band;
   band.tension = request.tension;
@@ -213,22 +218,76 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   band.names = request.names;
   // With no size or scale given, the structure grows until every band has room for its fastener.
   const bool scaleChosen = !request.size && !request.scale;
+  const double defaultSide = geometry::boundingBoxSize(mesh).maxCoeff();
+  const auto grownBy = [&] { return geometry::boundingBoxSize(mesh).maxCoeff() / defaultSide; };
+  const double kerf = request.kerf.value_or(request.material.kerf);
+  const auto roomOnTheBedFor = [&](const geometry::Structure& structure) {
+    return roomOnTheBed(structureParts(structure), request.machine, kerf);
+  };
+  const auto sized = [&](const std::string& why) {
+    return fmt::format(
+        "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), {}; {} N, fewer and "
+        "evener faces, may need less; {} or {} sets the size",
+        name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches,
+        geometry::boundingBoxSize(mesh).maxCoeff(), why, request.names(Parameter::Panels),
+        request.names(Parameter::Size), request.names(Parameter::Scale));
+  };
   try {
     if (!scaleChosen) return geometry::buildBandStructure(mesh, band, context);
-    geometry::GrownStructure built = geometry::buildBandStructureWithRoom(mesh, band, context);
-    grown = built.grown;
-    if (grown > 1) {
-      const int narrow = built.bandsWithoutRoom;
-      context.note(fmt::format(
-          "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), the smallest size "
-          "at which every band has room for its {:.3f} in fastener hole {:g} diameter from every outline ({} "
-          "band{} had none: narrow faces; {} N, fewer and evener faces, may need less); {} or {} sets the size",
-          name, geometry::kMeanEdgeInches * grown, geometry::kMeanEdgeInches,
-          geometry::boundingBoxSize(mesh).maxCoeff(), band.fastener, geometry::kLeastClearance, narrow,
-          narrow == 1 ? "" : "s", request.names(Parameter::Panels), request.names(Parameter::Size),
-          request.names(Parameter::Scale)));
+    std::optional<geometry::GrownStructure> built;
+    int narrow = 0;
+    std::optional<geometry::NoRoomForHoleError> noRoom;
+    try {
+      built = geometry::buildBandStructureWithRoom(mesh, band, context);
+      narrow = built->bandsWithoutRoom;
+    } catch (const geometry::NoRoomForHoleError& error) {
+      narrow = error.bands;
+      noRoom = error;
     }
-    return std::move(built.structure);
+    sizing.grown = grownBy();
+    if (built && (sizing.grown <= 1 || roomOnTheBedFor(built->structure) >= 1)) {
+      if (sizing.grown > 1) {
+        context.note(
+            sized(fmt::format("the smallest size at which every band has room for its {:.3f} in fastener "
+                              "hole {:g} diameter from every outline ({} band{} had none: narrow faces)",
+                              band.fastener, geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s")));
+      }
+      return std::move(built->structure);
+    }
+    // The size at which every band has room misses the bed, or growing did
+    // not find one: the largest size that fits the bed, no smaller than the
+    // default, and the bands still without room glued.
+    band.glueBandsWithoutRoom = true;
+    geometry::Structure glued;
+    constexpr int kShrinkAttempts = 3;
+    for (int attempt = 1;; ++attempt) {
+      glued = geometry::buildBandStructure(mesh, band, context);
+      const double room = roomOnTheBedFor(glued);
+      if (room >= 1 || attempt == kShrinkAttempts || grownBy() <= 1) break;
+      // (1% to spare: a tab's and a label's sizes do not grow with the rest)
+      const double shrink = std::max(0.99 * room, 1 / grownBy());
+      for (geometry::Point3& p : mesh.positions) p *= shrink;
+      context.report({"geometry", "smaller, for the bed", static_cast<size_t>(attempt), 0});
+    }
+    // Glue alone is not what a fastener was chosen for: then the size at
+    // which the fasteners fit, and the error that it misses the bed.
+    if (glued.fasteners == 0) {
+      if (noRoom) throw *noRoom;
+      sizing.grown = grownBy();
+      for (geometry::Point3& p : mesh.positions) p *= built->grown / sizing.grown;
+      sizing.grown = grownBy();
+      return std::move(built->structure);
+    }
+    sizing.grown = grownBy();
+    sizing.bedLimited = true;
+    if (sizing.grown > 1) {
+      const size_t n = glued.glued.size();
+      context.note(
+          sized(fmt::format("the largest size that fits the bed: not every band has room for its {:.3f} in "
+                            "fastener at any size that does, and {} band{} {} glued (narrow faces)",
+                            band.fastener, n, n == 1 ? "" : "s", n == 1 ? "is" : "are")));
+    }
+    return glued;
   } catch (const geometry::NoRoomForHoleError& error) {
     if (error.estimate) {
       throw core::UserError(
@@ -274,8 +333,8 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.seconds.import = lap();
   context.check();
 
-  double grown = 1;
-  job.structure = builtStructure(request, mesh, job.mesh.start, grown, context);
+  Sizing sizing;
+  job.structure = builtStructure(request, mesh, job.mesh.start, sizing, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.size = geometry::boundingBoxSize(mesh);
@@ -295,10 +354,11 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format(
         "{}: {}{}", name, error.what(),
-        grown > 1 ? fmt::format(" at {:.2f} times the default size, the smallest at which every band has room for "
-                                "its fastener; a smaller {}, or fewer and evener faces ({} N), needs less",
-                                grown, request.names(Parameter::Fastener), request.names(Parameter::Panels))
-                  : ""));
+        sizing.grown > 1 && !sizing.bedLimited
+            ? fmt::format(" at {:.2f} times the default size, the smallest at which every band has room for "
+                          "its fastener; a smaller {}, or fewer and evener faces ({} N), needs less",
+                          sizing.grown, request.names(Parameter::Fastener), request.names(Parameter::Panels))
+            : ""));
   }
   job.seconds.nesting = lap();
   job.meshFile = request.mesh;

@@ -242,8 +242,8 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
         geometry::PanelPiece& p = read.pieces.emplace_back();
         p.name = piece.at("name").get<std::string>();
         p.edge = piece.at("edge").get<int>();
-        if (piece.value("fastened", "tab") == geometry::fasteningName(geometry::PieceFastening::Band)) {
-          p.fastening = geometry::PieceFastening::Band;
+        for (geometry::PieceFastening kind : {geometry::PieceFastening::Band, geometry::PieceFastening::Glue}) {
+          if (piece.value("fastened", "tab") == geometry::fasteningName(kind)) p.fastening = kind;
         }
         for (const auto& hole : piece.at("holes")) {
           p.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
@@ -280,7 +280,9 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
   const std::vector<geometry::AssemblyStep> assembly = geometry::stepsInPanelOrder(panels);
   for (size_t i = 0; i < steps.size(); ++i) {
     steps[i].step = assembly[i];
-    for (const std::string& piece : assembly[i].pieces) steps[i].sheetOfPiece[piece] = sheetOfPiece.at(piece);
+    for (const auto* pieces : {&assembly[i].pieces, &assembly[i].gluedPieces}) {
+      for (const std::string& piece : *pieces) steps[i].sheetOfPiece[piece] = sheetOfPiece.at(piece);
+    }
     for (const geometry::AssemblyJoin& join : assembly[i].joins) {
       for (const std::string& piece : join.pieces) steps[i].sheetOfPiece[piece] = sheetOfPiece.at(piece);
     }
@@ -299,12 +301,18 @@ std::string describeJoins(const Step& step) {
   for (const std::string& piece : step.step.pieces) {
     text += fmt::format("first fasten piece {} (sheet {}) to it at its tab; ", piece, step.sheetOfPiece.at(piece));
   }
+  for (const std::string& piece : step.step.gluedPieces) {
+    text += fmt::format("first glue piece {} (sheet {}) to it by its tab; ", piece, step.sheetOfPiece.at(piece));
+  }
   if (step.step.joins.empty()) return text + "start here, the base";
   text += "join to ";
   for (size_t j = 0; j < step.step.joins.size(); ++j) {
     const geometry::AssemblyJoin& join = step.step.joins[j];
-    text += fmt::format("{}panel {} at edge {} ({} fastener{}", j ? ", " : "", join.panel, join.edge, join.fasteners,
-                        join.fasteners == 1 ? "" : "s");
+    // A band with no room for a hole (the structure at the largest size that fits the bed) is glued.
+    text += join.fasteners == 0 ? fmt::format("{}panel {} at edge {} (glue it: no room for a fastener", j ? ", " : "",
+                                              join.panel, join.edge)
+                                : fmt::format("{}panel {} at edge {} ({} fastener{}", j ? ", " : "", join.panel,
+                                              join.edge, join.fasteners, join.fasteners == 1 ? "" : "s");
     // The band cut across its middle: its far half goes on with the others.
     for (const std::string& piece : join.pieces) {
       text +=

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -28,6 +29,15 @@ Point2 rotatedPoint(const Point2& p, double degrees) {
     s = kSin[k];
   }
   return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
+}
+
+std::pair<Point2, Point2> rotatedBox(const Polygon2& outline, double degrees) {
+  Point2 low = Point2::Constant(std::numeric_limits<double>::max()), high = -low;
+  for (const Point2& p : outline) {
+    const Point2 q = rotatedPoint(p, degrees);
+    low = low.cwiseMin(q), high = high.cwiseMax(q);
+  }
+  return {low, high};
 }
 
 double polygonArea(const Polygon2& polygon) { return core::signedArea(polygon); }

@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/WorkContext.h"
@@ -102,5 +103,8 @@ double polygonArea(const Polygon2& polygon);
 
 // `p` turned counter-clockwise about the origin; quarter turns are exact.
 Point2 rotatedPoint(const Point2& p, double degrees);  // signed: positive counter-clockwise
+
+// The corners (lowest, highest) of the box of `outline` turned by `degrees` as rotatedPoint() turns it.
+std::pair<Point2, Point2> rotatedBox(const Polygon2& outline, double degrees);
 
 }  // namespace rotafab::jobs

@@ -27,11 +27,7 @@ NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOpti
     Point2 low = Point2::Zero(), high = Point2::Zero();
     bool fits = false;
     for (double rotation : part.rotations) {
-      Point2 min = Point2::Constant(std::numeric_limits<double>::max()), max = -min;
-      for (const Point2& p : part.outline) {
-        const Point2 q = rotatedPoint(p, rotation);
-        min = min.cwiseMin(q), max = max.cwiseMax(q);
-      }
+      const auto [min, max] = rotatedBox(part.outline, rotation);
       const Point2 size = max - min;
       if (size.x() > options.width || size.y() > options.height) continue;
       const Point2 bestSize = high - low;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -17,6 +18,22 @@ namespace rotafab::jobs {
 
 Point2 onSheet(const PlannedPart& placement, const Point2& local) {
   return rotatedPoint(local, placement.rotation) + Point2(placement.x, placement.y);
+}
+
+double roomOnTheBed(const std::vector<Part>& parts, const profiles::MachineProfile& machine, double kerf) {
+  const double width = machine.bed.width - 2 * machine.bed.margin - kerf;
+  const double height = machine.bed.height - 2 * machine.bed.margin - kerf;
+  double room = std::numeric_limits<double>::infinity();
+  for (const Part& part : parts) {
+    double best = 0;
+    for (double rotation : part.rotations) {
+      const auto [low, high] = rotatedBox(part.outline, rotation);
+      const Point2 size = high - low;
+      best = std::max(best, std::min(width / size.x(), height / size.y()));
+    }
+    room = std::min(room, best);
+  }
+  return room;
 }
 
 SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,

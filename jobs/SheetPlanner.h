@@ -49,6 +49,11 @@ struct SheetPlan {
 SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProfile& machine,
                      const PlanOptions& options, const core::WorkContext& context);
 
+// How many times larger every part could be and still fit the machine's
+// usable bed in one of its allowed rotations, its cut kerf/2 outside the
+// design (>= 1: all fit as they are). A part's box grows with it.
+double roomOnTheBed(const std::vector<Part>& parts, const profiles::MachineProfile& machine, double kerf);
+
 // The point of a part's frame on its sheet.
 Point2 onSheet(const PlannedPart& placement, const Point2& local);
 

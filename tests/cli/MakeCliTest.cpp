@@ -98,8 +98,9 @@ void expectHolesADiameterIn(const nlohmann::json& part, const std::string& name)
 // `interiorEdges` < 0: as many as the panels name. Every side's edge number
 // is etched but for at most `unlabelled` (make warns of each it could not fit).
 // (`splitFaces`: faces split in two, each two panels of one face)
-void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges, int unlabelled = 0,
-                      int splitFaces = 0) {
+// (`glued`: bands with no room for a hole, no holes on either copy)
+void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges, int unlabelled = 0, int splitFaces = 0,
+                      int glued = 0) {
   const auto& panels = m.at("panels");
   ASSERT_EQ(panels.size(), static_cast<size_t>(faceCount + splitFaces));
   std::map<int, std::vector<int>> holesOfEdge;  // edge -> hole count per panel
@@ -149,14 +150,19 @@ void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges,
     for (const auto& edge : p.at("edges")) namedEdges.insert(edge.get<int>());
     for (auto [edge, count] : mine) holesOfEdge[edge].push_back(count);
     EXPECT_EQ(p.at("neighbors").size(), p.at("edges").size());
+    // On the panel, or on the piece its band was cut off as with a tab (the
+    // manifest does not list a piece's labels).
     int edgeLabels = 0;
     for (const auto& label : p.at("labels")) edgeLabels += label.at("role") == "edge";
+    if (p.contains("pieces")) {
+      for (const auto& piece : p.at("pieces")) edgeLabels += piece.value("fastened", "tab") != "band";
+    }
     EXPECT_LE(edgeLabels, static_cast<int>(p.at("edges").size()));
     missingLabels += static_cast<int>(p.at("edges").size()) - edgeLabels;
   }
   EXPECT_LE(missingLabels, unlabelled);
   EXPECT_EQ(faces.size(), static_cast<size_t>(faceCount));
-  EXPECT_EQ(holesOfEdge.size(), interiorEdges < 0 ? namedEdges.size() : static_cast<size_t>(interiorEdges));
+  EXPECT_EQ(holesOfEdge.size() + glued, interiorEdges < 0 ? namedEdges.size() : static_cast<size_t>(interiorEdges));
   for (const auto& [edge, counts] : holesOfEdge) {
     ASSERT_EQ(counts.size(), 2u) << "edge " << edge;
     EXPECT_EQ(counts[0], counts[1]) << "edge " << edge;
@@ -220,8 +226,12 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 // vertex, and a panel that would overlap itself with a shallow vertex band),
 // pig, triple torus, elephant (106 holes) and mushroom (open); the npm
 // teapot (open, a bow-tie); STLs OpenSCAD and another program wrote; CGAL's
-// L-shaped prism (a panel that overlaps itself at a reflex corner). The
-// layout in rows, at once: how fast nesting is does not matter here.
+// L-shaped prism (a panel that overlaps itself at a reflex corner) and
+// "mpi" (polygons far from planar), whose faces are split; and meshes whose
+// narrowest bands would need a size that misses the bed, so that some are
+// glued: CGAL's anchor, and its boeing, whose sliver triangles leave no
+// room even for a tab's hole. The layout in rows, at once: how fast nesting
+// is does not matter here.
 TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
   const std::vector<std::string> meshes = {cgalMesh("cow.off"),
                                            cgalMesh("pig.off"),
@@ -231,7 +241,10 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
                                            (kSource / "tests/data/external/teapot.obj").string(),
                                            "/usr/share/openscad/testdata/scad/3D/features/import.stl",
                                            "/usr/share/assimp/models/STL/sphereWithHole.stl",
-                                           cgalMesh("corner_poly.off")};
+                                           cgalMesh("corner_poly.off"),
+                                           cgalMesh("mpi.off"),
+                                           cgalMesh("anchor.off"),
+                                           cgalMesh("boeing.off")};
   for (const std::string& where : meshes) {
     SCOPED_TRACE(where);
     TempDir dir;
@@ -246,7 +259,22 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
     const int split = std::regex_search(made.err, warned, std::regex(R"((\d+) faces? split in two)"))
                           ? std::stoi(warned[1].str())
                           : 0;
-    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split);
+    const int glued =
+        std::regex_search(made.err, warned, std::regex(R"((\d+) bands? ha(s|ve) no room for a \S+ in fastener hole)"))
+            ? std::stoi(warned[1].str())
+            : 0;
+    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split, glued);
+    if (glued > 0) {
+      // The size is the largest at which every part fits the bed, and the steps say which joins to glue.
+      EXPECT_NE(made.err.find("the largest size that fits the bed"), std::string::npos) << made.err;
+      const std::string steps = readFile(dir.path() / "out/manifest.txt");
+      std::ptrdiff_t glueSteps = 0;
+      for (size_t at = steps.find("(glue it: no room for a fastener"); at != std::string::npos;
+           at = steps.find("(glue it: no room for a fastener", at + 1)) {
+        ++glueSteps;
+      }
+      EXPECT_EQ(glueSteps, glued) << "each glued band is one join, at the later of its two panels";
+    }
     EXPECT_TRUE(m.at("stability").contains("stands"));
     EXPECT_TRUE(m.at("mesh").at("genus").is_number()) << "repaired into an orientable manifold";
     if (where.ends_with("cow.off")) {
@@ -254,6 +282,14 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
       bool pieces = false;
       for (const auto& panel : m.at("panels")) pieces = pieces || panel.contains("pieces");
       EXPECT_TRUE(pieces) << "the cow's panel that would overlap itself has a band cut off";
+    }
+    if (where.ends_with("anchor.off") || where.ends_with("boeing.off")) {
+      EXPECT_GT(glued, 0) << "at the size at which every band has room, a part misses the bed";
+    }
+    if (where.ends_with("boeing.off")) {
+      // Sliver triangles, too thin for a tab's hole: the band is cut off and its tab glued.
+      EXPECT_NE(made.err.find("tabs are glued"), std::string::npos) << made.err;
+      EXPECT_NE(readFile(dir.path() / "out/manifest.txt").find("first glue piece "), std::string::npos);
     }
     if (where.ends_with("corner_poly.off")) {
       // An L-shaped face: the bands at its reflex corner overlap, and no
@@ -418,8 +454,8 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   EXPECT_EQ(grown.status, 0) << grown.err;
   EXPECT_NE(grown.err.find("scaled to a mean edge of 5.00 in, not 2 in (24.3 in at its largest side), the smallest "
                            "size at which every band has room for its 1.000 in fastener hole 1 diameter from every "
-                           "outline (90 bands had none: narrow faces; --panels N, fewer and evener faces, may need "
-                           "less); --size or --scale sets the size"),
+                           "outline (90 bands had none: narrow faces); --panels N, fewer and evener faces, may need "
+                           "less; --size or --scale sets the size"),
             std::string::npos)
       << grown.err;
   // At a size the user fixed, the error says which --fastener or --size would do, and either one does.

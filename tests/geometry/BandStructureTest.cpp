@@ -302,5 +302,37 @@ TEST(BandStructure, APanelThatWouldOverlapItselfIsSplitAtABand) {
   EXPECT_EQ(holes, 2 * s.fasteners);  // a hole on each copy of a band, and on both sides of a tab
 }
 
+// Where the size at which every band has room would not fit the bed, make
+// builds with glueBandsWithoutRoom: a band without room gets no hole on
+// either copy and is listed to be glued; the others keep their holes.
+TEST(BandStructure, BandsWithoutRoomAreGluedWhenAsked) {
+  const PolygonMesh mesh = test::crumpledTorus();
+  BandOptions options;
+  options.fastener = 0.25;  // too large for a few of its narrowest bands
+  EXPECT_THROW(buildBandStructure(mesh, options, test::context()), NoRoomForHoleError);
+  options.glueBandsWithoutRoom = true;
+  const Structure s = buildBandStructure(mesh, options, test::context());
+  ASSERT_FALSE(s.glued.empty());
+  const std::set<int> glued(s.glued.begin(), s.glued.end());
+  std::map<int, int> holesOfEdge;
+  int holes = 0;
+  for (const Panel& panel : s.panels) {
+    for (const PanelHole& hole : panel.holes) ++holesOfEdge[hole.edge], ++holes;
+    for (const PanelPiece& piece : panel.pieces) {
+      for (const PanelHole& hole : piece.holes) ++holesOfEdge[hole.edge], ++holes;
+    }
+  }
+  for (int edge : glued) EXPECT_EQ(holesOfEdge.count(edge), 0u) << "edge " << edge;
+  EXPECT_EQ(holesOfEdge.size() + glued.size(), static_cast<size_t>(s.edges) + holesOfEdge.count(0));
+  EXPECT_EQ(holes, 2 * s.fasteners);
+  EXPECT_TRUE(std::any_of(s.warnings.begin(), s.warnings.end(), [&](const std::string& w) {
+    return w.find("so no hole: glue them") != std::string::npos;
+  })) << "the builders are told";
+  // In the steps, a glued band's join has no fasteners.
+  for (const AssemblyStep& step : s.steps) {
+    for (const AssemblyJoin& join : step.joins) EXPECT_EQ(join.fasteners == 0, glued.count(join.edge) == 1);
+  }
+}
+
 }  // namespace
 }  // namespace rotafab::geometry

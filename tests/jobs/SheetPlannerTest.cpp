@@ -67,6 +67,21 @@ double pathDistance(const DrawnPath& a, const DrawnPath& b) {
   return best;
 }
 
+// How much larger the parts could be on the 32 x 18 in bed (31.5 x 17.5
+// usable): the best of each part's allowed rotations, the worst part.
+TEST(SheetPlanner, RoomOnTheBedIsTheGrowthAtWhichTheWorstPartStillFits) {
+  Part wide = panel(0);
+  wide.outline = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
+  const profiles::MachineProfile machine = workshop();
+  EXPECT_NEAR(roomOnTheBed({wide}, machine, 0), 3.15, 1e-12);  // 31.5 / 10, upright: 17.5 / 10 is less
+  wide.rotations = {90};
+  EXPECT_NEAR(roomOnTheBed({wide}, machine, 0), 1.75, 1e-12);
+  Part tall = panel(1);
+  tall.outline = {{0, 0}, {5, 0}, {5, 40}, {0, 40}};  // fits no way round
+  EXPECT_NEAR(roomOnTheBed({wide, tall}, machine, 0), 31.5 / 40, 1e-12);
+  EXPECT_NEAR(roomOnTheBed({tall}, machine, 0.5), 31 / 40.0, 1e-12) << "the kerf takes its width off the bed";
+}
+
 TEST(SheetPlanner, KerfIsOnEveryCutAndMaterialStaysBetweenParts) {
   std::vector<Part> parts;
   for (int i = 0; i < 40; ++i) parts.push_back(panel(i));
