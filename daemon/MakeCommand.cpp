@@ -40,9 +40,11 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
     return;
   }
   const size_t sheets = job.sheets.sheets.size();
-  fmt::print("{}: {} panels on {} sheet{} ({:.1f}% of the usable bed area), {} fasteners; written to {}/\n",
-             options.mesh, job.structure.panels.size(), sheets, sheets == 1 ? "" : "s", 100 * job.sheets.utilization,
-             job.structure.fasteners, job.folder.string());
+  const size_t panels = job.structure.panels.size();
+  const int fasteners = job.structure.fasteners;
+  fmt::print("{}: {} panel{} on {} sheet{} ({:.1f}% of the usable bed area), {} fastener{}; written to {}/\n",
+             options.mesh, panels, panels == 1 ? "" : "s", sheets, sheets == 1 ? "" : "s", 100 * job.sheets.utilization,
+             fasteners, fasteners == 1 ? "" : "s", job.folder.string());
   if (const auto& simplified = job.mesh.simplified) {
     if (simplified->simplified()) {
       fmt::print("  panels asked: {}; the mesh simplified from {} faces to {}\n", simplified->asked,

@@ -43,11 +43,14 @@ profiles::Bed bedOf(const NestOptions& options) {
     if (options.machine != "workshop-32x18") throw;
   }
   if (!options.bed.empty()) {
-    const auto x = options.bed.find('x');
-    if (x == std::string::npos)
-      throw UserError(fmt::format("--bed {}: expected WIDTHxHEIGHT, e.g. 32x18 or 812.8mmx457.2mm", options.bed));
-    bed.width = lengthOption(options.bed.substr(0, x), "--bed");
-    bed.height = lengthOption(options.bed.substr(x + 1), "--bed");
+    const auto size = profiles::parseSize(options.bed);
+    if (!size || !(size->first > 0) || !(size->second > 0)) {
+      throw UserError(fmt::format(
+          "--bed {}: expected WIDTHxHEIGHT, a unit once at the end for both or one each, e.g. 32x18, 800x600mm or "
+          "32inx18in",
+          options.bed));
+    }
+    bed.width = size->first, bed.height = size->second;
   }
   if (!options.margin.empty()) bed.margin = lengthOption(options.margin, "--margin");
   if (2 * bed.margin >= std::min(bed.width, bed.height)) {

@@ -64,7 +64,7 @@ void ProgressLines::operator()(const core::Progress& p) {
     }
     if (!step.empty()) line = options_.nestingPrefix + step;
   } else if (p.phase == "writing" && p.step.empty()) {
-    line = fmt::format("writing {} sheets to {}", p.total, options_.folder);
+    line = fmt::format("writing {} sheet{} to {}", p.total, plural(p.total), options_.folder);
   }
   if (!line.empty()) fmt::print(stderr, "{}{}\n", options_.prefix, line);
 }

@@ -49,13 +49,35 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   try {
     done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation()), command.cancellation());
   } catch (const devices::DeviceFault& fault) {
-    fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
-               fault.laserOffConfirmed ? "the laser is off"
-                                       : "the controller did not confirm the laser off: switch it off at the machine");
+    // Where the job stopped, so that the operator knows what is cut and can
+    // go on from that sheet; and what is true of the laser.
+    const std::string where =
+        fault.sheet == 0    ? std::string("before the first sheet")
+        : fault.nothingSent ? fmt::format("at sheet {} of {}, before any of it was sent", fault.sheet, fault.sheets)
+                            : fmt::format("at sheet {} of {}, after stroke {} of {}", fault.sheet, fault.sheets,
+                                          fault.strokesDone, fault.strokes);
+    const std::string laser = fault.nothingSent && fault.sheet > 1
+                                  ? std::string("the sheets before it ended with the laser off")
+                                  : devices::laserStateAfter(fault);
+    if (fault.kind == devices::FaultKind::Cancelled) {
+      // The operator's choice, not an error.
+      fmt::print(stderr, "run: stopped {}; {}{}\n", where, laser,
+                 fault.sheet > 0
+                     ? fmt::format("; to go on, load sheet {} and run it with --sheet {}", fault.sheet, fault.sheet)
+                     : "");
+      // (no signal: the operator did not say the next sheet was loaded)
+      return command.signal() != 0 ? command.interruptedStatus() : kUserError;
+    }
+    fmt::print(stderr, "error: {} ({}; stopped {}; {})\n", fault.what(), devices::faultName(fault.kind), where, laser);
     return kDeviceFault;
   }
-  fmt::print("{}: {} sheet{} cut on {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target,
-             done.sheets, done.sheets == 1 ? "" : "s", options.device, done.strokes, done.burnt,
+  // The spool only writes the sheets (and hands them to the print queue): a print driver cuts them later.
+  const bool spool = options.device.starts_with("spool:");
+  const char* what = !spool                                                 ? "cut on"
+                     : options.device.find("printer=") != std::string::npos ? "sent to the printer by"
+                                                                            : "written as EPS by";
+  fmt::print("{}: {} sheet{} {} {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target, done.sheets,
+             done.sheets == 1 ? "" : "s", what, options.device, done.strokes, done.burnt,
              minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
              minutes(done.estimated));
   return kSuccess;
@@ -63,9 +85,9 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
 
 int runRun(const RunOptions& options) {
   return reportingErrors(options.target, [&]() -> int {
+    // Ctrl-C and SIGTERM cancel the job from here on (before any device, a simulator's thread, starts).
+    CommandContext command({}, 0, CommandContext::SecondSignal::Waits);
     try {
-      // Ctrl-C and SIGTERM cancel the job from here on (before any device, a simulator's thread, starts).
-      CommandContext command({}, 0, CommandContext::SecondSignal::Waits);
       devices::JobRunSetup setup;
       try {
         setup.device = devices::parseDeviceUri(options.device);
@@ -109,7 +131,12 @@ int runRun(const RunOptions& options) {
       fmt::print("{}: {}\n", options.out, job->writeDryRun(options.out));
       return kSuccess;
     } catch (const devices::DeviceFault& fault) {
-      fmt::print(stderr, "error: {} ({})\n", fault.what(), devices::faultName(fault.kind));
+      if (fault.kind == devices::FaultKind::Cancelled && command.signal() != 0) {
+        fmt::print(stderr, "run: stopped before the first sheet; {}\n", devices::laserStateAfter(fault));
+        return command.interruptedStatus();
+      }
+      fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
+                 devices::laserStateAfter(fault));
       return kDeviceFault;
     }
   });
@@ -146,7 +173,17 @@ void addRunCommand(CLI::App& app, int& status) {
       "  rotafab make examples/cube.obj --structure band --machine k40-m2nano --out k40/\n"
       "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512\n"
       "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512 --dry-run --out sheet1.egv");
-  run->callback([options, &status] { status = runRun(*options); });
+  run->callback([options, &status] {
+    // A safety check before anything opens a device: `--out` without
+    // `--dry-run` would otherwise cut for real and write nothing.
+    if (!options->out.empty() && !options->dryRun) {
+      throw CLI::ValidationError("--out",
+                                 "needs --dry-run: without it, run cuts on the device and writes no file; "
+                                 "add --dry-run to write the bytes to " +
+                                     options->out + " instead");
+    }
+    status = runRun(*options);
+  });
 }
 
 }  // namespace rotafab::cli

@@ -22,6 +22,12 @@ std::string_view faultName(FaultKind kind) {
   return "fault";
 }
 
+std::string laserStateAfter(const DeviceFault& fault) {
+  if (fault.nothingSent) return "nothing that lights the laser was sent";
+  if (fault.laserOffConfirmed) return "the controller confirmed the laser off";
+  return "the controller did not confirm the laser off: switch it off at the machine";
+}
+
 void stopAndRethrow(const std::function<bool()>& stopSafely) {
   try {
     throw;

@@ -36,7 +36,20 @@ class DeviceFault : public std::runtime_error {
   // Whether the driver saw the controller take its laser-off command after
   // the fault (it cannot when the device stopped answering or went away).
   bool laserOffConfirmed = false;
+  // Nothing that could light the laser had been sent (the device never
+  // connected, a sheet never started, the print spooler never took the
+  // file): the laser is off whatever the controller says.
+  bool nothingSent = false;
+  // Where the job stopped (JobRun fills these in): the sheet (1-based, 0
+  // before the first), and the strokes of it the device had acknowledged.
+  int sheet = 0, sheets = 0;
+  size_t strokesDone = 0, strokes = 0;
 };
+
+// What is true of the laser after `fault`, in words for the operator:
+// "nothing that lights the laser was sent", "the controller confirmed the
+// laser off", or that it did not and the laser must be switched off at the machine.
+std::string laserStateAfter(const DeviceFault& fault);
 
 struct Progress {
   int sheet = 1;

@@ -10,11 +10,17 @@ JobRun::JobRun(JobRunSetup setup) : setup_(std::move(setup)) {
   for (profiles::Operation operation : profiles::kAllOperations) {
     deviceSetup.colours[operation] = setup_.machine.settingFor(operation).rgb;
   }
-  device_ = driver.open(*setup_.device.address, deviceSetup);
-  if (!setup_.dryRun || driver.connectsForDryRun(*setup_.device.address)) {
-    const std::string identity = device_->connect();
-    connected_ = true;
-    if (setup_.connected) setup_.connected(identity);
+  // Nothing of the job is sent before run(): a fault here leaves the laser as it was.
+  try {
+    device_ = driver.open(*setup_.device.address, deviceSetup);
+    if (!setup_.dryRun || driver.connectsForDryRun(*setup_.device.address)) {
+      const std::string identity = device_->connect();
+      connected_ = true;
+      if (setup_.connected) setup_.connected(identity);
+    }
+  } catch (DeviceFault& fault) {
+    fault.nothingSent = true;
+    throw;
   }
   const jobs::MotionLimits limits = device_->motionLimits();
   for (const jobs::SheetDrawing& sheet : setup_.sheets) {
@@ -52,18 +58,36 @@ RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Ca
   RunSummary summary;
   for (size_t s = 0; s < toolpaths_.size(); ++s) {
     const jobs::Toolpath& toolpath = toolpaths_[s];
-    // Stop, do not cut blind, unless the next sheet is known to be loaded.
-    const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
-    if (!loaded) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
-    throwIfCancelled(&cancel);
-    if (events.sheetStarted) events.sheetStarted(s, toolpath);
-    if (frame) {
-      if (events.framing) events.framing();
-      device_->frame(toolpath);
-      throwIfCancelled(&cancel);  // a cancel while framing: the laser was never lit
+    // Where a fault finds the job: this sheet, and its strokes acknowledged.
+    // Until the sheet's own run starts, none of it has been sent (framing
+    // moves with the laser off).
+    size_t acknowledged = 0;
+    bool streaming = false;
+    try {
+      // Stop, do not cut blind, unless the next sheet is known to be loaded.
+      const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
+      if (!loaded) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
+      throwIfCancelled(&cancel);
+      if (events.sheetStarted) events.sheetStarted(s, toolpath);
+      if (frame) {
+        if (events.framing) events.framing();
+        device_->frame(toolpath);
+        throwIfCancelled(&cancel);  // a cancel while framing: the laser was never lit
+      }
+      streaming = true;
+      device_->run(
+          toolpath,
+          [&](const Progress& progress) {
+            acknowledged = progress.stroke;
+            if (events.progress) events.progress(progress);
+          },
+          cancel);
+    } catch (DeviceFault& fault) {
+      fault.nothingSent = fault.nothingSent || !streaming;
+      fault.sheet = static_cast<int>(s) + 1, fault.sheets = static_cast<int>(toolpaths_.size());
+      fault.strokesDone = acknowledged, fault.strokes = toolpath.strokes.size();
+      throw;
     }
-    device_->run(
-        toolpath, events.progress ? events.progress : [](const Progress&) {}, cancel);
     if (events.sheetFinished) events.sheetFinished();
     ++summary.sheets;
     summary.burnt += toolpath.burnLength, summary.estimated += toolpath.seconds;

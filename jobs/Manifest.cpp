@@ -325,8 +325,11 @@ std::string describeJoins(const Step& step) {
 
 std::string headline(const nlohmann::json& manifest) {
   const size_t sheets = manifest.at("sheets").size();
-  return fmt::format("{} structure, {} panels on {} sheet{}, {} fasteners", manifest.at("structure").get<std::string>(),
-                     manifest.at("panels").size(), sheets, sheets == 1 ? "" : "s", manifest.at("fasteners").get<int>());
+  const size_t panels = manifest.at("panels").size();
+  const int fasteners = manifest.at("fasteners").get<int>();
+  return fmt::format("{} structure, {} panel{} on {} sheet{}, {} fastener{}",
+                     manifest.at("structure").get<std::string>(), panels, panels == 1 ? "" : "s", sheets,
+                     sheets == 1 ? "" : "s", fasteners, fasteners == 1 ? "" : "s");
 }
 
 // What the builders should know before they start, from the manifest's
@@ -403,7 +406,7 @@ std::string manifestText(const nlohmann::json& manifest) {
       text += fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.step.panel, step.step.panel, step.sheet,
                           describeJoins(step));
     }
-    text += fmt::format("\n{} fasteners in all\n", total);
+    text += fmt::format("\n{} fastener{} in all\n", total, total == 1 ? "" : "s");
     return text;
   } catch (const nlohmann::json::exception& error) {
     throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", error.what()));
@@ -444,7 +447,7 @@ the same number on the panel named; fasten them through their holes.</p>
       html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.step.panel,
                           step.step.panel, step.sheet, xmlText(describeJoins(step)), fasteners);
     }
-    html += fmt::format("</table>\n<p>{} fasteners in all.</p>\n", total);
+    html += fmt::format("</table>\n<p>{} fastener{} in all.</p>\n", total, total == 1 ? "" : "s");
     for (const auto& sheet : manifest.at("sheets")) {
       std::string svgFile;
       for (const auto& file : sheet.at("files")) {

@@ -28,4 +28,32 @@ std::optional<double> parseLength(std::string_view text) {
   return value * inchesPerUnit;
 }
 
+namespace {
+
+// The unit a length ends with ("in", "mm", "cm"), or empty.
+std::string_view unitOf(std::string_view text) {
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+  for (std::string_view unit : {"in", "mm", "cm"}) {
+    if (text.size() > unit.size() && text.ends_with(unit)) return unit;
+  }
+  return {};
+}
+
+}  // namespace
+
+std::optional<std::pair<double, double>> parseSize(std::string_view text) {
+  const size_t x = text.find('x');
+  if (x == std::string_view::npos || text.find('x', x + 1) != std::string_view::npos) return std::nullopt;
+  const std::string_view first = text.substr(0, x), second = text.substr(x + 1);
+  const std::string_view firstUnit = unitOf(first), secondUnit = unitOf(second);
+  if (!firstUnit.empty() && secondUnit.empty()) return std::nullopt;
+  // "800x600mm": the one unit, at the end, is both numbers'.
+  const auto width = firstUnit.empty() && !secondUnit.empty()
+                         ? parseLength(std::string(first) + std::string(secondUnit))
+                         : parseLength(first);
+  const auto height = parseLength(second);
+  if (!width || !height) return std::nullopt;
+  return std::pair{*width, *height};
+}
+
 }  // namespace rotafab::profiles

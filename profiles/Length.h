@@ -5,11 +5,18 @@
 
 #include <optional>
 #include <string_view>
+#include <utility>
 
 namespace rotafab::profiles {
 
 // The length in inches, or nullopt when the text is not a finite number with
 // one of the units.
 std::optional<double> parseLength(std::string_view text);
+
+// A size WIDTHxHEIGHT (SPEC: a unit written once at the end applies to both
+// numbers, "800x600mm"; or one each, "32inx18in"; none, inches: "31.5x17.5"),
+// in inches; nullopt when it is not two lengths joined by an x, or when only
+// the first has a unit ("32inx18": which unit the second has is a guess).
+std::optional<std::pair<double, double>> parseSize(std::string_view text);
 
 }  // namespace rotafab::profiles

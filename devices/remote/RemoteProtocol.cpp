@@ -60,7 +60,10 @@ Progress progressOf(const nlohmann::json& json) {
 }
 
 nlohmann::json toJson(const DeviceFault& fault) {
-  return {{"kind", faultName(fault.kind)}, {"message", fault.what()}, {"confirmed", fault.laserOffConfirmed}};
+  return {{"kind", faultName(fault.kind)},
+          {"message", fault.what()},
+          {"confirmed", fault.laserOffConfirmed},
+          {"nothing_sent", fault.nothingSent}};
 }
 
 std::optional<FaultKind> faultKindNamed(std::string_view name) {
@@ -75,6 +78,7 @@ DeviceFault faultOf(const nlohmann::json& json) {
   DeviceFault fault(faultKindNamed(json.at("kind").get<std::string>()).value_or(FaultKind::Protocol),
                     json.at("message").get<std::string>());
   fault.laserOffConfirmed = json.at("confirmed").get<bool>();
+  fault.nothingSent = json.value("nothing_sent", false);  // (absent from an older end: not known, so false)
   return fault;
 }
 

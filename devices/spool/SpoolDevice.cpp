@@ -82,7 +82,13 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "lp", nullptr, &attributes, argv.data(), environ);
     posix_spawnattr_destroy(&attributes);
-    if (spawned != 0) throw DeviceFault(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
+    // (lp never ran, or refused the file: nothing reached the printer queue)
+    const auto notSent = [](FaultKind kind, const std::string& what) {
+      DeviceFault fault(kind, what);
+      fault.nothingSent = true;
+      return fault;
+    };
+    if (spawned != 0) throw notSent(FaultKind::Disconnected, "spool: cannot run lp (install cups-client)");
     int status = 0;
     pid_t waited = 0;
     do {
@@ -90,8 +96,8 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
     } while (waited < 0 && errno == EINTR);
     if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, "spool: cancelled");
     if (waited != pid || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      throw DeviceFault(FaultKind::Refused, fmt::format("spool: lp -d {} refused {} (exit status {})", printer_, file,
-                                                        WIFEXITED(status) ? WEXITSTATUS(status) : -1));
+      throw notSent(FaultKind::Refused, fmt::format("spool: lp -d {} refused {} (exit status {})", printer_, file,
+                                                    WIFEXITED(status) ? WEXITSTATUS(status) : -1));
     }
   }
   if (progress) {

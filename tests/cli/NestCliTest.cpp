@@ -56,6 +56,26 @@ TEST(NestCli, BinRunUsesTheWorkshopBedByDefault) {
   EXPECT_NEAR(summary["utilization"].get<double>(), 200.0 / (31.5 * 17.5), 1e-9);
 }
 
+// --bed 800x600mm is 800 mm by 600 mm, 31.5 x 23.6 in (a 15 x 11 in part
+// fits twice across and twice up, 4 to a bed: 12 take 3 beds; read as 800
+// in by 600 mm, one would do), the same as 800mmx600mm; a unit on the first
+// number only is refused, not guessed.
+TEST(NestCli, ABedUnitAtTheEndIsBothSides) {
+  TempDir dir;
+  const auto instance = dir.write(
+      "parts.json",
+      R"({"items":[{"id":1,"demand":12,"shape":{"type":"simple_polygon","data":[[0,0],[15,0],[15,11],[0,11]]}}]})");
+  for (const char* bed : {"800x600mm", "800mmx600mm", "80cmx600mm"}) {
+    const CommandResult result = run(kCli + " nest " + instance.string() + " --margin 0 --time 0 --json --bed " + bed);
+    ASSERT_EQ(result.status, 0) << bed << ": " << result.err;
+    EXPECT_EQ(nlohmann::json::parse(result.out)["sheets"], 3) << bed;
+  }
+  const CommandResult guessed = run(kCli + " nest " + instance.string() + " --time 0 --bed 800mmx600");
+  EXPECT_EQ(guessed.status, 1);
+  EXPECT_NE(guessed.err.find("--bed 800mmx600: expected WIDTHxHEIGHT, a unit once at the end"), std::string::npos)
+      << guessed.err;
+}
+
 TEST(NestCli, BadInstancesAreOneLineNamingTheElement) {
   TempDir dir;
   struct Case {

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 
 #include "cli/CliSupport.h"
@@ -98,7 +99,9 @@ TEST(RunCli, CutsAMakeOutputOnTheSimulatedM2NanoToTheEnd) {
       << r.out;
 }
 
-// Ctrl-C mid-job: the driver stops the machine; exit 3, the laser off.
+// Ctrl-C mid-job: the driver stops the machine, and the operator is told
+// where the job stopped and that the controller confirmed the laser off: no
+// error, the status of a command its signal stopped (128 + SIGINT).
 void interruptMidJob(const std::filesystem::path& job, const std::string& device) {
   // SIGINT once the job streams (after "run: sheet" on stderr).
   TempDir dir;
@@ -109,8 +112,15 @@ void interruptMidJob(const std::filesystem::path& job, const std::string& device
           " && break; sleep 0.05; done; grep -q 'run: sheet' " + quoted(err) +
           " || { kill -KILL $pid; exit 99; }; sleep 0.3; kill -INT $pid; wait $pid; status=$?; cat " + quoted(err) +
           " >&2; exit $status)");
-  EXPECT_EQ(r.status, 3) << device << ": " << r.err;
-  EXPECT_NE(r.err.find("cancelled (cancelled; the laser is off)"), std::string::npos) << device << ": " << r.err;
+  EXPECT_EQ(r.status, 130) << device << ": " << r.err;
+  std::smatch stopped;
+  ASSERT_TRUE(std::regex_search(r.err, stopped,
+                                std::regex(R"(run: stopped at sheet 1 of 1, after stroke (\d+) of (\d+); the )"
+                                           R"(controller confirmed the laser off; to go on, load sheet 1 and run it )"
+                                           R"(with --sheet 1\n)")))
+      << device << ": " << r.err;
+  EXPECT_LT(std::stoi(stopped[1].str()), std::stoi(stopped[2].str())) << "stopped mid-sheet";
+  EXPECT_EQ(r.err.find("error:"), std::string::npos) << "Ctrl-C is the operator's choice: " << r.err;
 }
 
 TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
@@ -140,6 +150,13 @@ TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
   fails(quoted(cubeJob()) + " --device sim:grbl --dry-run", 1, "--dry-run needs --out");
   fails(quoted(dir.path()) + " --device sim:grbl", 1, "no manifest.json");
   fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port", 3, "cannot open it");
+  fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port", 3,
+        "(disconnected; nothing that lights the laser was sent)");
+  // --out without --dry-run would cut for real: refused as a usage error
+  // before any device is opened (this one cannot be: that would be status 3).
+  fails(quoted(cubeJob()) + " --device grbl:///dev/rotafab-no-such-port --out " + quoted(dir.path() / "x.gcode"), 2,
+        "--out: needs --dry-run: without it, run cuts on the device and writes no file");
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.gcode"));
   fails(quoted(cubeJob()) + " --device m2nano://usb/1a86:5512 --machine grbl-diode-400 --dry-run --out " +
             quoted(dir.path() / "x.egv"),
         1, "is driven by grbl");
@@ -198,6 +215,8 @@ TEST(RunCli, TheSpoolWritesEpsAndHandsItToLp) {
   const CommandResult r =
       run(kCli + " run " + quoted(job) + " --device " + quoted(std::filesystem::path("spool:" + spool.string())));
   ASSERT_EQ(r.status, 0) << r.err;
+  // The spool writes a sheet (and hands it to lp): a print driver cuts it later, not this run.
+  EXPECT_NE(r.out.find("1 sheet written as EPS by spool:"), std::string::npos) << r.out;
   const CommandResult gs = run("gs -q -dNOPAUSE -dBATCH -sDEVICE=bbox " + quoted(spool / "sheet-001.eps"));
   ASSERT_EQ(gs.status, 0) << gs.err;
   const auto at = gs.err.find("%%BoundingBox: ");
@@ -217,12 +236,29 @@ TEST(RunCli, TheSpoolWritesEpsAndHandsItToLp) {
   const CommandResult printed = run(withLp + kCli + " run " + quoted(job) + " --device " +
                                     quoted(std::filesystem::path("spool:" + spool.string() + "?printer=laser1")));
   ASSERT_EQ(printed.status, 0) << printed.err;
+  EXPECT_NE(printed.out.find("1 sheet sent to the printer by spool:"), std::string::npos) << printed.out;
   EXPECT_EQ(readFile(dir.path() / "lp-args"),
             "-d laser1 -t rotafab sheet 1 -- " + (spool / "sheet-001.eps").string() + "\n");
   const CommandResult refused = run(withLp + kCli + " run " + quoted(job) + " --device " +
                                     quoted(std::filesystem::path("spool:" + spool.string() + "?printer=nope")));
   EXPECT_EQ(refused.status, 3) << refused.err;
   EXPECT_NE(refused.err.find("lp -d nope refused"), std::string::npos) << refused.err;
+  // A refused file never reached a laser, and the message says so, not to switch the laser off.
+  EXPECT_NE(
+      refused.err.find("stopped at sheet 1 of 1, before any of it was sent; nothing that lights the laser was sent)"),
+      std::string::npos)
+      << refused.err;
+  // No lp at all: the same.
+  const std::filesystem::path empty = dir.path() / "empty";
+  std::filesystem::create_directories(empty);
+  const CommandResult noLp = run("PATH=" + quoted(empty) + " " + kCli + " run " + quoted(job) + " --device " +
+                                 quoted(std::filesystem::path("spool:" + spool.string() + "?printer=laser1")));
+  EXPECT_EQ(noLp.status, 3) << noLp.err;
+  EXPECT_NE(noLp.err.find("cannot run lp (install cups-client) (disconnected; stopped at sheet 1 of 1, before any "
+                          "of it was sent; nothing that lights the laser was sent)"),
+            std::string::npos)
+      << noLp.err;
+  EXPECT_EQ(noLp.err.find("switch it off"), std::string::npos) << noLp.err;
 }
 
 }  // namespace

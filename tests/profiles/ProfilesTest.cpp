@@ -28,6 +28,26 @@ TEST(Length, UnitsAndBareInches) {
   }
 }
 
+// WIDTHxHEIGHT: a unit at the end is both numbers' ("800x600mm" is not 800
+// in by 600 mm), or each has its own; none is inches.
+TEST(Length, SizesTakeOneUnitForBothOrOneEach) {
+  const auto expectSize = [](const char* text, double width, double height) {
+    const auto size = parseSize(text);
+    ASSERT_TRUE(size.has_value()) << text;
+    EXPECT_NEAR(size->first, width, 1e-12) << text;
+    EXPECT_NEAR(size->second, height, 1e-12) << text;
+  };
+  expectSize("800x600mm", 800 / 25.4, 600 / 25.4);
+  expectSize("800mmx600mm", 800 / 25.4, 600 / 25.4);
+  expectSize("31.5x17.5", 31.5, 17.5);
+  expectSize("32inx18in", 32, 18);
+  expectSize("81.28cmx18in", 32, 18);
+  expectSize("32x45.72cm", 32 / 2.54, 18);
+  for (const char* bad : {"", "32", "32x", "x18", "32x18x2", "32inx18", "32 by 18", "axb", "32x18ft"}) {
+    EXPECT_FALSE(parseSize(bad).has_value()) << bad;
+  }
+}
+
 TEST(Profiles, ShippedProfilesLoad) {
   const ProfileCatalogue catalogue = loadProfiles({kShipped});
   EXPECT_TRUE(catalogue.errors.empty()) << catalogue.errors.front();
