@@ -49,8 +49,10 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
 struct GrownStructure {
   Structure structure;
   double grown = 1;
-  int bandsWithoutRoom = 0;  // at the size given
+  int bandsWithoutRoom = 0;          // at the size given
+  std::vector<double> scalesNeeded;  // what each of them needed, times the size given
 };
+// (A NoRoomForHoleError it throws has `scales` of the size given, as the first try found them.)
 constexpr int kGrowAttempts = 3;
 GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,
                                           const core::WorkContext& context);

@@ -259,13 +259,19 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   const BandTooSmall* first = nullptr;
   int small = 0;
   double scaleNeeded = 1;
+  std::vector<double> scales;
   for (const auto& some : tooSmall) {
     if (!some) continue;
     if (!first) first = &*some;
     ++small;
     scaleNeeded = std::max(scaleNeeded, some->scaleNeeded);
+    scales.push_back(some->scaleNeeded);
   }
-  if (first) throw NoRoomForHoleError(first->what, small, scaleNeeded, diameter, names);
+  if (first) {
+    NoRoomForHoleError error(first->what, small, scaleNeeded, diameter, names);
+    error.scales = std::move(scales);
+    throw error;
+  }
   Placed holesOn;
   for (size_t f = 0; f < panels.size(); ++f) {
     for (const FlatBand& copy : panels[f].bands) {

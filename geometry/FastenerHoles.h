@@ -73,6 +73,7 @@ class NoRoomForHoleError : public std::invalid_argument {
   double scaleNeeded;            // > 1; infinite when a band's middle is off its panel
   int bands;                     // how many have no room
   bool estimate = false;         // scaleNeeded may not be enough (a tab's room stops growing)
+  std::vector<double> scales;    // what each band without room needs, scaleNeeded the largest
 };
 
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed

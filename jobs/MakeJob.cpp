@@ -6,6 +6,7 @@
 #include <cctype>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <regex>
 
 #include "core/UserError.h"
@@ -179,6 +180,11 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   return std::move(imported.mesh);
 }
 
+// The sides of the box of the structure as built (its panels in 3D).
+geometry::Point3 builtSize(const geometry::Structure& structure) {
+  return geometry::boundingBoxSize(geometry::surfaceMesh(structure));
+}
+
 // The advice for bands without room for a hole: the fastener, or the size
 // (or the scale, if that is what was given), that gives every band room;
 // every length of the structure scales with the mesh.
@@ -188,10 +194,11 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
   if (!std::isfinite(scaleNeeded)) {
     return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
   }
-  const geometry::Point3 box = geometry::boundingBoxSize(mesh);
-  const std::string larger =
-      request.scale ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
-                    : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(box.maxCoeff() * scaleNeeded));
+  // --size is the structure's size, which scales as the mesh does.
+  const double size = request.size ? *request.size : geometry::boundingBoxSize(mesh).maxCoeff();
+  const std::string larger = request.scale
+                                 ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
+                                 : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(size * scaleNeeded));
   const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
   return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every band room",
                                    names(Parameter::Fastener), smaller, larger)
@@ -201,7 +208,7 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
 // How the structure's size was chosen, when make chose it.
 struct Sizing {
   double grown = 1;         // times the default size (1: as it was)
-  bool bedLimited = false;  // the largest size that fits the bed, some bands glued
+  bool bedLimited = false;  // limited by the bed or by the narrowest bands, which are glued
 };
 
 // `start`: the flood fill's first face in the mesh as built.
@@ -224,15 +231,26 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   const auto roomOnTheBedFor = [&](const geometry::Structure& structure) {
     return roomOnTheBed(structureParts(structure), request.machine, kerf);
   };
-  const auto sized = [&](const std::string& why) {
+  const auto sized = [&](const std::string& why, const geometry::Structure& structure) {
     return fmt::format(
         "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), {}; {} N, fewer and "
         "evener faces, may need less; {} or {} sets the size",
-        name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches,
-        geometry::boundingBoxSize(mesh).maxCoeff(), why, request.names(Parameter::Panels),
-        request.names(Parameter::Size), request.names(Parameter::Scale));
+        name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches, builtSize(structure).maxCoeff(), why,
+        request.names(Parameter::Panels), request.names(Parameter::Size), request.names(Parameter::Scale));
   };
   try {
+    if (request.size) {
+      // --size is the structure's largest side (SPEC), and the structure is
+      // smaller than the mesh (its vertex bands are cut back at the corners),
+      // by a ratio that does not depend on the scale: measured on a first
+      // build (glued, so that no band's room stops it), then the mesh scaled by it.
+      geometry::BandOptions measuring = band;
+      measuring.glueBandsWithoutRoom = true;
+      const double side = builtSize(geometry::buildBandStructure(mesh, measuring, context)).maxCoeff();
+      if (side > 0) {
+        for (geometry::Point3& p : mesh.positions) p *= *request.size / side;
+      }
+    }
     if (!scaleChosen) return geometry::buildBandStructure(mesh, band, context);
     std::optional<geometry::GrownStructure> built;
     int narrow = 0;
@@ -247,10 +265,10 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     sizing.grown = grownBy();
     if (built && (sizing.grown <= 1 || roomOnTheBedFor(built->structure) >= 1)) {
       if (sizing.grown > 1) {
-        context.note(
-            sized(fmt::format("the smallest size at which every band has room for its {:.3f} in fastener "
-                              "hole {:g} diameter from every outline ({} band{} had none: narrow faces)",
-                              band.fastener, geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s")));
+        context.note(sized(fmt::format("the smallest size at which every band has room for its {:.3f} in fastener "
+                                       "hole {:g} diameter from every outline ({} band{} had none: narrow faces)",
+                                       band.fastener, geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s"),
+                           built->structure));
       }
       return std::move(built->structure);
     }
@@ -258,6 +276,19 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     // not find one: the largest size that fits the bed, no smaller than the
     // default, and the bands still without room glued.
     band.glueBandsWithoutRoom = true;
+    // Nor larger than needed: a few slivers may ask for a size many times
+    // any other band's. At most the size at which all but one band in a
+    // hundred have room (each band without room at the default size said
+    // how much larger it needs to be).
+    std::vector<double> scales = built ? built->scalesNeeded : noRoom ? noRoom->scales : std::vector<double>{};
+    std::sort(scales.begin(), scales.end(), std::greater<>());
+    size_t sides = 0;
+    for (const auto& face : mesh.faces) sides += face.size();
+    const size_t mayGlue = sides / 2 / 100;  // of the edges, about
+    if (mayGlue < scales.size() && scales[mayGlue] < grownBy()) {
+      const double shrink = std::max(scales[mayGlue], 1.0) / grownBy();
+      for (geometry::Point3& p : mesh.positions) p *= shrink;
+    }
     geometry::Structure glued;
     constexpr int kShrinkAttempts = 3;
     for (int attempt = 1;; ++attempt) {
@@ -282,10 +313,11 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     sizing.bedLimited = true;
     if (sizing.grown > 1) {
       const size_t n = glued.glued.size();
-      context.note(
-          sized(fmt::format("the largest size that fits the bed: not every band has room for its {:.3f} in "
-                            "fastener at any size that does, and {} band{} {} glued (narrow faces)",
-                            band.fastener, n, n == 1 ? "" : "s", n == 1 ? "is" : "are")));
+      context.note(sized(
+          fmt::format("at most the largest size that fits the bed and that at which all but 1 in 100 bands have room "
+                      "for its {:.3f} in fastener; {} band{} without room {} glued (narrow faces)",
+                      band.fastener, n, n == 1 ? "" : "s", n == 1 ? "is" : "are"),
+          glued));
     }
     return glued;
   } catch (const geometry::NoRoomForHoleError& error) {
@@ -337,7 +369,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.structure = builtStructure(request, mesh, job.mesh.start, sizing, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
-  job.size = geometry::boundingBoxSize(mesh);
+  job.size = builtSize(job.structure);
   job.seconds.geometry = lap();
 
   PlanOptions plan;
