@@ -64,12 +64,14 @@ int runProfiles(const ProfilesOptions& options) {
     }
     std::cout << out.dump() << '\n';
   } else {
-    fmt::print("machines\n");
+    // A section only where there is something in it: checking only bad
+    // files prints nothing on standard output, only the errors.
+    if (!catalogue.machines.empty()) fmt::print("machines\n");
     for (const auto& m : catalogue.machines) {
       fmt::print("  {:<18} {:>6.3g} x {:<6.3g} in  margin {:<6.3g} {:<7} {:<34} {}\n", m.name, m.bed.width,
                  m.bed.height, m.bed.margin, m.driver, m.connection, m.source.string());
     }
-    fmt::print("materials\n");
+    if (!catalogue.materials.empty()) fmt::print("materials\n");
     for (const auto& m : catalogue.materials) {
       fmt::print("  {:<18} {:.4g} in thick, kerf {:.4g} in, fastener {:.4g} in  {}\n", m.name, m.thickness, m.kerf,
                  m.fastenerDiameter, m.source.string());

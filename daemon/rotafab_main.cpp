@@ -1,9 +1,14 @@
 // rotafab: the command line (SPEC, "Command line"). Wiring only.
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "daemon/DevicesCommand.h"
 #include "daemon/ExitCode.h"
@@ -13,6 +18,37 @@
 #include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
 #include "daemon/RunCommand.h"
+
+namespace {
+
+// The commands of SPEC's command line that are not built yet: the daemon's.
+constexpr std::string_view kDaemonVerbs[] = {"submit", "jobs",  "status", "cancel", "pause",
+                                             "resume", "start", "next",   "move",   "dashboard"};
+// Options of SPEC's `make` that only the woven structure takes.
+constexpr std::string_view kWeaveOptions[] = {"--width", "--curve", "--offset", "--cycles"};
+
+size_t editDistance(std::string_view a, std::string_view b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+// A usage error the parser would word as its own: one line, and where to read more.
+int usageError(const std::string& message, const std::string& help) {
+  fmt::print(stderr, "error: {}\nRun `{}` for usage.\n", message, help);
+  return rotafab::cli::kUsageError;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace rotafab::cli;
@@ -30,6 +66,47 @@ int main(int argc, char** argv) {
   addProfilesCommand(app, status);
   addDevicesCommand(app, status);
   addRunCommand(app, status);
+  // The command named, if it is one: usage errors point to its own --help.
+  std::vector<std::string> verbs;
+  for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
+    verbs.push_back(command->get_name());
+  }
+  std::string verb;
+  if (argc == 1) return usageError(fmt::format("give a command: {}", fmt::join(verbs, ", ")), "rotafab --help");
+  if (argv[1][0] != '-') {
+    const std::string_view word = argv[1];
+    if (std::find(verbs.begin(), verbs.end(), word) != verbs.end()) {
+      verb = word;
+    } else if (std::find(std::begin(kDaemonVerbs), std::end(kDaemonVerbs), word) != std::end(kDaemonVerbs)) {
+      return usageError(fmt::format("`rotafab {}` is a command of the fabrication daemon, which is not built yet; "
+                                    "`rotafab make` and `rotafab run` work without it",
+                                    word),
+                        "rotafab --help");
+    } else {
+      std::string nearest = verbs.front();
+      for (const std::string& candidate : verbs) {
+        if (editDistance(word, candidate) < editDistance(word, nearest)) nearest = candidate;
+      }
+      return usageError(
+          editDistance(word, nearest) <= 2
+              ? fmt::format("{} is not a rotafab command; did you mean `rotafab {}`?", word, nearest)
+              : fmt::format("{} is not a rotafab command (the commands: {})", word, fmt::join(verbs, ", ")),
+          "rotafab --help");
+    }
+  }
+  if (verb == "make") {
+    for (int i = 2; i < argc; ++i) {
+      const std::string_view arg = argv[i];
+      for (std::string_view option : kWeaveOptions) {
+        if (arg == option || (arg.starts_with(option) && arg.substr(option.size()).starts_with("="))) {
+          return usageError(fmt::format("{} is an option of the plain-woven structure (--structure weave, "
+                                        "dissertation ch. IV), which is not built yet",
+                                        option),
+                            "rotafab make --help");
+        }
+      }
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& help) {
@@ -39,8 +116,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& version) {
     return app.exit(version);
   } catch (const CLI::ParseError& error) {
-    fmt::print(stderr, "error: {}\nRun `rotafab --help` for usage.\n", error.what());
-    return kUsageError;
+    return usageError(error.what(), verb.empty() ? "rotafab --help" : "rotafab " + verb + " --help");
   } catch (const std::exception& error) {
     // Last resort (e.g. standard output closed): one line, never an abort.
     std::fprintf(stderr, "error: %s\n", error.what());

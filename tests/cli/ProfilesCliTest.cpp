@@ -18,6 +18,7 @@ TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
   EXPECT_EQ(refused.err, "error: " + bad.string() +
                              ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
                              "connection, colours, operations)\n");
+  EXPECT_EQ(refused.out, "") << "nothing on standard output before, or instead of, the error";
   const CommandResult accepted = run(std::string(ROTAFAB_CLI) + " profiles --json " + good.string());
   EXPECT_EQ(accepted.status, 0) << accepted.err;
   EXPECT_NE(accepted.out.find(R"("name":"test")"), std::string::npos) << accepted.out;

@@ -1,0 +1,46 @@
+// Usage errors as a new user meets them: a mistyped command, a command of
+// SPEC's that is not built yet, an option of the woven structure, and a bad
+// option of a command, each one line with exit status 2 and the `--help` to read.
+
+#include <gtest/gtest.h>
+
+#include "cli/CliSupport.h"
+#include "support/TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+void expectUsage(const std::string& args, const std::string& says, const std::string& help) {
+  SCOPED_TRACE(args);
+  const CommandResult r = run(kCli + " " + args);
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(r.err, "error: " + says + "\nRun `" + help + "` for usage.\n");
+}
+
+TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
+  const std::string cube = quoted(kSource / "examples/cube.obj");
+  expectUsage("inpsect " + cube, "inpsect is not a rotafab command; did you mean `rotafab inspect`?", "rotafab --help");
+  expectUsage("bake " + cube, "bake is not a rotafab command; did you mean `rotafab make`?", "rotafab --help");
+  expectUsage("fabricate " + cube,
+              "fabricate is not a rotafab command (the commands: inspect, make, manifest, nest, profiles, devices, "
+              "run)",
+              "rotafab --help");
+  expectUsage("", "give a command: inspect, make, manifest, nest, profiles, devices, run", "rotafab --help");
+  expectUsage("submit " + cube,
+              "`rotafab submit` is a command of the fabrication daemon, which is not built yet; `rotafab make` and "
+              "`rotafab run` work without it",
+              "rotafab --help");
+  expectUsage("make " + cube + " --structure band --width 0.5in",
+              "--width is an option of the plain-woven structure (--structure weave, dissertation ch. IV), which is "
+              "not built yet",
+              "rotafab make --help");
+  // The parser's own errors point to the command's help, not the program's.
+  const CommandResult noDevice = run(kCli + " run " + quoted(kSource));
+  EXPECT_EQ(noDevice.status, 2);
+  EXPECT_NE(noDevice.err.find("--device is required\nRun `rotafab run --help` for usage.\n"), std::string::npos)
+      << noDevice.err;
+}
+
+}  // namespace
+}  // namespace rotafab::test
