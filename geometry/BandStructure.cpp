@@ -64,16 +64,14 @@ bool splitFaceInTwo(PolygonMesh& mesh, int face) {
   const std::vector<int> corners = mesh.faces[face];
   const int n = static_cast<int>(corners.size());
   if (n < 4) return false;
-  Point3 normal = Point3::Zero();
-  for (int i = 0; i < n; ++i) {
-    normal += mesh.positions[corners[i]].cross(mesh.positions[corners[(i + 1) % n]]);
-  }
-  if (!(normal.norm() > 0)) return false;
-  normal.normalize();
-  const Point3 x = (std::abs(normal.x()) < 0.9 ? Point3::UnitX() : Point3::UnitY()).cross(normal).normalized();
-  const Point3 y = normal.cross(x);
+  std::vector<Point3> polygon;
+  for (int v : corners) polygon.push_back(mesh.positions[v]);
+  const Point3 normal = newellNormal(polygon);
+  if (normal.isZero()) return false;
+  // The plane's axes, so that the face turns counter-clockwise in it.
+  const Point3 x = normal.unitOrthogonal(), y = normal.cross(x);
   std::vector<core::Point2> flat;
-  for (int v : corners) flat.emplace_back(mesh.positions[v].dot(x), mesh.positions[v].dot(y));
+  for (const Point3& p : polygon) flat.emplace_back(p.dot(x), p.dot(y));
   const auto part = [&](int from, int to) {
     std::vector<core::Point2> polygon;
     for (int i = from;; i = (i + 1) % n) {
