@@ -2,6 +2,7 @@
 // What the command-line verbs share: the one-line user error, length options and error reporting.
 
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include <stdexcept>
 #include <string>
@@ -10,6 +11,7 @@
 #include "daemon/ExitCode.h"
 #include "geometry/Parameters.h"
 #include "jobs/Nesting.h"
+#include "jobs/OutputFolder.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
 
@@ -77,6 +79,17 @@ int reportingErrors(const std::string& subject, Body&& body) {
     fmt::print(stderr, "error: {}: {}\n", subject, error.what());
   }
   return kUserError;
+}
+
+// An --out folder option's check (a usage error, before any work): not a
+// file, nor inside one, and writable.
+inline CLI::Validator outputFolderCheck() {
+  return CLI::Validator(
+      [](std::string& folder) {
+        const std::string why = jobs::whyNotAnOutputFolder(folder);
+        return why.empty() ? std::string() : fmt::format("{}: {}", folder, why);
+      },
+      "FOLDER");
 }
 
 }  // namespace rotafab::cli

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -29,18 +30,21 @@ int runDevices(bool json) {
     std::cout << list.dump() << '\n';
     return kSuccess;
   }
-  if (found.empty()) {
-    fmt::print(
-        "no serial port or cutter found (a GRBL board shows as /dev/ttyUSB* or /dev/ttyACM*; check the cable, "
-        "and that you may open it: the dialout group)\n");
-    return kSuccess;
-  }
   for (const auto& d : found) {
     fmt::print("{}  {}", d.port, d.description.empty() ? "(no description)" : d.description);
     if (d.vendor >= 0) fmt::print("  usb {:04x}:{:04x}", d.vendor, d.product);
     if (!d.serial.empty()) fmt::print(" serial {}", d.serial);
     if (!d.uri.empty()) fmt::print("\n    {} driver: --device {}", d.driver, d.uri);
     fmt::print("\n");
+  }
+  if (std::none_of(found.begin(), found.end(), [](const auto& d) { return !d.uri.empty(); })) {
+    fmt::print(
+        "{} (a GRBL board shows as /dev/ttyUSB* or /dev/ttyACM*: check the cable, and that you may open "
+        "it, the dialout group){}.\n"
+        "Without a cutter, the simulator takes a job as a GRBL board would: "
+        "rotafab run FOLDER --device sim:grbl\n",
+        found.empty() ? "no serial port or cutter found" : "no cutter recognised among these",
+        found.empty() ? "" : "; a port above may still be one: --device grbl://PORT");
   }
   return kSuccess;
 }

@@ -71,7 +71,9 @@ int runMake(const MakeOptions& options) {
     lines.prefix = "make: ";
     lines.nestingPrefix = "nesting: ";
     lines.seconds = options.seconds;
-    lines.bed = fmt::format("{} x {} in", request.machine.bed.width, request.machine.bed.height);
+    const auto& bed = request.machine.bed;
+    const double k = profiles::unitsPerInch(bed.unit);
+    lines.bed = fmt::format("{:.4g} x {:.4g} {}", bed.width * k, bed.height * k, bed.unit);
     lines.rows = request.rows;
     lines.folder = folder.string();
     CommandContext command{ProgressLines(lines)};

@@ -7,6 +7,7 @@
 
 #include "daemon/CommandSupport.h"
 #include "jobs/Manifest.h"
+#include "jobs/ManifestFile.h"
 
 namespace rotafab::cli {
 namespace {

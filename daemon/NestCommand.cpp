@@ -135,7 +135,7 @@ void addNestCommand(CLI::App& app, int& status) {
                    "Searches side by side, seeds SEED, SEED+1, ...; the best layout wins (default 0: one per core)")
       ->capture_default_str()
       ->check(CLI::Range(0, 256));
-  command->add_option("--out", options->out, "Folder for layout.json and layout.svg");
+  command->add_option("--out", options->out, "Folder for layout.json and layout.svg")->check(outputFolderCheck());
   command->add_flag("--json", options->json,
                     "Print one JSON object: sheets, utilization, strip_length, density, seconds, layouts");
   command->footer(

@@ -45,12 +45,13 @@ int runProfiles(const ProfilesOptions& options) {
     nlohmann::ordered_json out = {{"machines", nlohmann::ordered_json::array()},
                                   {"materials", nlohmann::ordered_json::array()}};
     for (const auto& m : catalogue.machines) {
-      out["machines"].push_back({{"name", m.name},
-                                 {"description", m.description},
-                                 {"bed", {{"width", m.bed.width}, {"height", m.bed.height}, {"margin", m.bed.margin}}},
-                                 {"driver", m.driver},
-                                 {"connection", m.connection},
-                                 {"file", m.source.string()}});
+      out["machines"].push_back(
+          {{"name", m.name},
+           {"description", m.description},
+           {"bed", {{"width", m.bed.width}, {"height", m.bed.height}, {"margin", m.bed.margin}, {"unit", m.bed.unit}}},
+           {"driver", m.driver},
+           {"connection", m.connection},
+           {"file", m.source.string()}});
     }
     for (const auto& m : catalogue.materials) {
       out["materials"].push_back({{"name", m.name},
@@ -67,14 +68,18 @@ int runProfiles(const ProfilesOptions& options) {
     // A section only where there is something in it: checking only bad
     // files prints nothing on standard output, only the errors.
     if (!catalogue.machines.empty()) fmt::print("machines\n");
+    // Each in the unit its file gives (a 400 x 400 mm bed is not shown as 15.7 in).
     for (const auto& m : catalogue.machines) {
-      fmt::print("  {:<18} {:>6.3g} x {:<6.3g} in  margin {:<6.3g} {:<7} {:<34} {}\n", m.name, m.bed.width,
-                 m.bed.height, m.bed.margin, m.driver, m.connection, m.source.string());
+      const double k = profiles::unitsPerInch(m.bed.unit);
+      fmt::print("  {:<18} {:>6.4g} x {:<6.4g} {:<2}  margin {:<10} {:<7} {:<34} {}\n", m.name, m.bed.width * k,
+                 m.bed.height * k, m.bed.unit, profiles::formatLength(m.bed.margin, m.bed.unit), m.driver, m.connection,
+                 m.source.string());
     }
     if (!catalogue.materials.empty()) fmt::print("materials\n");
     for (const auto& m : catalogue.materials) {
-      fmt::print("  {:<18} {:.4g} in thick, kerf {:.4g} in, fastener {:.4g} in  {}\n", m.name, m.thickness, m.kerf,
-                 m.fastenerDiameter, m.source.string());
+      fmt::print("  {:<18} {} thick, kerf {}, fastener {}  {}\n", m.name,
+                 profiles::formatLength(m.thickness, m.units.thickness), profiles::formatLength(m.kerf, m.units.kerf),
+                 profiles::formatLength(m.fastenerDiameter, m.units.fastener), m.source.string());
     }
   }
   return catalogue.errors.empty() ? kSuccess : kUserError;

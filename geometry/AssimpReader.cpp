@@ -74,6 +74,13 @@ StatedFaces statedFaceCount(std::string_view bytes, const std::string& extension
     const bool looksAscii = text != std::string_view::npos && bytes.substr(text, 5) == "solid";
     if (exactBinary || (!looksAscii && bytes.size() >= 84)) {
       stated.count = triangles;
+      // Far more than the file could hold: not a damaged STL but another file.
+      if (!exactBinary && 84 + 50ull * triangles > 4 * bytes.size() + 4096) {
+        throw InvalidMeshError(fmt::format(
+            "the file is not STL: it does not start with 'solid' (text STL), and as a binary STL its header would "
+            "state {} triangles, {} times what its {} bytes hold",
+            triangles, (84 + 50ull * triangles) / bytes.size(), bytes.size()));
+      }
       if (bytes.size() < 84 + 50ull * triangles) {
         throw InvalidMeshError(fmt::format("truncated: the binary STL header states {} triangles, the file holds {}",
                                            triangles, (bytes.size() - 84) / 50));
@@ -150,7 +157,7 @@ PolygonMesh readWithAssimp(std::string_view bytes, const std::string& extension,
   constexpr unsigned kFlags = aiProcess_ValidateDataStructure;
   const aiScene* scene = path ? importer.ReadFile(path->string(), kFlags)
                               : importer.ReadFileFromMemory(bytes.data(), bytes.size(), kFlags, extension.c_str());
-  if (!scene || !scene->mRootNode) throw InvalidMeshError(firstLine(importer.GetErrorString()));
+  if (!scene || !scene->mRootNode) throw AssimpFailure(firstLine(importer.GetErrorString()));
   PolygonMesh mesh;
   long long polygons = 0, faces = 0;
   appendScene(*scene, mesh, polygons, faces);

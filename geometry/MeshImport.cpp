@@ -15,6 +15,7 @@
 
 #include "core/ChildProcess.h"
 #include "core/ProgramFolders.h"
+#include "geometry/MeshFileChecks.h"
 #include "geometry/MeshReaders.h"
 #include "geometry/MeshWire.h"
 
@@ -80,6 +81,16 @@ PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& exte
         fmt::format("the {} reader ({}) ended with status {} and no answer", format, argv[0], result.exitCode));
   }
   if (result.output[0] == 'E') throw InvalidMeshError(result.output.substr(1));
+  if (result.output[0] == 'A') {
+    std::string message = result.output.substr(1);
+    // Assimp names the file by its whole path; the error starts with its name already.
+    if (path) {
+      const std::string where = std::filesystem::absolute(*path).string();
+      for (size_t at; !where.empty() && (at = message.find(where)) != std::string::npos;)
+        message.replace(at, where.size(), "it");
+    }
+    throw InvalidMeshError(explainReaderFailure(message, bytes, extension));
+  }
   if (result.output[0] != 'M') throw InvalidMeshError(fmt::format("the {} reader's reply is not a mesh", format));
   return deserializeMesh(std::string_view(result.output).substr(1));
 }
@@ -87,6 +98,7 @@ PolygonMesh readWithAssimpHelper(std::string_view bytes, const std::string& exte
 PolygonMesh readAny(std::string_view bytes, const std::string& extension, const std::filesystem::path* path,
                     const core::Cancellation* cancellation) {
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
+  if (auto mismatch = contentMismatch(bytes, extension)) throw InvalidMeshError(*mismatch);
   if (extension == "off") return readOff(bytes);
   if (extension == "ply") return readPly(bytes);
   // Assimp 5.2's glTF reader loops on text that is not JSON at all.

@@ -4,7 +4,8 @@
 // of its own. PARENT is the importer's process id: this program ends with it.
 // The bytes of the file come on standard input; PATH, when given, is where
 // they came from, for the files they refer to. The reply is one tag byte, then the
-// mesh ('M', MeshWire.h) or one line saying what is wrong with the file ('E').
+// mesh ('M', MeshWire.h), or one line saying what is wrong with the file ('E'),
+// or Assimp's own message on it ('A').
 // Exit status 0 whenever a reply was written; anything else is a crash.
 
 #include <fcntl.h>
@@ -75,11 +76,13 @@ int main(int argc, char** argv) {
     reply = "M" + geo::serializeMesh(geo::readWithAssimp(bytes, argv[2], argc == 4 ? &path : nullptr));
   } catch (const geo::InvalidMeshError& error) {
     reply = std::string("E") + error.what();
+  } catch (const geo::AssimpFailure& error) {
+    reply = std::string("A") + error.what();
   } catch (const std::bad_alloc&) {
     reply = "Ethe mesh does not fit in memory";
   } catch (const std::exception& error) {
     // Assimp throws DeadlyImportError and others on some malformed inputs.
-    reply = "E" + firstLineOf(error.what());
+    reply = "A" + firstLineOf(error.what());
   }
   // _exit: no destructors of Assimp's statics, and no leak report of a
   // sanitizer build (Debian's Assimp leaks on some inputs) in the way.

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "core/UserError.h"
+#include "jobs/JsonErrors.h"
+#include "jobs/ManifestFile.h"
 #include "jobs/SheetReader.h"
 
 namespace rotafab::jobs {
@@ -18,17 +20,7 @@ std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesys
   std::vector<std::pair<int, std::filesystem::path>> sheets;
   if (std::filesystem::is_directory(target)) {
     const auto manifestFile = target / "manifest.json";
-    std::ifstream in(manifestFile);
-    if (!in) {
-      throw core::UserError(
-          fmt::format("{}: no manifest.json (is it an output folder of `rotafab make`?)", target.string()));
-    }
-    nlohmann::json manifest;
-    try {
-      manifest = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& error) {
-      throw core::UserError(fmt::format("{}: not JSON: {}", manifestFile.string(), error.what()));
-    }
+    const nlohmann::json manifest = readManifest(target);
     try {
       for (const auto& sheet : manifest.at("sheets")) {
         const int index = sheet.at("index");
@@ -38,7 +30,7 @@ std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesys
         }
       }
     } catch (const nlohmann::json::exception& error) {
-      throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), error.what()));
+      throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
     }
     if (sheets.empty()) throw core::UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
   } else {

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <numbers>
@@ -10,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/UserError.h"
+#include "jobs/JsonErrors.h"
 #include "jobs/SvgWriter.h"
 
 namespace rotafab::jobs {
@@ -377,18 +380,6 @@ std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
 
 }  // namespace
 
-nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
-  std::filesystem::path file(folderOrFile);
-  if (std::filesystem::is_directory(file)) file /= "manifest.json";
-  std::ifstream in(file);
-  if (!in) throw core::UserError(fmt::format("{}: cannot read it", file.string()));
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& error) {
-    throw core::UserError(fmt::format("{}: not JSON: {}", file.string(), error.what()));
-  }
-}
-
 std::string manifestText(const nlohmann::json& manifest) {
   try {
     std::string text = fmt::format(
@@ -409,7 +400,7 @@ std::string manifestText(const nlohmann::json& manifest) {
     text += fmt::format("\n{} fastener{} in all\n", total, total == 1 ? "" : "s");
     return text;
   } catch (const nlohmann::json::exception& error) {
-    throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", error.what()));
+    throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", jsonErrorText(error)));
   }
 }
 
@@ -470,7 +461,7 @@ the same number on the panel named; fasten them through their holes.</p>
     html += "</body>\n</html>\n";
     return html;
   } catch (const nlohmann::json::exception& error) {
-    throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", error.what()));
+    throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", jsonErrorText(error)));
   }
 }
 

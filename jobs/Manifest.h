@@ -58,10 +58,6 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
                                          const profiles::Bed& bed, const SheetPlan& plan,
                                          const std::vector<std::vector<std::string>>& files);
 
-// A manifest.json, or the one in an output folder. Throws core::UserError
-// naming the file when it cannot be read or is not JSON.
-nlohmann::json readManifest(const std::filesystem::path& folderOrFile);
-
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
 // the panels already placed that it joins and the edge numbers to fasten
 // with the fasteners of each; totals at the end. Throws

@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
+#include "jobs/JsonErrors.h"
+
 namespace rotafab::jobs {
 
 // Reads the instance: one part per copy of each item. Names the element at fault.
@@ -19,7 +21,7 @@ NestingInstance readNestingInstance(const std::string& file) {
   try {
     instance = nlohmann::json::parse(in);
   } catch (const nlohmann::json::parse_error& error) {
-    throw std::invalid_argument(fmt::format("{}: not JSON: {}", file, error.what()));
+    throw std::invalid_argument(fmt::format("{}: not JSON: {}", file, jsonErrorText(error)));
   }
   auto fail = [&](const std::string& where, const std::string& what) {
     return std::invalid_argument(fmt::format("{}: {}: {}", file, where, what));

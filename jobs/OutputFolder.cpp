@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <set>
 
 namespace rotafab::jobs {
@@ -13,6 +15,27 @@ namespace {
 std::atomic<unsigned> stagings{0};
 
 }  // namespace
+
+std::string whyNotAnOutputFolder(const std::filesystem::path& target) {
+  std::error_code error;
+  auto full = std::filesystem::absolute(target, error).lexically_normal();
+  if (error) return error.message();
+  if (full.filename().empty()) full = full.parent_path();  // "dir/"
+  for (std::filesystem::path p = full;; p = p.parent_path()) {
+    const auto status = std::filesystem::status(p, error);
+    if (status.type() == std::filesystem::file_type::directory) {
+      if (::access(p.c_str(), W_OK | X_OK) != 0) {
+        return fmt::format("cannot write in {}: {}", p.string(), std::strerror(errno));
+      }
+      return "";
+    }
+    if (status.type() != std::filesystem::file_type::not_found && status.type() != std::filesystem::file_type::none) {
+      return p == full ? "is a file, not a folder: name a folder (it is made if it is missing)"
+                       : fmt::format("{} is a file, so no folder can be made inside it", p.string());
+    }
+    if (p == p.parent_path()) return "";
+  }
+}
 
 OutputFolder::OutputFolder(std::filesystem::path target) : target_(std::move(target)) {
   if (target_.filename().empty()) target_ = target_.parent_path();  // "dir/"

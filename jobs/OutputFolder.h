@@ -14,6 +14,11 @@
 
 namespace rotafab::jobs {
 
+// Why `target` cannot be an output folder (it is a file, or a file stands
+// where one of the folders above it would be), or "" when it can: asked
+// before any work, so that a job is not built only to fail at the end.
+std::string whyNotAnOutputFolder(const std::filesystem::path& target);
+
 class OutputFolder {
  public:
   // Creates `target` if need be, and the hidden folder inside it. Throws

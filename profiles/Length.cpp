@@ -1,5 +1,7 @@
 #include "profiles/Length.h"
 
+#include <fmt/format.h>
+
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -40,6 +42,17 @@ std::string_view unitOf(std::string_view text) {
 }
 
 }  // namespace
+
+std::string_view writtenUnit(std::string_view text) {
+  const std::string_view unit = unitOf(text);
+  return unit.empty() ? "in" : unit;
+}
+
+double unitsPerInch(std::string_view unit) { return unit == "mm" ? 25.4 : unit == "cm" ? 2.54 : 1.0; }
+
+std::string formatLength(double inches, std::string_view unit) {
+  return fmt::format("{:.4g} {}", inches * unitsPerInch(unit), unit);
+}
 
 std::optional<std::pair<double, double>> parseSize(std::string_view text) {
   const size_t x = text.find('x');

@@ -4,6 +4,7 @@
 // unit. "0.25in", "6.35mm", "0.635cm" and "0.25" are the same length.
 
 #include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 
@@ -12,6 +13,15 @@ namespace rotafab::profiles {
 // The length in inches, or nullopt when the text is not a finite number with
 // one of the units.
 std::optional<double> parseLength(std::string_view text);
+
+// The unit a length is written in: "in", "mm" or "cm" ("in" for a bare number).
+std::string_view writtenUnit(std::string_view text);
+
+// `inches` in `unit` for people, to 4 significant digits: "400 mm", "0.125 in".
+std::string formatLength(double inches, std::string_view unit);
+
+// Millimetres or centimetres per inch, or 1 for inches.
+double unitsPerInch(std::string_view unit);
 
 // A size WIDTHxHEIGHT (SPEC: a unit written once at the end applies to both
 // numbers, "800x600mm"; or one each, "32inx18in"; none, inches: "31.5x17.5"),

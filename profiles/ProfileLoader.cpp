@@ -180,6 +180,7 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   const YAML::Node bed = root["bed"];
   reader.keys(bed, "bed", {"width", "height", "margin"}, {"width", "height"});
   machine.bed.width = reader.length(bed["width"], "bed.width", 0.0, false);
+  machine.bed.unit = writtenUnit(bed["width"].Scalar());
   machine.bed.height = reader.length(bed["height"], "bed.height", 0.0, false);
   if (bed["margin"]) machine.bed.margin = reader.length(bed["margin"], "bed.margin", 0.0, true);
   if (2 * machine.bed.margin >= std::min(machine.bed.width, machine.bed.height)) {
@@ -265,10 +266,15 @@ MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
   material.name = reader.text(root["name"], "name");
   if (root["description"]) material.description = reader.text(root["description"], "description");
   material.thickness = reader.length(root["thickness"], "thickness", 0.0, false);
+  material.units.thickness = writtenUnit(root["thickness"].Scalar());
   material.kerf = reader.length(root["kerf"], "kerf", 0.0, true);
   if (material.kerf >= 0.25)
     reader.fail(root["kerf"], "kerf", "must be under 0.25in: a laser cut is a few thousandths wide");
-  if (root["fastener"]) material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false);
+  material.units.kerf = writtenUnit(root["kerf"].Scalar());
+  if (root["fastener"]) {
+    material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false);
+    material.units.fastener = writtenUnit(root["fastener"].Scalar());
+  }
   // Grams per square metre, as board and paper are sold (posterboard about
   // 350, 1/16 in chipboard about 1,000, 3 mm birch plywood about 2,000).
   if (root["areal_density"]) material.arealDensity = reader.number(root["areal_density"], "areal_density", 1.0, 1e5);

@@ -18,7 +18,8 @@ namespace rotafab::profiles {
 struct Bed {
   double width = 32.0;  // inches
   double height = 18.0;
-  double margin = 0.25;  // on every side; nothing is drawn nearer the edge
+  double margin = 0.25;     // on every side; nothing is drawn nearer the edge
+  std::string unit = "in";  // the unit the profile gives the width in: how it is shown
 };
 
 enum class LaserMode { Vector, Raster, RasterAndVector };
@@ -66,6 +67,10 @@ struct MaterialProfile {
   // not say; grams per fastener with its nut or clip (`fastener_mass`).
   double arealDensity = 0.0;
   double fastenerMass = 0.0;
+  // The units the profile gives the thickness, kerf and fastener in: how they are shown.
+  struct WrittenUnits {
+    std::string thickness = "in", kerf = "in", fastener = "in";
+  } units;
   std::map<std::string, std::map<Operation, PowerSpeed>> machines;  // machine name -> overrides
   std::filesystem::path source;
 };

@@ -29,5 +29,30 @@ TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
   EXPECT_NE(listed.out.find("posterboard"), std::string::npos);
 }
 
+// Each length is shown in the unit its file gives it in: a 400 mm bed is not
+// "15.7 in", a 3 mm sheet not "0.1181 in"; a file in inches stays in inches.
+TEST(ProfilesCli, LengthsAreShownInTheirFilesUnits) {
+  const CommandResult listed = run("cd " + std::string(ROTAFAB_SOURCE_DIR) + " && " + ROTAFAB_CLI + " profiles");
+  ASSERT_EQ(listed.status, 0) << listed.err;
+  const auto line = [&](const std::string& name) {
+    const size_t at = listed.out.find("  " + name + " ");
+    return at == std::string::npos ? std::string() : listed.out.substr(at, listed.out.find('\n', at) - at);
+  };
+  EXPECT_NE(line("grbl-diode-400").find(" 400 x 400    mm  margin 5 mm "), std::string::npos) << line("grbl-diode-400");
+  EXPECT_NE(line("workshop-32x18").find(" 32 x 18     in  margin 0.25 in "), std::string::npos)
+      << line("workshop-32x18");
+  EXPECT_NE(line("plywood-3mm").find(" 3 mm thick, kerf 0.15 mm, fastener 3.2 mm "), std::string::npos)
+      << line("plywood-3mm");
+  EXPECT_NE(line("posterboard").find(" 0.8 mm thick, kerf 0.004 in, fastener 0.125 in "), std::string::npos)
+      << line("posterboard");
+  // JSON keeps SPEC's inches, and says which unit the file used.
+  const CommandResult json = run("cd " + std::string(ROTAFAB_SOURCE_DIR) + " && " + ROTAFAB_CLI + " profiles --json");
+  EXPECT_NE(
+      json.out.find(
+          R"("bed":{"width":15.748031496062993,"height":15.748031496062993,"margin":0.19685039370078738,"unit":"mm"})"),
+      std::string::npos)
+      << json.out;
+}
+
 }  // namespace
 }  // namespace rotafab::test

@@ -194,6 +194,20 @@ TEST(DevicesCli, ListsTheCuttersOfAFakedSysfs) {
   EXPECT_EQ(list[1].at("uri"), "m2nano://usb/1a86:5512");
   const CommandResult text = run(umockdev + " devices");
   EXPECT_NE(text.out.find("grbl driver: --device grbl:///dev/ttyUSB0?baud=115200"), std::string::npos) << text.out;
+  EXPECT_EQ(text.out.find("sim:grbl"), std::string::npos) << "cutters were found: no simulator to suggest";
+}
+
+// Nothing plugged in (an empty sysfs): said so, with the simulator to try instead.
+TEST(DevicesCli, NothingFoundSuggestsTheSimulator) {
+  const CommandResult r = run("ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 umockdev-run -- " +
+                              std::string(ROTAFAB_CLI) + " devices");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(r.out.starts_with("no serial port or cutter found (")) << r.out;
+  EXPECT_NE(r.out.find("--device sim:grbl\n"), std::string::npos) << r.out;
+  EXPECT_EQ(run("ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 umockdev-run -- " + std::string(ROTAFAB_CLI) +
+                " devices --json")
+                .out,
+            "[]\n");
 }
 
 }  // namespace
