@@ -35,6 +35,23 @@ nlohmann::ordered_json topologyJson(const geometry::MeshTopology& t) {
           {"manifold", t.manifold}};
 }
 
+// The problem kinds for --json, named as the repairs are.
+const char* problemKindName(geometry::MeshProblemKind kind) {
+  switch (kind) {
+    case geometry::MeshProblemKind::RepeatedCorner:
+      return "repeated-corner";
+    case geometry::MeshProblemKind::ZeroAreaFace:
+      return "zero-area-face";
+    case geometry::MeshProblemKind::NonManifoldEdge:
+      return "non-manifold-edge";
+    case geometry::MeshProblemKind::BowTieVertex:
+      return "bow-tie-vertex";
+    case geometry::MeshProblemKind::NonOrientable:
+      return "non-orientable";
+  }
+  return "other";
+}
+
 void printRepairPreview(const geometry::RepairPreview& preview) {
   if (preview.repairs.empty()) {
     fmt::print("`rotafab make` (--repair auto) has nothing to repair here; it refuses this mesh too\n");
@@ -108,6 +125,13 @@ int runInspect(const InspectOptions& options) {
     if (options.json) {
       for (const auto& note : analysis.notes) fmt::print(stderr, "note: {}: {}\n", options.mesh, note);
       nlohmann::ordered_json object = topologyJson(analysis.topology);
+      // What the text lists, all of it (the text shows the first 20).
+      object["usable"] = analysis.usable();
+      object["problems"] = nlohmann::ordered_json::array();
+      for (const auto& problem : analysis.problems) {
+        object["problems"].push_back({{"kind", problemKindName(problem.kind)}, {"message", problem.message}});
+      }
+      object["repaired"] = analysis.notes;
       if (!analysis.usable()) {
         object["repairs"] = jobs::repairsJson(preview.repairs);
         object["usable_after_repair"] = preview.after.usable();

@@ -5,12 +5,18 @@
 
 namespace rotafab::geometry {
 
-void writeObj(std::ostream& out, const PolygonMesh& mesh, std::string_view comment) {
+void writeObj(std::ostream& out, const PolygonMesh& mesh, std::string_view comment,
+              const std::vector<ObjGroup>& groups) {
   fmt::memory_buffer buffer;
   if (!comment.empty()) fmt::format_to(std::back_inserter(buffer), "# {}\n", comment);
   for (const Point3& p : mesh.positions)
     fmt::format_to(std::back_inserter(buffer), "v {} {} {}\n", p.x(), p.y(), p.z());
-  for (const auto& face : mesh.faces) {
+  auto group = groups.begin();
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    const auto& face = mesh.faces[f];
+    for (; group != groups.end() && group->firstFace <= f; ++group) {
+      fmt::format_to(std::back_inserter(buffer), "g {}\n", group->name);
+    }
     buffer.push_back('f');
     for (int v : face) fmt::format_to(std::back_inserter(buffer), " {}", v + 1);
     buffer.push_back('\n');

@@ -1,5 +1,7 @@
 #include "geometry/Structure.h"
 
+#include <fmt/format.h>
+
 #include <map>
 
 namespace rotafab::geometry {
@@ -77,6 +79,16 @@ PolygonMesh surfaceMesh(const Structure& structure) {
     }
   }
   return surface;
+}
+
+std::vector<ObjGroup> panelGroups(const Structure& structure) {
+  std::vector<ObjGroup> groups;
+  int face = 0;
+  for (const Panel& panel : structure.panels) {
+    groups.push_back({face, fmt::format("panel-{}", panel.id)});
+    face += static_cast<int>(panel.surface.size());
+  }
+  return groups;
 }
 
 }  // namespace rotafab::geometry

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "core/Polygon2.h"
+#include "geometry/ObjWriter.h"
 #include "geometry/PanelLabels.h"
 #include "geometry/PolygonMesh.h"
 
@@ -124,5 +125,9 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
 
 // The panels' 3D surfaces as one mesh, polygon by polygon.
 PolygonMesh surfaceMesh(const Structure& structure);
+
+// Where each panel's polygons start in surfaceMesh, named "panel-17": a
+// group per panel in structure.obj, to find a panel in any 3D viewer.
+std::vector<ObjGroup> panelGroups(const Structure& structure);
 
 }  // namespace rotafab::geometry

@@ -408,7 +408,8 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
     geometry::writeObj(
         stream, geometry::surfaceMesh(job.structure),
         fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
-                    job.meshFile.string(), job.structure.panels.size()));
+                    job.meshFile.string(), job.structure.panels.size()),
+        geometry::panelGroups(job.structure));
   });
   job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
   job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};

@@ -17,22 +17,22 @@ nlohmann::json inspectJson(const std::filesystem::path& mesh) {
   return nlohmann::json::parse(result.out);
 }
 
-TEST(InspectCli, ExamplesGiveSpecJsonInSpecOrder) {
+TEST(InspectCli, ExamplesGiveSpecJsonInSpecOrderThenTheProblems) {
   struct Case {
     const char* file;
     const char* json;
   };
   const Case cases[] = {
       {"bunny.obj",
-       R"({"vertices":1839,"edges":5511,"faces":3674,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+       R"({"vertices":1839,"edges":5511,"faces":3674,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true,"usable":true,"problems":[],"repaired":[]})"},
       {"soccer-ball.obj",
-       R"({"vertices":60,"edges":90,"faces":32,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+       R"({"vertices":60,"edges":90,"faces":32,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true,"usable":true,"problems":[],"repaired":[]})"},
       {"torus.obj",
-       R"({"vertices":288,"edges":576,"faces":288,"boundary_loops":0,"components":1,"euler":0,"genus":1,"orientable":true,"manifold":true})"},
+       R"({"vertices":288,"edges":576,"faces":288,"boundary_loops":0,"components":1,"euler":0,"genus":1,"orientable":true,"manifold":true,"usable":true,"problems":[],"repaired":[]})"},
       {"genus2.obj",
-       R"({"vertices":48,"edges":100,"faces":50,"boundary_loops":0,"components":1,"euler":-2,"genus":2,"orientable":true,"manifold":true})"},
+       R"({"vertices":48,"edges":100,"faces":50,"boundary_loops":0,"components":1,"euler":-2,"genus":2,"orientable":true,"manifold":true,"usable":true,"problems":[],"repaired":[]})"},
       {"cube.obj",
-       R"({"vertices":8,"edges":12,"faces":6,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true})"},
+       R"({"vertices":8,"edges":12,"faces":6,"boundary_loops":0,"components":1,"euler":2,"genus":0,"orientable":true,"manifold":true,"usable":true,"problems":[],"repaired":[]})"},
   };
   for (const auto& c : cases) {
     SCOPED_TRACE(c.file);
@@ -58,9 +58,14 @@ TEST(InspectCli, BrokenButReadableMeshIsReportedWithExitZero) {
   const auto object = nlohmann::json::parse(json.out);
   EXPECT_EQ(object["manifold"], false);
   EXPECT_TRUE(object["genus"].is_null());
+  EXPECT_EQ(object["usable"], false);
   const CommandResult text = run(kCli + " inspect " + mesh.string());
   EXPECT_EQ(text.status, 0);
   EXPECT_NE(text.out.find("edge (0, 1) is shared by 3 faces (0, 1, 2)"), std::string::npos) << text.out;
+  // The JSON lists the problems the text prints, each with its kind.
+  ASSERT_EQ(object["problems"].size(), 1u) << json.out;
+  EXPECT_EQ(object["problems"][0]["kind"], "non-manifold-edge");
+  EXPECT_NE(text.out.find("  " + object["problems"][0]["message"].get<std::string>() + "\n"), std::string::npos);
 }
 
 TEST(InspectCli, UnreadableMeshIsOneLineAndExitOne) {

@@ -64,8 +64,24 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
   // structure.obj: the 3D panels, a vertex band and the bands' triangles each.
   std::istringstream obj(readFile(out / "structure.obj"));
   int faces = 0;
-  for (std::string line; std::getline(obj, line);) faces += line.starts_with("f ");
+  // A group per panel, in panel order, each with its vertex band and its half of each edge band.
+  std::vector<std::string> groups;
+  std::vector<int> facesInGroup;
+  for (std::string line; std::getline(obj, line);) {
+    if (line.starts_with("f ")) {
+      ++faces;
+      ASSERT_FALSE(facesInGroup.empty()) << "a face before the first group";
+      ++facesInGroup.back();
+    }
+    if (line.starts_with("g ")) groups.push_back(line.substr(2)), facesInGroup.push_back(0);
+  }
   EXPECT_EQ(faces, 32 + 90 * 2 * 16);  // 32 vertex bands; 90 bands on two panels, 8 segments of 2 triangles
+  ASSERT_EQ(groups.size(), manifest.at("panels").size());
+  for (size_t k = 0; k < groups.size(); ++k) {
+    EXPECT_EQ(groups[k], "panel-" + std::to_string(manifest.at("panels")[k].at("id").get<int>()));
+    // a pentagon's or hexagon's vertex band, and 5 or 6 edge bands' halves
+    EXPECT_TRUE(facesInGroup[k] == 1 + 5 * 16 || facesInGroup[k] == 1 + 6 * 16) << groups[k] << ": " << facesInGroup[k];
+  }
 }
 
 // The distance from a point to a closed outline given as manifest.json's [[x, y], ...].
