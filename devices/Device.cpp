@@ -18,6 +18,8 @@ std::string_view faultName(FaultKind kind) {
       return "protocol";
     case FaultKind::Cancelled:
       return "cancelled";
+    case FaultKind::Stalled:
+      return "stalled";
   }
   return "fault";
 }

@@ -26,6 +26,7 @@ enum class FaultKind {
   Refused,       // the device is not set up to run this job (laser mode off, bed too small, ...)
   Protocol,      // the device said something no controller of its kind says
   Cancelled,     // the user stopped the job
+  Stalled,       // the machine stopped moving while it says it runs
 };
 std::string_view faultName(FaultKind kind);
 
@@ -87,6 +88,9 @@ class Device {
   // What the machine can do, for planning its toolpaths (once connected, as
   // the controller reports it).
   [[nodiscard]] virtual jobs::MotionLimits motionLimits() const { return {}; }
+  // Machine seconds per real second: a simulator may run faster than the
+  // machine it stands for; progress and estimates are said in real time.
+  [[nodiscard]] virtual double timeScale() const { return 1.0; }
   // The bytes run() would send for these toolpaths, one after another, as a
   // dry run writes them (SPEC, "Devices"), and what they are, for people:
   // "G-code for 1 sheet (108 strokes), as the driver would send it".

@@ -68,7 +68,7 @@ RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Ca
       const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
       if (!loaded) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
       throwIfCancelled(&cancel);
-      if (events.sheetStarted) events.sheetStarted(s, toolpath);
+      if (events.sheetStarted) events.sheetStarted(s, toolpath, toolpath.seconds / device_->timeScale());
       if (frame) {
         if (events.framing) events.framing();
         device_->frame(toolpath);
@@ -77,8 +77,9 @@ RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Ca
       streaming = true;
       device_->run(
           toolpath,
-          [&](const Progress& progress) {
+          [&](Progress progress) {
             acknowledged = progress.stroke;
+            progress.secondsLeft /= device_->timeScale();
             if (events.progress) events.progress(progress);
           },
           cancel);
@@ -90,7 +91,7 @@ RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Ca
     }
     if (events.sheetFinished) events.sheetFinished();
     ++summary.sheets;
-    summary.burnt += toolpath.burnLength, summary.estimated += toolpath.seconds;
+    summary.burnt += toolpath.burnLength, summary.estimated += toolpath.seconds / device_->timeScale();
     summary.strokes += toolpath.strokes.size();
   }
   device_->disconnect();

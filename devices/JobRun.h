@@ -41,7 +41,8 @@ struct RunEvents {
   // not, the job stops as cancelled). The command line asks at the
   // terminal, a daemon waits for its client. Not set: go on.
   std::function<bool(const jobs::Toolpath& next)> beforeSheet;
-  std::function<void(size_t index, const jobs::Toolpath& toolpath)> sheetStarted;  // index of all, from 0
+  // Index of all, from 0; the estimated seconds, in real time (Device::timeScale).
+  std::function<void(size_t index, const jobs::Toolpath& toolpath, double seconds)> sheetStarted;
   std::function<void()> framing;
   std::function<void(const Progress&)> progress;
   std::function<void()> sheetFinished;
@@ -51,7 +52,7 @@ struct RunEvents {
 struct RunSummary {
   size_t sheets = 0, strokes = 0;
   double burnt = 0;      // inches
-  double estimated = 0;  // seconds
+  double estimated = 0;  // seconds, real time
 };
 
 class JobRun {

@@ -115,13 +115,6 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   return out;
 }
 
-double segmentSeconds(double length, double speed, double acceleration) {
-  if (length <= 0 || speed <= 0) return 0;
-  // From a stop to a stop: cruise at `speed` if there is room to reach it.
-  if (acceleration <= 0 || length >= speed * speed / acceleration) return length / speed + speed / acceleration;
-  return 2 * std::sqrt(length / acceleration);
-}
-
 }  // namespace
 
 Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
@@ -207,18 +200,23 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
   return toolpath;
 }
 
-double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits) {
-  const double travel = limits.maxSpeed;  // moves with the laser off go at the machine's full speed
-  double seconds = 0;
-  Point2 head(0, 0);
+std::vector<Move> toolpathMoves(const Toolpath& toolpath) {
+  std::vector<Move> moves;
   for (const ToolpathStroke& stroke : toolpath.strokes) {
-    seconds += segmentSeconds((stroke.points.front() - head).norm(), travel, limits.acceleration);
-    for (size_t i = 1; i < stroke.points.size(); ++i) {
-      seconds += segmentSeconds((stroke.points[i] - stroke.points[i - 1]).norm(), stroke.speed, limits.acceleration);
-    }
-    head = stroke.points.back();
+    moves.push_back({stroke.points.front(), 0, false});
+    for (size_t i = 1; i < stroke.points.size(); ++i) moves.push_back({stroke.points[i], stroke.speed, false});
   }
-  return seconds + segmentSeconds(head.norm(), travel, limits.acceleration);
+  moves.push_back({Point2(0, 0), 0, true});
+  return moves;
+}
+
+MotionTime toolpathTime(const Toolpath& toolpath, const MotionLimits& limits) {
+  return plannedTime(Point2(0, 0), toolpathMoves(toolpath), limits.maxSpeed, limits.acceleration,
+                     limits.junctionDeviation, limits.perAxis);
+}
+
+double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits) {
+  return toolpathTime(toolpath, limits).seconds;
 }
 
 std::array<double, 4> toolpathBounds(const Toolpath& toolpath) {

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "jobs/MotionPlan.h"
 #include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
 
@@ -28,6 +29,10 @@ namespace rotafab::jobs {
 struct MotionLimits {
   double maxSpeed = 500.0 / 25.4 / 60;  // in/s (GRBL's default $110, 500 mm/min)
   double acceleration = 10.0 / 25.4;    // in/s^2 (GRBL's default $120, 10 mm/s^2)
+  // How far a corner may be cut (GRBL's $11, inches); 0: every corner is
+  // taken from a stop (a controller without look-ahead).
+  double junctionDeviation = 0;
+  bool perAxis = false;  // the speed and acceleration are each axis's (GRBL's): a diagonal goes faster
 };
 
 struct ToolpathStroke {
@@ -52,9 +57,15 @@ struct Toolpath {
 Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
                       const profiles::MaterialProfile& material, const MotionLimits& limits);
 
-// The time to run: each segment at its stroke's speed (travel at the travel
-// speed), accelerating from and braking to a stop at every corner (so an
-// upper bound for smooth curves, which a planner takes without stopping).
+// The head's moves: from the origin to each stroke's start at the rapid
+// rate, along the stroke at its speed, and back to the origin once the
+// laser is off (after a stop: switching it off waits for the motion).
+std::vector<Move> toolpathMoves(const Toolpath& toolpath);
+
+// The time to run, as a planner with look-ahead runs it (MotionPlan.h):
+// each move accelerating and braking at the limit, corners taken at the
+// junction deviation's speed.
+MotionTime toolpathTime(const Toolpath& toolpath, const MotionLimits& limits);
 double estimateSeconds(const Toolpath& toolpath, const MotionLimits& limits);
 
 // The box the laser head covers (strokes and nothing else), for framing: min x, min y, max x, max y.

@@ -33,6 +33,11 @@ GCodeProgram gcodeProgram(const jobs::Toolpath& toolpath, const GCodeOptions& op
   }
   lines.push_back("M5 S0");
   lines.push_back("G0 X0 Y0");
+  // A move per line from the first G0 to the last, but the M5 (its moves
+  // are toolpathMoves', in the same order).
+  int move = 0;
+  for (const std::string& line : lines)
+    program.lineMove.push_back(line.starts_with("G0 ") || line.starts_with("G1 ") ? move++ : -1);
   return program;
 }
 

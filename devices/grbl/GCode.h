@@ -25,9 +25,12 @@ std::vector<std::string> gcodeLines(const jobs::Toolpath& toolpath, const GCodeO
 
 // The same lines, and how many of them run through the end of each stroke
 // (for progress by strokes).
+// `lineMove`: for each line, the head's move it is (jobs::toolpathMoves'
+// numbering), or -1 for a line that does not move it.
 struct GCodeProgram {
   std::vector<std::string> lines;
   std::vector<size_t> strokeEnds;
+  std::vector<int> lineMove;
 };
 GCodeProgram gcodeProgram(const jobs::Toolpath& toolpath, const GCodeOptions& options);
 

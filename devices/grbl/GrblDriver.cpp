@@ -33,6 +33,65 @@ DeviceFault errorFault(const std::string& device, const std::string& command, co
   return DeviceFault(FaultKind::Error, fmt::format("{}: {}: {}", device, command, errorMessage(codeAfter(reply, 6))));
 }
 
+// Lines in a row that are no GRBL reply before the link is taken for broken:
+// a USB serial link garbles a byte now and then, and a report or an `ok`
+// lost to it is not a fault by itself (a lost `ok` is found otherwise).
+constexpr int kGarbledRun = 3;
+
+// What the controller said, shown safely: printable ASCII, at most 40 bytes.
+std::string shown(const std::string& line) {
+  std::string text;
+  for (char c : line.substr(0, 40)) text += (c >= 32 && c < 127) ? c : '?';
+  return text;
+}
+
+// A machine that says Run yet neither moves nor acknowledges: a stall.
+// Progress is an `ok`, or a position that changed, or any other state.
+class StallWatch {
+ public:
+  explicit StallWatch(std::chrono::steady_clock::duration bound) : bound_(bound) {}
+  void progressed() { since_ = std::chrono::steady_clock::now(); }
+  // Whether the report shows a stall.
+  bool stalled(const DeviceStatus& report) {
+    const auto now = std::chrono::steady_clock::now();
+    if (report.state != "Run" || std::abs(report.x - x_) > 1e-7 || std::abs(report.y - y_) > 1e-7) {
+      x_ = report.x, y_ = report.y, since_ = now;
+      return false;
+    }
+    return now - since_ > bound_;
+  }
+  [[nodiscard]] double seconds() const { return std::chrono::duration<double>(bound_).count(); }
+  void setBound(std::chrono::steady_clock::duration bound) { bound_ = bound; }
+
+ private:
+  std::chrono::steady_clock::duration bound_;
+  std::chrono::steady_clock::time_point since_ = std::chrono::steady_clock::now();
+  double x_ = 1e300, y_ = 1e300;
+};
+
+DeviceFault stallFault(const std::string& device, const DeviceStatus& report, double seconds) {
+  return DeviceFault(FaultKind::Stalled,
+                     fmt::format("{}: the machine stopped moving: it says Run, yet it has stood at ({:.3f}, {:.3f}) "
+                                 "mm for {:.0f} s without taking a line; check the motors and their drivers",
+                                 device, report.x * kMillimetresPerInch, report.y * kMillimetresPerInch, seconds));
+}
+
+// The longest a stall may look like motion: twice the slowest move that can
+// be in the planner (GRBL's 15 blocks, or the lines from `first` on), at
+// least `floor`, at most 30 s.
+std::chrono::milliseconds stallBound(const std::vector<double>& moveEnds, const GCodeProgram& program, size_t first,
+                                     size_t last, Millis floor, double timeScale) {
+  double longest = 0;
+  for (size_t line = first; line < last && line < program.lines.size(); ++line) {
+    const int move = program.lineMove[line];
+    if (move < 0) continue;
+    longest = std::max(longest, moveEnds[move] - (move > 0 ? moveEnds[move - 1] : 0.0));
+  }
+  const auto bound = std::chrono::milliseconds(static_cast<long long>(2000 * longest / timeScale));
+  return std::min<std::chrono::milliseconds>(std::max<std::chrono::milliseconds>(bound, floor),
+                                             std::chrono::milliseconds(30000));
+}
+
 }  // namespace
 
 std::optional<DeviceStatus> parseStatusReport(const std::string& line) {
@@ -46,8 +105,8 @@ std::optional<DeviceStatus> parseStatusReport(const std::string& line) {
   }
 }
 
-GrblDriver::GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts)
-    : open_(std::move(open)), timeouts_(timeouts) {}
+GrblDriver::GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts, double timeScale)
+    : open_(std::move(open)), timeouts_(timeouts), timeScale_(timeScale) {}
 
 std::string GrblDriver::expectLine(Millis timeout, const char* waitingFor) {
   auto line = link_->readLine(timeout);
@@ -89,14 +148,14 @@ std::string GrblDriver::connect() {
     if (std::regex_search(line, m, setting)) settings_[std::stoi(m[1])] = std::stod(m[2]);
   }
   // $I: [VER:...] and [OPT:flags,blocks,rx bytes], then ok.
-  receiveBuffer_ = 128;
+  receiveBuffer_ = 128, plannerBlocks_ = 15;
   link_->write("$I\n", timeouts_.answer);
   for (;;) {
     const std::string line = expectLine(timeouts_.answer, "the build info ($I)");
     if (line == "ok") break;
     static const std::regex options(R"(^\[OPT:[^,\]]*,(\d+),(\d+))");
     std::smatch m;
-    if (std::regex_search(line, m, options)) receiveBuffer_ = std::stoul(m[2]);
+    if (std::regex_search(line, m, options)) plannerBlocks_ = std::stoul(m[1]), receiveBuffer_ = std::stoul(m[2]);
   }
   if (!settings_.count(32)) {
     throw DeviceFault(FaultKind::Refused,
@@ -150,6 +209,9 @@ jobs::MotionLimits GrblDriver::motionLimits() const {
   const double rate = std::min(get(110), get(111)), accel = std::min(get(120), get(121));
   if (rate > 0) limits.maxSpeed = rate / kMillimetresPerInch / 60;
   if (accel > 0) limits.acceleration = accel / kMillimetresPerInch;
+  // GRBL's planner: look-ahead through corners of $11's deviation, each axis at its own limits.
+  limits.junctionDeviation = (settings_.count(11) ? get(11) : 0.01) / kMillimetresPerInch;
+  limits.perAxis = true;
   return limits;
 }
 
@@ -191,9 +253,10 @@ DeviceStatus GrblDriver::status() {
   }
 }
 
-void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel) {
-  // As long as status reports come, the machine is working (or held).
+void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter) {
+  // As long as status reports come and the position changes, the machine is working (or held).
   bool idleBefore = false;
+  StallWatch stall(stallAfter);
   for (;;) {
     if (cancel && cancel->cancelled()) throw DeviceFault(FaultKind::Cancelled, link_->name() + ": cancelled");
     if (holdRequested_.exchange(false)) link_->write(std::string(1, kHold), timeouts_.answer);
@@ -220,6 +283,7 @@ void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel) {
     if (report->state.starts_with("Alarm")) {
       throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller is in alarm");
     }
+    if (stall.stalled(*report)) throw stallFault(link_->name(), *report, stall.seconds());
     std::this_thread::sleep_for(timeouts_.poll);
   }
 }
@@ -248,9 +312,12 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
   if (!link_) connect();
   const GCodeProgram program = gcodeProgram(toolpath, gcodeOptions());
   const std::vector<std::string>& lines = program.lines;
+  // The time each move ends, as GRBL's planner runs it with these settings.
+  const jobs::MotionTime timing = jobs::toolpathTime(toolpath, motionLimits());
   Progress state;
   state.sheet = toolpath.sheet;
   state.strokes = toolpath.strokes.size();
+  state.secondsLeft = timing.seconds;
   for (const std::string& line : lines) state.bytesTotal += line.size() + 1;
   // Character counting: the bytes sent and not yet acknowledged never exceed
   // what the receive buffer holds (one byte of the ring stays free).
@@ -262,6 +329,8 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
   // was lost (or a line), and the job would wait for ever.
   bool idle = false;
   auto idleSince = lastHeard;
+  int garbled = 0;
+  StallWatch stall(timeouts_.answer);
   holdRequested_ = false, resumeRequested_ = false;  // none left over from an earlier job
   try {
     while (acknowledged < lines.size()) {
@@ -289,32 +358,45 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
         continue;
       }
       lastHeard = std::chrono::steady_clock::now();
+      const bool report = line->starts_with("<");
+      const auto status = report ? parseStatusReport(*line) : std::nullopt;
+      const bool understood = *line == "ok" || line->starts_with("error:") || line->starts_with("ALARM:") || status ||
+                              isBanner(*line) || line->empty() || line->starts_with("[");
+      if (!understood) {
+        if (++garbled >= kGarbledRun) {
+          throw DeviceFault(FaultKind::Protocol,
+                            fmt::format("{}: {} lines in a row that are no GRBL reply (the last: \"{}\"): is the "
+                                        "cable sound, and the baud rate right?",
+                                        link_->name(), garbled, shown(*line)));
+        }
+        continue;  // line noise: the next poll brings another report
+      }
+      garbled = 0;
       if (*line == "ok") {
         if (inFlight.empty()) throw DeviceFault(FaultKind::Protocol, link_->name() + ": an `ok` for no line sent");
         idle = false;  // a reply came: nothing is lost
+        stall.progressed();
         inFlightBytes -= inFlight.front();
         state.bytesAcknowledged += inFlight.front();
         inFlight.pop_front();
+        if (const int move = program.lineMove[acknowledged]; move >= 0) {
+          state.secondsLeft = std::max(0.0, timing.seconds - timing.endsAt[move]);
+        }
         ++acknowledged;
         state.stroke =
             static_cast<size_t>(std::upper_bound(program.strokeEnds.begin(), program.strokeEnds.end(), acknowledged) -
                                 program.strokeEnds.begin());
-        state.secondsLeft = toolpath.seconds * (1.0 - static_cast<double>(state.bytesAcknowledged) /
-                                                          static_cast<double>(state.bytesTotal));
+        if (acknowledged == lines.size()) state.secondsLeft = 0;
         if (progress) progress(state);
       } else if (line->starts_with("error:")) {
         throw errorFault(link_->name(), fmt::format("line {} `{}`", acknowledged + 1, lines[acknowledged]), *line);
       } else if (line->starts_with("ALARM:")) {
         throw alarmFault(link_->name(), *line);
-      } else if (line->starts_with("<")) {
-        const auto report = parseStatusReport(*line);
-        if (!report)
-          throw DeviceFault(FaultKind::Protocol,
-                            fmt::format("{}: a malformed status report: {}", link_->name(), *line));
-        if (report->state.starts_with("Alarm")) {
+      } else if (status) {
+        if (status->state.starts_with("Alarm")) {
           throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller went into alarm");
         }
-        if (report->state == "Idle" && !inFlight.empty()) {
+        if (status->state == "Idle" && !inFlight.empty()) {
           if (!idle) idle = true, idleSince = std::chrono::steady_clock::now();
           if (std::chrono::steady_clock::now() - idleSince > timeouts_.answer) {
             throw DeviceFault(
@@ -325,16 +407,18 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
         } else {
           idle = false;
         }
+        // The planner holds at most the lines acknowledged lately; the slowest of them bounds an honest pause.
+        const size_t planned = acknowledged > plannerBlocks_ ? acknowledged - plannerBlocks_ : 0;
+        stall.setBound(stallBound(timing.endsAt, program, planned, next, timeouts_.answer, timeScale_));
+        if (stall.stalled(*status)) throw stallFault(link_->name(), *status, stall.seconds());
       } else if (isBanner(*line)) {
         throw DeviceFault(FaultKind::Protocol, link_->name() + ": the controller reset itself mid-job");
-      } else if (!line->empty() && !line->starts_with("[")) {
-        std::string shown;
-        for (char c : line->substr(0, 40)) shown += (c >= 32 && c < 127) ? c : '?';
-        throw DeviceFault(FaultKind::Protocol, fmt::format("{}: not a GRBL reply: \"{}\"", link_->name(), shown));
       }
     }
     // Every line is in the planner: wait for the motion to end.
-    waitIdle(timeouts_.answer, &cancel);
+    waitIdle(timeouts_.answer, &cancel,
+             stallBound(timing.endsAt, program, lines.size() > plannerBlocks_ ? lines.size() - plannerBlocks_ : 0,
+                        lines.size(), timeouts_.answer, timeScale_));
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }

@@ -6,7 +6,9 @@
 // buffer (gnea/grbl's stream.py method), with realtime `?` status polls; a
 // hold is `!`, a resume `~`. On any error, alarm, timeout, cancel or
 // disconnect: feed hold, soft reset (0x18), and `M5 S0` once the controller
-// answers again, then a DeviceFault.
+// answers again, then a DeviceFault. A garbled line now and then is
+// skipped (a run of them is a fault); a machine that says Run and stands
+// still without taking lines is a stall.
 
 #include <atomic>
 #include <map>
@@ -31,7 +33,8 @@ struct GrblTimeouts {
 class GrblDriver : public Device {
  public:
   // `open` makes the link (serial, TCP, or the simulator's pseudo-terminal).
-  GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts = {});
+  // `timeScale`: machine seconds per real second, for a simulator that runs faster than real.
+  GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts = {}, double timeScale = 1.0);
   std::string connect() override;
   void home() override;
   void frame(const jobs::Toolpath& toolpath) override;
@@ -52,6 +55,7 @@ class GrblDriver : public Device {
   // controller; GRBL's defaults before connect().
   [[nodiscard]] GCodeOptions gcodeOptions() const;
   [[nodiscard]] jobs::MotionLimits motionLimits() const override;
+  [[nodiscard]] double timeScale() const override { return timeScale_; }
   // The G-code, each line ended by a newline.
   [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override;
   [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override;
@@ -59,8 +63,9 @@ class GrblDriver : public Device {
  private:
   void send(const std::string& line);  // a command and its `ok`
   std::string expectLine(Millis timeout, const char* waitingFor);
-  // Polls until the controller is Idle; throws on silence, an alarm or a cancel.
-  void waitIdle(Millis silence, const core::Cancellation* cancel);
+  // Polls until the controller is Idle; throws on silence, an alarm, a cancel,
+  // or a stall (Run at one position for `stallAfter`).
+  void waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter = Millis(30000));
   // Feed hold; once the machine has stopped (Hold:0), soft reset, which
   // turns the laser off without the alarm a reset in motion raises; then
   // M5 S0. Returns whether the controller answered it all. Never throws.
@@ -71,7 +76,9 @@ class GrblDriver : public Device {
   std::unique_ptr<Link> link_;
   std::map<int, double> settings_;
   size_t receiveBuffer_ = 128;
+  size_t plannerBlocks_ = 15;  // [OPT:]'s
   bool characterCounting_ = true;
+  double timeScale_ = 1.0;
   std::atomic<bool> holdRequested_{false}, resumeRequested_{false};
 };
 

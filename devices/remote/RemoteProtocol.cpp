@@ -68,7 +68,7 @@ nlohmann::json toJson(const DeviceFault& fault) {
 
 std::optional<FaultKind> faultKindNamed(std::string_view name) {
   for (FaultKind kind : {FaultKind::Timeout, FaultKind::Disconnected, FaultKind::Alarm, FaultKind::Error,
-                         FaultKind::Refused, FaultKind::Protocol, FaultKind::Cancelled}) {
+                         FaultKind::Refused, FaultKind::Protocol, FaultKind::Cancelled, FaultKind::Stalled}) {
     if (faultName(kind) == name) return kind;
   }
   return std::nullopt;

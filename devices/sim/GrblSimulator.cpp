@@ -16,6 +16,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "jobs/MotionPlan.h"
+
 namespace rotafab::devices::sim {
 namespace {
 
@@ -52,7 +54,10 @@ GrblSimulator::~GrblSimulator() {
 GrblSimulatorRecord GrblSimulator::record() const {
   const std::lock_guard lock(mutex_);
   GrblSimulatorRecord copy = record_;
-  copy.state = alarm_ ? "Alarm" : held_ ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0") : planner_.empty() ? "Idle" : "Run";
+  copy.state = alarm_                          ? "Alarm"
+               : held_                         ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0")
+               : planner_.empty() && !syncing_ ? "Idle"
+                                               : "Run";
   copy.spindleEnabled = laserModal_;
   return copy;
 }
@@ -150,8 +155,8 @@ void GrblSimulator::receive(char byte) {
       break;
   }
   if (static_cast<unsigned char>(byte) >= 0x80) return;  // the extended realtime commands: none simulated
-  if (buffer_.size() >= options_.receiveBuffer - 1) {
-    record_.overflowed = true;  // GRBL's ring buffer drops it
+  if (buffer_.size() >= options_.receiveBuffer) {
+    record_.overflowed = true;  // GRBL's ring buffer (serial.c, RX_BUFFER_SIZE + 1 slots) drops it
     return;
   }
   buffer_ += byte;
@@ -159,7 +164,16 @@ void GrblSimulator::receive(char byte) {
 }
 
 void GrblSimulator::takeLines() {
+  if (stalled_) return;
   for (;;) {
+    // A spindle change waits for the motion before it (spindle_sync():
+    // protocol_buffer_synchronize()); nothing after it is read meanwhile.
+    if (syncing_) {
+      if (!planner_.empty()) return;
+      const std::string line = *std::exchange(syncing_, std::nullopt);
+      executeLine(line);
+      continue;
+    }
     const auto newline = buffer_.find('\n');
     if (newline == std::string::npos) return;
     if (planner_.size() >= options_.plannerBlocks) return;  // the line waits in the buffer
@@ -167,8 +181,37 @@ void GrblSimulator::takeLines() {
     std::string line = buffer_.substr(0, newline);
     buffer_.erase(0, newline + 1);
     if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (!planner_.empty() && needsSync(line)) {
+      syncing_ = line;
+      continue;
+    }
     executeLine(line);
   }
+}
+
+// gcode.c, laser mode: a change of M3/M4/M5 is synced; so is a new S on a
+// line without motion while the spindle is on.
+bool GrblSimulator::needsSync(const std::string& raw) const {
+  std::string line;
+  for (char c : raw) {
+    if (c != ' ') line += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  if (line.empty() || line[0] == '$') return false;
+  bool motion = false;
+  std::optional<double> s;
+  std::optional<int> m;
+  for (size_t at = 0; at < line.size();) {
+    const char letter = line[at++];
+    double value = 0;
+    const auto [end, error] = std::from_chars(line.data() + at, line.data() + line.size(), value);
+    if (error != std::errc()) return false;  // an error: answered at once
+    at = static_cast<size_t>(end - line.data());
+    if (letter == 'X' || letter == 'Y') motion = true;
+    if (letter == 'S') s = value;
+    if (letter == 'M' && (value == 3 || value == 4 || value == 5)) m = static_cast<int>(value);
+  }
+  if (m && *m != spindleMode_) return true;
+  return s && *s != spindle_ && !motion && spindleMode_ != 5;
 }
 
 void GrblSimulator::executeLine(const std::string& raw) {
@@ -179,16 +222,23 @@ void GrblSimulator::executeLine(const std::string& raw) {
   record_.lines.push_back(line);
   if (line.empty()) return reply("ok\r\n");
   if (line[0] == '$') {
+    // system.c: settings, build info, homing and the rest need Idle or
+    // Alarm ($G and $X do not).
+    const bool busy = !planner_.empty() || held_;
+    if (busy && line != "$G" && line != "$X") return reply("error:8\r\n");
     if (line == "$$") {
       reply(fmt::format(
-          "$0=10\r\n$1=25\r\n$10=1\r\n$20=0\r\n$21=0\r\n$22=0\r\n$30={}\r\n$31=0\r\n$32={}\r\n$100=80.000\r\n"
-          "$101=80.000\r\n$110={:.3f}\r\n$111={:.3f}\r\n$120={:.3f}\r\n$121={:.3f}\r\n$130=400.000\r\n$131=400.000\r\n"
-          "ok\r\n",
-          options_.maxSpindle, options_.laserMode ? 1 : 0, options_.maxRate, options_.maxRate, options_.acceleration,
-          options_.acceleration));
+          "$0=10\r\n$1=25\r\n$10=1\r\n$11={:.3f}\r\n$12=0.002\r\n$20=0\r\n$21=0\r\n$22=0\r\n$30={}\r\n$31=0\r\n"
+          "$32={}\r\n$100=80.000\r\n$101=80.000\r\n$110={:.3f}\r\n$111={:.3f}\r\n$120={:.3f}\r\n$121={:.3f}\r\n"
+          "$130=400.000\r\n$131=400.000\r\nok\r\n",
+          options_.junctionDeviation, options_.maxSpindle, options_.laserMode ? 1 : 0, options_.maxRate,
+          options_.maxRate, options_.acceleration, options_.acceleration));
     } else if (line == "$I") {
       reply(fmt::format("[VER:1.1h.20190825:]\r\n[OPT:V,{},{}]\r\nok\r\n", options_.plannerBlocks,
                         options_.receiveBuffer));
+    } else if (line == "$G") {
+      reply(fmt::format("[GC:G{} G54 G17 G21 G90 G94 M{} M9 T0 F{:g} S{:g}]\r\nok\r\n", rapid_ ? 0 : 1, spindleMode_,
+                        feed_, spindle_));
     } else if (line == "$X") {
       alarm_ = false;
       reply("[MSG:Caution: Unlocked]\r\nok\r\n");
@@ -225,9 +275,9 @@ void GrblSimulator::executeLine(const std::string& raw) {
         break;
       case 'M':
         if (value == 3 || value == 4)
-          laserModal_ = true;
+          laserModal_ = true, spindleMode_ = static_cast<int>(value);
         else if (value == 5)
-          laserModal_ = false;
+          laserModal_ = false, spindleMode_ = 5;
         else
           return reply("error:20\r\n");
         break;
@@ -254,34 +304,102 @@ void GrblSimulator::executeLine(const std::string& raw) {
     if (!planner_.empty()) fromX = planner_.back().x, fromY = planner_.back().y;
     // Laser mode lights only G1 (and never at S0); without it the laser stays on through G0 too.
     const bool lit = laserModal_ && spindle_ > 0 && (!rapid_ || !options_.laserMode);
-    planner_.push_back(
-        {x.value_or(fromX), y.value_or(fromY), rapid_ ? options_.maxRate : std::min(feed_, options_.maxRate), lit});
+    Block block{x.value_or(fromX), y.value_or(fromY), lit, 0, 0, 0, 0, 0, 0};
+    block.length = std::hypot(block.x - fromX, block.y - fromY);
+    // planner.c: a move of no steps is dropped (and acknowledged).
+    if (block.length >= 0.5 / 80.0) {
+      block.unitX = (block.x - fromX) / block.length, block.unitY = (block.y - fromY) / block.length;
+      const jobs::Point2 unit(block.unitX, block.unitY);
+      const double rate = jobs::axisLimited(options_.maxRate / 60, unit);
+      block.nominal = rapid_ ? rate : std::min(feed_ / 60, rate);
+      block.acceleration = jobs::axisLimited(options_.acceleration, unit);
+      // From a stop there is no junction; else the corner's and both blocks' speeds bound the entry.
+      if (!planner_.empty()) {
+        const double nominals = std::min(planner_.back().nominal, block.nominal);
+        block.maxEntrySquared = std::min(
+            nominals * nominals, jobs::junctionSpeedSquared(jobs::Point2(lastUnitX_, lastUnitY_), unit,
+                                                            options_.acceleration, options_.junctionDeviation, true));
+      }
+      lastUnitX_ = block.unitX, lastUnitY_ = block.unitY;
+      if (record_.motionStartedAt < 0) record_.motionStartedAt = clock_;
+      planner_.push_back(block);
+      replan();
+    }
   }
   ++record_.linesExecuted;
   reply("ok\r\n");
 }
 
+// The look-ahead (planner.c's recalculation): how fast the first block may
+// leave, so that every block after it can still stop by the end of the last.
+void GrblSimulator::replan() {
+  if (planner_.size() < 2) {
+    exitSpeed_ = 0;
+    return;
+  }
+  std::vector<jobs::PlannedBlock> ahead;
+  for (size_t i = 1; i < planner_.size(); ++i) {
+    ahead.push_back(
+        {planner_[i].length, planner_[i].nominal, planner_[i].acceleration, planner_[i].maxEntrySquared, 0});
+  }
+  const Block& first = planner_.front();
+  const double reachable =
+      std::sqrt(speed_ * speed_ + 2 * first.acceleration * std::max(0.0, first.length - blockDone_));
+  jobs::planEntrySpeeds(ahead, reachable);
+  exitSpeed_ = std::sqrt(ahead.front().entrySquared);
+}
+
 void GrblSimulator::advance(double seconds) {
   record_.laserOn = false;
-  if (held_) holdSettle_ = std::max(0.0, holdSettle_ - seconds);
-  while (seconds > 0 && !held_ && !alarm_ && !planner_.empty()) {
+  clock_ += seconds;
+  if (held_) {
+    holdSettle_ = std::max(0.0, holdSettle_ - seconds);
+    speed_ = 0;  // (the deceleration of a hold is not modelled: it stands at once)
+  }
+  if (stalled_) return;
+  replan();
+  // Small steps of the trapezoid: accelerate toward the block's speed,
+  // brake when the distance left is what braking to the exit speed takes.
+  constexpr double kStep = 0.0005;  // simulated seconds
+  while (seconds > 1e-12 && !held_ && !alarm_ && !planner_.empty()) {
     const Block& block = planner_.front();
     if (blockDone_ == 0) startX_ = record_.x, startY_ = record_.y;
-    const double length = std::hypot(block.x - startX_, block.y - startY_);
-    const double speed = block.feed / 60;  // mm/s
-    const double step = std::min(length - blockDone_, speed * seconds);
+    const double dt = std::min(seconds, kStep);
+    const double left = block.length - blockDone_;
+    const double exit = std::min(exitSpeed_, block.nominal);
+    double next = speed_;
+    if (speed_ * speed_ - exit * exit >= 2 * block.acceleration * left) {
+      next = std::max(exit, speed_ - block.acceleration * dt);
+    } else if (speed_ < block.nominal) {
+      next = std::min(block.nominal, speed_ + block.acceleration * dt);
+    } else {
+      next = block.nominal;
+    }
+    double step = (speed_ + next) / 2 * dt, used = dt;
+    if (step <= 0) step = std::min(left, 1e-9), used = dt;  // (cannot stand still in a block)
+    if (step >= left) {
+      used = dt * left / step;
+      step = left;
+    }
+    speed_ = next;
+    record_.topSpeed = std::max(record_.topSpeed, speed_);
     blockDone_ += step;
-    seconds -= step / speed;
-    if (block.lit) record_.litSeconds += step / speed;
+    seconds -= used;
+    if (block.lit) record_.litSeconds += used;
     record_.laserOn = block.lit;
-    if (blockDone_ >= length - 1e-9) {
+    if (blockDone_ >= block.length - 1e-9) {
       record_.x = block.x, record_.y = block.y;
       planner_.erase(planner_.begin());
       blockDone_ = 0;
+      speed_ = std::min(speed_, exit);
+      if (planner_.empty()) {
+        speed_ = 0;
+        record_.motionEndedAt = clock_ - seconds;
+      }
+      replan();
     } else {
-      const double t = length > 0 ? blockDone_ / length : 1;
+      const double t = block.length > 0 ? blockDone_ / block.length : 1;
       record_.x = startX_ + (block.x - startX_) * t, record_.y = startY_ + (block.y - startY_) * t;
-      break;
     }
   }
   if (planner_.empty() || held_ || alarm_) record_.laserOn = false;
@@ -291,8 +409,11 @@ void GrblSimulator::reset() {
   const bool moving = !planner_.empty() && (!held_ || holdSettle_ > 0);
   buffer_.clear();
   planner_.clear();
-  blockDone_ = 0;
-  held_ = false, laserModal_ = false, spindle_ = 0, feedSet_ = false, rapid_ = true;
+  syncing_.reset();
+  blockDone_ = 0, speed_ = 0, exitSpeed_ = 0;
+  stalled_ = false;
+  wcoCounter_ = 0, overrideCounter_ = 0;
+  held_ = false, laserModal_ = false, spindle_ = 0, feedSet_ = false, rapid_ = true, spindleMode_ = 5;
   record_.laserOn = false;
   if (moving) {
     alarm_ = true;
@@ -302,13 +423,39 @@ void GrblSimulator::reset() {
   if (alarm_) reply("[MSG:'$H'|'$X' to unlock]\r\n");
 }
 
-std::string GrblSimulator::statusReport() const {
-  const char* state = alarm_             ? "Alarm"
-                      : held_            ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0")
-                      : planner_.empty() ? "Idle"
-                                         : "Run";
-  return fmt::format("<{}|MPos:{:.3f},{:.3f},0.000|FS:{:.0f},{:.0f}>", state, record_.x, record_.y,
-                     planner_.empty() ? 0.0 : planner_.front().feed, laserModal_ ? spindle_ : 0.0);
+std::string GrblSimulator::statusReport() {
+  const char* state = alarm_                          ? "Alarm"
+                      : held_                         ? (holdSettle_ > 0 ? "Hold:1" : "Hold:0")
+                      : planner_.empty() && !syncing_ ? "Idle"
+                                                      : "Run";
+  const bool busy = !planner_.empty() || held_;
+  std::string report = fmt::format("<{}|MPos:{:.3f},{:.3f},0.000|FS:{:.0f},{:.0f}", state, record_.x, record_.y,
+                                   speed_ * 60, laserModal_ ? spindle_ : 0.0);
+  // report.c: the pins only while one is active; the work offset every 10
+  // (idle) or 30 (busy) reports, the overrides every 10 or 20, and at once
+  // after the work offset.
+  if (!pins_.empty()) report += "|Pn:" + pins_;
+  if (wcoCounter_ > 0) {
+    --wcoCounter_;
+  } else {
+    wcoCounter_ = (busy ? 30 : 10) - 1;
+    if (overrideCounter_ == 0) overrideCounter_ = 1;
+    report += "|WCO:0.000,0.000,0.000";
+  }
+  if (overrideCounter_ > 0) {
+    --overrideCounter_;
+  } else {
+    overrideCounter_ = (busy ? 20 : 10) - 1;
+    report += "|Ov:100,100,100";
+    if (laserModal_) report += spindleMode_ == 3 ? "|A:S" : "|A:C";
+  }
+  report += ">";
+  if (std::exchange(garbleStatus_, false)) {
+    // Line noise: a few bytes changed on the way.
+    report[report.size() / 2] = '\xb7';
+    report[report.find('|')] = '~';
+  }
+  return report;
 }
 
 void GrblSimulator::unplug() { unplugRequested_ = true; }  // the loop thread closes the terminal
@@ -316,6 +463,21 @@ void GrblSimulator::unplug() { unplugRequested_ = true; }  // the loop thread cl
 void GrblSimulator::mute(bool silent) { muted_ = silent; }
 
 void GrblSimulator::loseNextOk() { loseOk_ = true; }
+
+void GrblSimulator::garbleNextStatus() {
+  const std::lock_guard lock(mutex_);
+  garbleStatus_ = true;
+}
+
+void GrblSimulator::stall() {
+  const std::lock_guard lock(mutex_);
+  stalled_ = true;
+}
+
+void GrblSimulator::setPins(std::string pins) {
+  const std::lock_guard lock(mutex_);
+  pins_ = std::move(pins);
+}
 
 void GrblSimulator::sendGarbage() {
   const std::lock_guard lock(mutex_);
@@ -327,7 +489,9 @@ void GrblSimulator::raiseAlarm(int code) {
   planner_.clear();
   buffer_.clear();
   blockDone_ = 0;
-  alarm_ = true, held_ = false, laserModal_ = false;
+  syncing_.reset();
+  speed_ = 0;
+  alarm_ = true, held_ = false, laserModal_ = false, spindleMode_ = 5;
   record_.laserOn = false;
   reply(fmt::format("ALARM:{}\r\n", code));
 }

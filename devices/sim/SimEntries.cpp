@@ -38,8 +38,8 @@ bool isSim(std::string_view uri, std::string_view name) {
 // A GRBL driver that owns the simulator it talks to.
 class SimulatedGrbl : public grbl::GrblDriver {
  public:
-  explicit SimulatedGrbl(std::unique_ptr<GrblSimulator> simulator)
-      : GrblDriver([path = simulator->path()] { return openSerialLink(path, 115200); }),
+  SimulatedGrbl(std::unique_ptr<GrblSimulator> simulator, double speed)
+      : GrblDriver([path = simulator->path()] { return openSerialLink(path, 115200); }, {}, speed),
         simulator_(std::move(simulator)) {}
 
  private:
@@ -56,7 +56,7 @@ class SimGrblEntry : public DriverEntry {
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup&) const override {
     GrblSimulatorOptions options;
     options.timeScale = dynamic_cast<const SimAddress&>(address).speed;
-    return std::make_unique<SimulatedGrbl>(std::make_unique<GrblSimulator>(options));
+    return std::make_unique<SimulatedGrbl>(std::make_unique<GrblSimulator>(options), options.timeScale);
   }
   // The simulator is asked for its settings ($30, $110), as a real GRBL cannot be for a dry run.
   [[nodiscard]] bool connectsForDryRun(const DeviceAddress&) const override { return true; }
@@ -66,7 +66,8 @@ class SimGrblEntry : public DriverEntry {
 class SimulatedM2Nano : public remote::RemoteDevice {
  public:
   explicit SimulatedM2Nano(double speed)
-      : RemoteDevice({core::helperProgram(kM2NanoHelper), "--speed", fmt::format("{}", speed)}) {}
+      : RemoteDevice({core::helperProgram(kM2NanoHelper), "--speed", fmt::format("{}", speed)}), speed_(speed) {}
+  [[nodiscard]] double timeScale() const override { return speed_; }
   [[nodiscard]] jobs::MotionLimits motionLimits() const override { return m2nano::motionLimits(); }
   [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override {
     return m2nano::egvProgram(toolpaths);
@@ -74,6 +75,9 @@ class SimulatedM2Nano : public remote::RemoteDevice {
   [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override {
     return m2nano::describeEgvProgram(toolpaths);
   }
+
+ private:
+  double speed_;
 };
 
 class SimM2NanoEntry : public DriverEntry {

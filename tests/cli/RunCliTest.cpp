@@ -40,6 +40,17 @@ TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
       << r.err;
   EXPECT_NE(r.err.find("] 100%  stroke 108 of 108"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("1 sheet cut on sim:grbl?speed=200: 108 strokes"), std::string::npos) << r.out;
+  // The estimate and the bar count the simulator's time, 200 times the machine's: seconds, not minutes.
+  std::smatch about;
+  ASSERT_TRUE(std::regex_search(r.err, about, std::regex(R"(about (\d+)s \((\d+)m (\d+)s on the machine simulated\))")))
+      << r.err;
+  const double machine = std::stoi(about[2]) * 60 + std::stoi(about[3]);
+  EXPECT_NEAR(std::stoi(about[1]), machine / 200, 1.0);
+  const std::regex timeLeft(R"(, (\S+) left)");
+  for (std::sregex_iterator left(r.err.begin(), r.err.end(), timeLeft), end; left != end; ++left) {
+    EXPECT_TRUE(std::regex_match((*left)[1].str(), std::regex(R"(\d+s)"))) << (*left)[1];
+    EXPECT_LE(std::stoi((*left)[1]), std::stoi(about[1]));
+  }
 }
 
 TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {

@@ -63,9 +63,9 @@ grbl::GrblTimeouts quick() {
   return t;
 }
 
-std::unique_ptr<grbl::GrblDriver> driverFor(const sim::GrblSimulator& simulator) {
+std::unique_ptr<grbl::GrblDriver> driverFor(const sim::GrblSimulator& simulator, double timeScale = 1) {
   const std::string path = simulator.path();
-  return std::make_unique<grbl::GrblDriver>([path] { return openSerialLink(path, 115200); }, quick());
+  return std::make_unique<grbl::GrblDriver>([path] { return openSerialLink(path, 115200); }, quick(), timeScale);
 }
 
 // A simulated GRBL moving `timeScale` times faster than real, a driver
@@ -77,7 +77,7 @@ struct Rig {
           options.timeScale = timeScale;
           return options;
         }()),
-        driver(driverFor(simulator)) {
+        driver(driverFor(simulator, timeScale)) {
     driver->connect();
     path = toolpath(driver->motionLimits());
   }
@@ -140,6 +140,43 @@ TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
   EXPECT_EQ(seen.back().stroke, path.strokes.size());
 }
 
+// The estimate is the time the job takes on GRBL's planner (accelerations,
+// corners at the junction deviation's speed, the drain before M5) within
+// 15%, and the progress counts down that time.
+TEST(Grbl, TheEstimateIsTheTimeTheSimulatedMachineTakes) {
+  // The test sheet and a circle of 90 short segments, taken without a stop at each.
+  jobs::SheetDrawing curved = sheet();
+  jobs::DrawnPath circle{jobs::Operation::Cut, {}, true};
+  for (int k = 0; k < 90; ++k)
+    circle.points.emplace_back(10 + 2 * std::cos(k * M_PI / 45), 10 + 2 * std::sin(k * M_PI / 45));
+  curved.paths.push_back(circle);
+  for (double scale : {10.0, 40.0}) {
+    SCOPED_TRACE(scale);
+    Rig rig(scale);
+    auto& [simulator, driver, path] = rig;
+    const auto machine =
+        profiles::loadMachineProfile(std::string(ROTAFAB_SOURCE_DIR) + "/profiles/machines/grbl-diode-400.yaml");
+    profiles::MaterialProfile material;
+    material.name = "test";
+    path = jobs::planToolpath(curved, machine, material, driver->motionLimits());
+    std::vector<Progress> seen;
+    core::Cancellation cancel;
+    driver->run(
+        path, [&](const Progress& p) { seen.push_back(p); }, cancel);
+    const auto record = simulator.record();
+    const double ran = record.motionEndedAt - record.motionStartedAt;
+    EXPECT_NEAR(path.seconds, ran, 0.15 * ran) << "estimated " << path.seconds << " s, ran " << ran << " s";
+    // The old estimate, from a stop to a stop at every corner, was far above.
+    jobs::MotionLimits stopping = driver->motionLimits();
+    stopping.junctionDeviation = 0;
+    EXPECT_GT(jobs::estimateSeconds(path, stopping), path.seconds);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_NEAR(seen.front().secondsLeft, path.seconds, 0.1 * path.seconds);
+    for (size_t i = 1; i < seen.size(); ++i) EXPECT_LE(seen[i].secondsLeft, seen[i - 1].secondsLeft + 1e-9);
+    EXPECT_EQ(seen.back().secondsLeft, 0);
+  }
+}
+
 // Each fault: the driver throws its kind, and the controller is left with the laser off.
 void expectFault(FaultKind kind, const std::function<void(sim::GrblSimulator&)>& inject, const std::string& says,
                  bool cancelIt = false) {
@@ -182,9 +219,39 @@ TEST(Grbl, AnAlarmStopsTheJobWithTheLaserOff) {
 
 TEST(Grbl, CancelHoldsResetsAndLeavesTheLaserOff) { expectFault(FaultKind::Cancelled, nullptr, "cancelled", true); }
 
-TEST(Grbl, GarbageIsAProtocolFault) {
+// A link that brings nothing but garbage is broken: a run of lines that are no GRBL reply is a fault.
+TEST(Grbl, ARunOfGarbageIsAProtocolFault) {
   expectFault(
-      FaultKind::Protocol, [](sim::GrblSimulator& s) { s.sendGarbage(); }, "not a GRBL reply");
+      FaultKind::Protocol,
+      [](sim::GrblSimulator& s) {
+        for (int i = 0; i < 3; ++i) s.sendGarbage();
+      },
+      "3 lines in a row that are no GRBL reply");
+}
+
+// Line noise now and then is not a fault: a garbled status report and a
+// garbled line are skipped, and the job ends as it would have.
+TEST(Grbl, AGarbledReportOrLineNowAndThenIsSkipped) {
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
+  simulator.afterLines(12, [](sim::GrblSimulator& s) {
+    s.garbleNextStatus();
+    s.sendGarbage();
+  });
+  core::Cancellation cancel;
+  driver->run(path, nullptr, cancel);
+  const auto record = simulator.record();
+  EXPECT_EQ(record.state, "Idle");
+  EXPECT_FALSE(record.spindleEnabled);
+  EXPECT_EQ(record.linesExecuted, record.lines.size() - 2) << "every line but $$ and $I ran";
+}
+
+// A machine that says Run and stands still, taking no line (a stepper
+// driver's fault, a jammed axis): found within the bound the moves in its
+// planner set, and stopped with the laser off.
+TEST(Grbl, AStallIsFoundAndTheLaserTurnedOff) {
+  expectFault(
+      FaultKind::Stalled, [](sim::GrblSimulator& s) { s.stall(); }, "the machine stopped moving");
 }
 
 TEST(Grbl, AControllerThatStopsAnsweringTimesOut) {
