@@ -10,11 +10,6 @@
 
 namespace rotafab::cli {
 
-std::string minutes(double seconds) {
-  const int s = static_cast<int>(std::lround(seconds));
-  return s >= 60 ? fmt::format("{}m {:02}s", s / 60, s % 60) : fmt::format("{}s", s);
-}
-
 void ProgressBar::operator()(const devices::Progress& p) {
   const int percent = static_cast<int>(100 * p.bytesAcknowledged / std::max<size_t>(p.bytesTotal, 1));
   const auto now = std::chrono::steady_clock::now();

@@ -6,13 +6,13 @@
 #include <string>
 
 #include "core/Cancellation.h"
+#include "core/Duration.h"
 #include "devices/Device.h"
 #include "devices/JobRun.h"
 
 namespace rotafab::cli {
 
-// "4m 37s", "12s".
-std::string minutes(double seconds);
+using core::minutes;
 
 // A bar redrawn in place on a terminal (at most every 200 ms), a line every
 // 10% otherwise.

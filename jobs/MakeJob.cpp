@@ -7,8 +7,10 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <numeric>
 #include <regex>
 
+#include "core/Duration.h"
 #include "core/UserError.h"
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
@@ -22,6 +24,7 @@
 #include "geometry/Simplification.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/OutputFolder.h"
+#include "jobs/Toolpath.h"
 
 namespace rotafab::jobs {
 namespace {
@@ -351,6 +354,38 @@ std::filesystem::path defaultOutputFolder(const MakeRequest& request) {
   return request.mesh.stem().string() + "-" + std::string(geometry::structureName(request.structure));
 }
 
+// The sheets, the fasteners and the cutting time, sheet by sheet, on the
+// profile's machine (the toolpath `rotafab run` would send, and its time).
+JobCost jobCost(const PlannedJob& job, const MakeRequest& request, const core::WorkContext& context) {
+  JobCost cost;
+  cost.material = request.material.name;
+  cost.materialDescription = request.material.description;
+  cost.sheets = job.sheets.sheets.size();
+  cost.sheetWidth = request.machine.bed.width, cost.sheetHeight = request.machine.bed.height;
+  cost.fasteners = job.structure.fasteners;
+  cost.fastenerDiameter = request.fastener.value_or(request.material.fastenerDiameter);
+  cost.motionGiven = request.machine.motion.has_value();
+  const MotionLimits limits = profileMotion(request.machine);
+  // (The toolpath's stroke order takes the bunny's 30 sheets 7 s: shared out among the threads.)
+  std::vector<double> seconds(job.sheets.sheets.size(), 0.0);
+  std::vector<std::string> refused(seconds.size());
+  context.parallelFor(seconds.size(), [&](size_t s) {
+    try {
+      seconds[s] = planToolpath(job.sheets.sheets[s], request.machine, request.material, limits).seconds;
+    } catch (const std::invalid_argument& error) {
+      refused[s] = error.what();
+    }
+  });
+  context.check();
+  if (const auto why = std::find_if(refused.begin(), refused.end(), [](const auto& r) { return !r.empty(); });
+      why != refused.end()) {
+    context.warn(fmt::format("{}: no cutting time: {}", request.mesh.string(), *why));
+  } else {
+    cost.cuttingSeconds = std::move(seconds);
+  }
+  return cost;
+}
+
 PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context) {
   Lap lap;
   const std::string name = request.mesh.string();
@@ -392,9 +427,10 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
                           sizing.grown, request.names(Parameter::Fastener), request.names(Parameter::Panels))
             : ""));
   }
-  job.seconds.nesting = lap();
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;
+  job.seconds.nesting = lap();
+  job.cost = jobCost(job, request, context);
   return job;
 }
 
@@ -414,11 +450,13 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
   job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
   job.manifest["stability"] = stabilityJson(job.stability);
+  job.manifest["cost"] = costJson(job.cost);
   writeFileAtomically(output.staging() / "manifest.json", job.manifest.dump(1) + "\n");
   writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
   context.check();
   // manifest.json last: until it moves in, the folder's manifest is the old job's.
-  static const std::regex ours(R"((sheet-\d{3,}\.(eps|svg|dxf))|manifest\.json|manifest\.txt|structure\.obj)");
+  static const std::regex ours(
+      R"((sheet-\d{3,}\.(eps|svg|dxf|preview\.svg))|manifest\.json|manifest\.txt|structure\.obj)");
   output.commit("manifest.json", [](const std::string& name) { return std::regex_match(name, ours); });
   job.folder = output.target();
   job.seconds.writing = lap();
@@ -435,6 +473,7 @@ nlohmann::ordered_json summaryJson(const PlannedJob& job) {
   if (job.mesh.simplified) summary["simplified"] = simplifiedJson(*job.mesh.simplified);
   summary["size"] = {job.size.x(), job.size.y(), job.size.z()};
   summary["stability"] = stabilityJson(job.stability);
+  summary["cost"] = costJson(job.cost);
   return summary;
 }
 

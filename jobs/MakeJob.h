@@ -16,6 +16,7 @@
 #include "geometry/Parameters.h"
 #include "geometry/Stability.h"
 #include "geometry/Structure.h"
+#include "jobs/JobCost.h"
 #include "jobs/Manifest.h"
 #include "jobs/Nesting.h"
 #include "jobs/Part.h"
@@ -73,6 +74,7 @@ struct PlannedJob {
   geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
   std::vector<Part> parts;                           // structureParts()
   SheetPlan sheets;
+  JobCost cost;
   // Once written (writeJob()):
   std::filesystem::path folder;
   std::vector<std::vector<std::string>> files;  // per sheet

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/UserError.h"
+#include "jobs/JobCost.h"
 #include "jobs/JsonErrors.h"
 #include "jobs/SvgWriter.h"
 
@@ -147,7 +148,8 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
       }
     }
     nlohmann::ordered_json sheet = {{"index", s + 1}, {"files", files.at(s)}, {"panels", panels}};
-    if (!pieces.empty()) sheet["pieces"] = pieces;  // extension: the pieces of split panels it holds
+    sheet["preview"] = previewFile(static_cast<int>(s) + 1);  // extension: the sheet for people to look at
+    if (!pieces.empty()) sheet["pieces"] = pieces;            // extension: the pieces of split panels it holds
     manifest["sheets"].push_back(sheet);
   }
   manifest["panels"] = nlohmann::ordered_json::array();
@@ -340,6 +342,8 @@ std::string headline(const nlohmann::json& manifest) {
 // structure will stand or must be hung. One sentence each.
 std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
   std::vector<std::string> notes;
+  if (manifest.contains("cost"))
+    notes.push_back(fmt::format("It takes {}.", costLine(costFromJson(manifest.at("cost")))));
   if (manifest.contains("repairs")) {
     for (const auto& repair : manifest.at("repairs")) {
       const geometry::MeshRepair made{repair.at("kind").get<std::string>(), repair.at("count").get<int>(),
@@ -417,8 +421,8 @@ table {{ border-collapse: collapse; }}
 td, th {{ border: 1px solid #999; padding: 0.2em 0.6em; text-align: left; vertical-align: top; }}
 section.sheet {{ break-before: page; }}
 section.sheet svg {{ width: 100%; height: auto; border: 1px solid #ccc; }}
-section.sheet svg path {{ vector-effect: non-scaling-stroke; stroke-width: 1px; }}
-section.sheet svg #etch path {{ stroke: #a0522d; }}
+section.sheet .cutfile svg path {{ vector-effect: non-scaling-stroke; stroke-width: 1px; }}
+section.sheet .cutfile svg #etch path {{ stroke: #a0522d; }}
 @media print {{ body {{ margin: 0; }} }}
 </style>
 </head>
@@ -440,11 +444,14 @@ the same number on the panel named; fasten them through their holes.</p>
     }
     html += fmt::format("</table>\n<p>{} fastener{} in all.</p>\n", total, total == 1 ? "" : "s");
     for (const auto& sheet : manifest.at("sheets")) {
+      // The preview, made for people; else (a manifest from before previews) the cut file, restyled.
       std::string svgFile;
       for (const auto& file : sheet.at("files")) {
         const auto name = file.get<std::string>();
         if (name.ends_with(".svg")) svgFile = name;
       }
+      const bool preview = sheet.contains("preview");
+      if (preview) svgFile = sheet.at("preview").get<std::string>();
       std::string panels;
       for (const auto& id : sheet.at("panels")) panels += (panels.empty() ? "" : ", ") + std::to_string(id.get<int>());
       html += fmt::format("<section class=\"sheet\">\n<h2>Sheet {}</h2>\n<p>Panels, in cutting order: {}</p>\n",
@@ -454,7 +461,7 @@ the same number on the panel named; fasten them through their holes.</p>
         if (!in) throw std::invalid_argument(fmt::format("{}: cannot read it", (folder / svgFile).string()));
         std::string svg{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
         if (svg.starts_with("<?xml")) svg.erase(0, svg.find('\n') + 1);  // no declaration inside HTML
-        html += svg;
+        html += fmt::format("<div class=\"{}\">\n{}</div>\n", preview ? "preview" : "cutfile", svg);
       }
       html += "</section>\n";
     }

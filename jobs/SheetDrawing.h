@@ -27,6 +27,7 @@ struct DrawnPath {
   Operation operation = Operation::Cut;
   std::vector<Point2> points;  // at least 2
   bool closed = false;         // the last point joins the first (not repeated)
+  std::string part = {};       // the part it belongs to, as an id ("panel-17"); empty: the bed's
 };
 
 struct SheetDrawing {

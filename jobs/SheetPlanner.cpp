@@ -1,5 +1,7 @@
 #include "jobs/SheetPlanner.h"
 
+#include <cctype>
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -84,7 +86,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
     auto add = [&](Operation operation, const std::vector<Polyline2>& strokes, const PlannedPart& placed, bool closed) {
       for (const Polyline2& stroke : strokes) {
         if (stroke.size() < 2) continue;
-        DrawnPath path{operation, {}, closed};
+        DrawnPath path{operation, {}, closed, partId(parts[placed.part].name)};
         for (const Point2& p : stroke) path.points.push_back(onSheet(placed, p));
         sheet.paths.push_back(std::move(path));
       }
@@ -104,6 +106,14 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   return plan;
 }
 
+std::string partId(const std::string& name) {
+  std::string id;
+  for (char c : name) id += std::isalnum(static_cast<unsigned char>(c)) ? c : '-';
+  return id;
+}
+
+std::string previewFile(int sheet) { return fmt::format("sheet-{:03}.preview.svg", sheet); }
+
 std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
                                                   const core::WorkContext& context) {
   std::filesystem::create_directories(folder);
@@ -118,6 +128,8 @@ std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const s
     writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
     context.check();
     writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
+    context.check();
+    writeFileAtomically(folder / previewFile(sheet.index), [&](std::ostream& out) { writeSvgPreview(sheet, out); });
     files[s] = {stem + ".eps", stem + ".svg", stem + ".dxf"};
   });
   return files;

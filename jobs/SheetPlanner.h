@@ -57,9 +57,16 @@ double roomOnTheBed(const std::vector<Part>& parts, const profiles::MachineProfi
 // The point of a part's frame on its sheet.
 Point2 onSheet(const PlannedPart& placement, const Point2& local);
 
+// A part's name as an SVG id: "panel 17" -> "panel-17".
+std::string partId(const std::string& name);
+
+// The preview of a sheet for people: "sheet-001.preview.svg".
+std::string previewFile(int sheet);
+
 // Writes sheet-001.eps, .svg and .dxf, ... into `folder` (each atomically),
-// the sheets shared out on the context's executor; returns the file names of
-// each sheet, in order. Throws core::Cancelled.
+// and each sheet's preview (previewFile()), the sheets shared out on the
+// context's executor; returns the file names of each sheet's cut files
+// (not the preview), in order. Throws core::Cancelled.
 std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
                                                   const core::WorkContext& context);
 

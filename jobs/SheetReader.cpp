@@ -41,6 +41,7 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
   bool sized = false, described = false;
   Operation group = Operation::Outline;
   bool inGroup = false;
+  int depth = 0;  // groups open inside the operation's (a part's)
   std::string line;
   int lineNumber = 0;
   while (std::getline(in, line)) {
@@ -88,12 +89,17 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
       if (!named) {
         throw fail(lineNumber, fmt::format("group \"{}\" is not an operation (cut, score, etch, outline)", m[1].str()));
       }
-      group = *named, inGroup = true;
+      group = *named, inGroup = true, depth = 0;
       sheet.colours[group] = {static_cast<uint8_t>(std::stoi(m[2], nullptr, 16)),
                               static_cast<uint8_t>(std::stoi(m[3], nullptr, 16)),
                               static_cast<uint8_t>(std::stoi(m[4], nullptr, 16))};
+    } else if (inGroup && line.starts_with("<g ")) {
+      ++depth;
     } else if (line == "</g>") {
-      inGroup = false;
+      if (depth > 0)
+        --depth;
+      else
+        inGroup = false;
     }
   }
   if (!sized) throw fail(lineNumber, "not a sheet of rotafab's: no <svg> element with a viewBox \"0 0 W H\"");

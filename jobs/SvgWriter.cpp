@@ -55,6 +55,40 @@ std::string xmlText(std::string_view text) {
   return out;
 }
 
+namespace {
+
+// The parts of an operation's paths in the order of their first path, each
+// with its paths in drawing order.
+std::vector<std::pair<std::string, std::vector<const DrawnPath*>>> partsOf(const SheetDrawing& sheet,
+                                                                           Operation operation) {
+  std::vector<std::pair<std::string, std::vector<const DrawnPath*>>> parts;
+  for (const DrawnPath& path : sheet.paths) {
+    if (path.operation != operation) continue;
+    auto it = std::find_if(parts.begin(), parts.end(), [&](const auto& p) { return p.first == path.part; });
+    if (it == parts.end()) it = parts.insert(parts.end(), {path.part, {}});
+    it->second.push_back(&path);
+  }
+  return parts;
+}
+
+std::vector<Operation> operationsOf(const SheetDrawing& sheet) {
+  std::vector<Operation> order;  // operations by their first path
+  for (const DrawnPath& path : sheet.paths)
+    if (std::find(order.begin(), order.end(), path.operation) == order.end()) order.push_back(path.operation);
+  return order;
+}
+
+void appendPath(fmt::memory_buffer& buffer, const SheetDrawing& sheet, const DrawnPath& path, std::string_view extra) {
+  const auto to = std::back_inserter(buffer);
+  fmt::format_to(to, "<path d=\"");
+  for (size_t i = 0; i < path.points.size(); ++i)
+    fmt::format_to(to, "{}{} {}", i == 0 ? "M" : " L", formatDecimal(path.points[i].x(), kDecimals),
+                   formatDecimal(sheet.height - path.points[i].y(), kDecimals));
+  fmt::format_to(to, "{}\"{}/>\n", path.closed ? " Z" : "", extra);
+}
+
+}  // namespace
+
 void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   checkDrawable(sheet);
   fmt::memory_buffer buffer;
@@ -63,32 +97,75 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   const std::string width = formatDecimal(sheet.width, kDecimals), height = formatDecimal(sheet.height, kDecimals);
   fmt::format_to(to, "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n");
   fmt::format_to(to,
-                 "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0}in\" height=\"{1}in\" "
-                 "viewBox=\"0 0 {0} {1}\">\n",
+                 "<svg xmlns=\"http://www.w3.org/2000/svg\" "
+                 "xmlns:inkscape=\"http://www.inkscape.org/namespaces/inkscape\" "
+                 "xmlns:sodipodi=\"http://sodipodi.sourceforge.net/DTD/sodipodi-0.dtd\" version=\"1.1\" "
+                 "width=\"{0}in\" height=\"{1}in\" viewBox=\"0 0 {0} {1}\">\n",
                  width, height);
   fmt::format_to(to, "<title>{}</title>\n",
                  xmlText(sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title));
   fmt::format_to(to, "<desc>rotafab sheet {} of {}; units: inches; bed {} x {} in, margin {} in</desc>\n", sheet.index,
                  sheet.sheetCount, width, height, formatDecimal(sheet.margin, kDecimals));
 
-  std::vector<Operation> order;  // operations by their first path
-  for (const DrawnPath& path : sheet.paths)
-    if (std::find(order.begin(), order.end(), path.operation) == order.end()) order.push_back(path.operation);
-
-  for (Operation operation : order) {
+  for (Operation operation : operationsOf(sheet)) {
     const Rgb& rgb = sheet.colours.at(operation);
+    const bool bed = operation == Operation::Outline;
+    const std::string name(profiles::operationName(operation));
     fmt::format_to(to,
                    "<g id=\"{}\" fill=\"none\" stroke=\"#{:02x}{:02x}{:02x}\" stroke-width=\"{}\" "
-                   "stroke-linecap=\"round\" stroke-linejoin=\"round\">\n",
-                   profiles::operationName(operation), int{rgb.r}, int{rgb.g}, int{rgb.b},
-                   formatDecimal(kHairlineInches, kDecimals));
-    for (const DrawnPath& path : sheet.paths) {
-      if (path.operation != operation) continue;
-      fmt::format_to(to, "<path d=\"");
-      for (size_t i = 0; i < path.points.size(); ++i)
-        fmt::format_to(to, "{}{} {}", i == 0 ? "M" : " L", formatDecimal(path.points[i].x(), kDecimals),
-                       formatDecimal(sheet.height - path.points[i].y(), kDecimals));
-      fmt::format_to(to, "{}\"/>\n", path.closed ? " Z" : "");
+                   "stroke-linecap=\"round\" stroke-linejoin=\"round\" inkscape:groupmode=\"layer\" "
+                   "inkscape:label=\"{}\"{}>\n",
+                   name, int{rgb.r}, int{rgb.g}, int{rgb.b}, formatDecimal(kHairlineInches, kDecimals),
+                   bed ? "bed (not cut)" : name, bed ? " sodipodi:insensitive=\"true\"" : "");
+    for (const auto& [part, paths] : partsOf(sheet, operation)) {
+      if (!part.empty()) {
+        fmt::format_to(to, "<g id=\"{}{}\">\n", xmlText(part), operation == Operation::Cut ? "" : "-" + name);
+      }
+      for (const DrawnPath* path : paths) appendPath(buffer, sheet, *path, "");
+      if (!part.empty()) fmt::format_to(to, "</g>\n");
+    }
+    fmt::format_to(to, "</g>\n");
+  }
+  fmt::format_to(to, "</svg>\n");
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+}
+
+void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out) {
+  checkDrawable(sheet);
+  fmt::memory_buffer buffer;
+  const auto to = std::back_inserter(buffer);
+  // Room above the bed for the title.
+  constexpr double kTitle = 0.8;
+  const std::string width = formatDecimal(sheet.width, kDecimals);
+  fmt::format_to(to, "<?xml version=\"1.0\" encoding=\"UTF-8\" standalone=\"no\"?>\n");
+  fmt::format_to(to,
+                 "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0}in\" height=\"{1}in\" "
+                 "viewBox=\"0 {2} {0} {1}\">\n",
+                 width, formatDecimal(sheet.height + kTitle, kDecimals), formatDecimal(-kTitle, kDecimals));
+  const std::string title = sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title;
+  fmt::format_to(to, "<title>{} (preview, not for cutting)</title>\n", xmlText(title));
+  fmt::format_to(to,
+                 "<text x=\"0\" y=\"-0.25\" font-family=\"sans-serif\" font-size=\"0.45\" fill=\"#222\">{}</text>\n",
+                 xmlText(title));
+  fmt::format_to(to,
+                 "<rect class=\"material\" x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" fill=\"#f3ead8\" "
+                 "stroke=\"#999\" stroke-width=\"0.02\"/>\n",
+                 width, formatDecimal(sheet.height, kDecimals));
+  struct Look {
+    Operation operation;
+    const char* style;
+  };
+  // Etch and score under the cuts, as they are burnt.
+  for (const Look& look :
+       {Look{Operation::Etch, "stroke=\"#3b2a1a\" stroke-width=\"0.012\""},
+        Look{Operation::Score, "stroke=\"#b03a2e\" stroke-width=\"0.015\" stroke-dasharray=\"0.1 0.06\""},
+        Look{Operation::Cut, "stroke=\"#1f3a93\" stroke-width=\"0.02\""}}) {
+    fmt::format_to(to, "<g class=\"{}\" fill=\"none\" {} stroke-linecap=\"round\" stroke-linejoin=\"round\">\n",
+                   profiles::operationName(look.operation), look.style);
+    for (const auto& [part, paths] : partsOf(sheet, look.operation)) {
+      fmt::format_to(to, "<g class=\"{}\">\n", xmlText(part));
+      for (const DrawnPath* path : paths) appendPath(buffer, sheet, *path, "");
+      fmt::format_to(to, "</g>\n");
     }
     fmt::format_to(to, "</g>\n");
   }

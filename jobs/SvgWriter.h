@@ -8,12 +8,17 @@
 // origin, is the viewBox's bottom-left corner. The geometry is exactly that of
 // the EPS and DXF of the same sheet.
 //
-// One group per operation that has paths, <g id="cut" stroke="#0000ff"
-// fill="none" stroke-width="0.001">, holding that operation's paths as
-// <path d="M ... L ... [Z]"> (Z when the path is closed); the stroke is the
-// profile's exact colour (LightBurn assigns layers by it) and a 0.001 in
-// hairline. Groups come in the order of their operation's first path, and each
-// keeps the drawing's (cutting) order. Coordinates have 9 decimals (1e-9 in).
+// One group per operation that has paths, <g id="cut" fill="none"
+// stroke="#0000ff" stroke-width="0.001" ...>, an Inkscape layer named for
+// the operation; the bed's outline (never cut) is a layer of its own,
+// "bed (not cut)", locked, out of the cut layers' way. In each, a group per
+// part: <g id="panel-17"> in the cut layer, "panel-17-score" and
+// "panel-17-etch" in the others, so that a panel can be picked whole. The
+// paths are <path d="M ... L ... [Z]"> (Z when the path is closed); the
+// stroke is the profile's exact colour (LightBurn assigns layers by it) and a
+// 0.001 in hairline. Layers come in the order of their operation's first
+// path; within one, parts in the order of their first path, and each part's
+// paths in the drawing's (cutting) order. Coordinates have 9 decimals (1e-9 in).
 //
 // The same inputs as the EPS writer are refused, with std::invalid_argument.
 
@@ -26,6 +31,12 @@
 namespace rotafab::jobs {
 
 void writeSvg(const SheetDrawing& sheet, std::ostream& out);
+
+// The same sheet for people to look at (a cutter would burn its wide lines):
+// the material light, cuts 0.02 in wide in dark blue, scores dashed in red,
+// labels dark brown; the title above. Classes, not ids, so that many can
+// share one HTML page.
+void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out);
 
 // Character data for XML 1.0 (and HTML): markup characters escaped, control
 // characters (not allowed in XML 1.0) and bytes that are not valid UTF-8

@@ -200,6 +200,19 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
   return toolpath;
 }
 
+MotionLimits profileMotion(const profiles::MachineProfile& profile) {
+  MotionLimits limits;
+  const bool grbl = profile.driver == "grbl";
+  limits.perAxis = grbl;
+  limits.junctionDeviation = grbl ? 0.01 / 25.4 : 0;  // GRBL's default $11
+  if (profile.motion) {
+    limits.maxSpeed = profile.motion->maxSpeed;
+    limits.acceleration = profile.motion->acceleration;
+    limits.junctionDeviation = profile.motion->junctionDeviation;
+  }
+  return limits;
+}
+
 std::vector<Move> toolpathMoves(const Toolpath& toolpath) {
   std::vector<Move> moves;
   for (const ToolpathStroke& stroke : toolpath.strokes) {

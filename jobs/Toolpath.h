@@ -53,6 +53,10 @@ struct Toolpath {
   double seconds = 0;       // estimated: see estimateSeconds()
 };
 
+// How the machine of `profile` moves, by its `motion` (GRBL's defaults when it
+// gives none): on GRBL each axis at its own limits, with look-ahead.
+MotionLimits profileMotion(const profiles::MachineProfile& profile);
+
 // Throws std::invalid_argument when an operation drawn has no usable setting.
 Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
                       const profiles::MaterialProfile& material, const MotionLimits& limits);

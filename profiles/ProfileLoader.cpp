@@ -110,6 +110,27 @@ class ProfileReader {
     return *value;
   }
 
+  // A speed (`order` 1: 100mm/s, 6000mm/min, 4in/s) or an acceleration
+  // (`order` 2: 500mm/s2, 500mm/s^2), in inches and seconds; positive.
+  double rate(const YAML::Node& node, const std::string& key, int order) const {
+    const std::string text = node.IsScalar() ? node.Scalar() : "";
+    const char* example = order == 1 ? "100mm/s, 6000mm/min or 4in/s" : "500mm/s2 or 20in/s2";
+    const size_t slash = text.find('/');
+    const std::string length = text.substr(0, slash), per = slash == std::string::npos ? "" : text.substr(slash + 1);
+    // The unit written, not a bare number: "100/s" is too easily meant in mm.
+    const bool unitWritten = length.ends_with("in") || length.ends_with("mm") || length.ends_with("cm");
+    const double inches = unitWritten ? parseLength(length).value_or(0.0) : 0.0;
+    double seconds = 0;
+    if (order == 1) seconds = per == "s" ? 1 : per == "min" ? 60 : 0;
+    if (order == 2) seconds = per == "s2" || per == "s^2" ? 1 : 0;
+    if (!(inches > 0) || seconds == 0) {
+      fail(node, key,
+           fmt::format("expected {} such as {}, found '{}'", order == 1 ? "a speed" : "an acceleration", example,
+                       node.IsScalar() ? text : "a list or map"));
+    }
+    return inches / (order == 1 ? seconds : seconds * seconds);
+  }
+
   Rgb rgb(const YAML::Node& node, const std::string& key) const {
     if (node.IsScalar() && node.Scalar().size() == 7 && node.Scalar()[0] == '#') {
       char* end = nullptr;
@@ -170,7 +191,8 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   const ProfileReader reader(file);
   const YAML::Node root = reader.load();
   requireKind(reader, root, "machine");
-  reader.keys(root, "", {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations"},
+  reader.keys(root, "",
+              {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations", "motion"},
               {"name", "bed", "driver", "connection", "colours"});
   MachineProfile machine;
   machine.source = file;
@@ -187,6 +209,17 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
     reader.fail(bed, "bed",
                 fmt::format("margins of {}in on every side leave no usable area on a {} x {} in bed",
                             machine.bed.margin, machine.bed.width, machine.bed.height));
+  }
+
+  if (const YAML::Node motion = root["motion"]) {
+    reader.keys(motion, "motion", {"speed", "acceleration", "junction_deviation"}, {"speed", "acceleration"});
+    MachineMotion m;
+    m.maxSpeed = reader.rate(motion["speed"], "motion.speed", 1);
+    m.acceleration = reader.rate(motion["acceleration"], "motion.acceleration", 2);
+    if (motion["junction_deviation"]) {
+      m.junctionDeviation = reader.length(motion["junction_deviation"], "motion.junction_deviation", 0.0, true);
+    }
+    machine.motion = m;
   }
 
   machine.driver = reader.text(root["driver"], "driver");

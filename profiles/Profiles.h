@@ -36,6 +36,15 @@ struct ColourSetting {
   bool zAxis = false;
 };
 
+// How the machine moves (YAML `motion`), for the cutting time `make`
+// estimates; a driver that reads its controller's settings (GRBL's $110,
+// $120, $11) uses those instead when it runs the job.
+struct MachineMotion {
+  double maxSpeed = 0;           // in/s, each axis's
+  double acceleration = 0;       // in/s^2
+  double junctionDeviation = 0;  // inches; 0: it stops at every corner (no look-ahead)
+};
+
 struct MachineProfile {
   std::string name;
   std::string description;
@@ -44,6 +53,7 @@ struct MachineProfile {
   std::string connection;  // the default device URI (SPEC, "Devices")
   std::vector<ColourSetting> colours;
   std::map<Operation, std::string> operationColour;  // every operation has one
+  std::optional<MachineMotion> motion;
   std::filesystem::path source;
 
   // The colour table row that `operation` is drawn in.

@@ -49,6 +49,15 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
     }
   }
   for (const char* name : {"manifest.txt", "structure.obj"}) EXPECT_TRUE(std::filesystem::is_regular_file(out / name));
+  // Each sheet's preview, for people (not a cut file: not in "files").
+  for (const auto& sheet : manifest.at("sheets")) {
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / sheet.at("preview").get<std::string>())) << sheet;
+    for (const auto& file : sheet.at("files")) EXPECT_EQ(file.get<std::string>().find("preview"), std::string::npos);
+  }
+  // The cut SVG groups each panel's paths: a panel of this sheet is a group of its own.
+  const std::string firstSvg = readFile(out / "sheet-001.svg");
+  const int firstPanel = manifest.at("sheets")[0].at("panels")[0].get<int>();
+  EXPECT_NE(firstSvg.find("<g id=\"panel-" + std::to_string(firstPanel) + "\">"), std::string::npos);
   // Ghostscript reads every sheet, and its bounding box is the bed, in points.
   for (int s = 1; s <= sheets; ++s) {
     char name[32];
@@ -61,6 +70,21 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
     EXPECT_LE(std::stoi(box[3]), 32 * 72 + 1);
     EXPECT_LE(std::stoi(box[4]), 18 * 72 + 1);
   }
+  // What it takes: the sheets of the material, the fasteners of the diameter, the cutting time sheet by sheet.
+  const auto& cost = manifest.at("cost");
+  EXPECT_EQ(cost.at("material"), "posterboard");
+  EXPECT_EQ(cost.at("sheets"), sheets);
+  EXPECT_EQ(cost.at("sheet_size"), nlohmann::json::parse("[32.0, 18.0]"));
+  EXPECT_EQ(cost.at("fasteners").at("count"), manifest.at("fasteners"));
+  EXPECT_EQ(cost.at("fasteners").at("diameter"), 0.125);
+  ASSERT_EQ(cost.at("sheet_cutting_seconds").size(), static_cast<size_t>(sheets));
+  double total = 0;
+  for (const auto& seconds : cost.at("sheet_cutting_seconds")) {
+    EXPECT_GT(seconds.get<double>(), 0);
+    total += seconds.get<double>();
+  }
+  EXPECT_NEAR(cost.at("cutting_seconds").get<double>(), total, 1e-6);
+  EXPECT_NE(readFile(out / "manifest.txt").find("It takes " + std::to_string(sheets) + " sheet"), std::string::npos);
   // structure.obj: the 3D panels, a vertex band and the bands' triangles each.
   std::istringstream obj(readFile(out / "structure.obj"));
   int faces = 0;
@@ -341,6 +365,7 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
   EXPECT_EQ(sections, manifest.at("sheets").size());
   EXPECT_EQ(svgs, manifest.at("sheets").size());
   EXPECT_EQ(html.out.find("<?xml"), std::string::npos);
+  EXPECT_NE(html.out.find("<div class=\"preview\">"), std::string::npos) << "the previews, made for people";
   EXPECT_NE(html.out.find("<tr><td>2</td><td>2</td>"), std::string::npos);
   EXPECT_NE(html.out.find("<p>It stands: its centre of mass is "), std::string::npos) << "before the steps, as in text";
   EXPECT_TRUE(html.out.ends_with("</html>\n"));

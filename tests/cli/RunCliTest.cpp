@@ -46,6 +46,9 @@ TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
       << r.err;
   const double machine = std::stoi(about[2]) * 60 + std::stoi(about[3]);
   EXPECT_NEAR(std::stoi(about[1]), machine / 200, 1.0);
+  // make's cutting time for the profile's machine is the time the run estimates on the controller.
+  const auto manifest = nlohmann::json::parse(readFile(cubeJob() / "manifest.json"));
+  EXPECT_NEAR(manifest.at("cost").at("sheet_cutting_seconds").at(0).get<double>(), machine, 1.0);
   const std::regex timeLeft(R"(, (\S+) left)");
   for (std::sregex_iterator left(r.err.begin(), r.err.end(), timeLeft), end; left != end; ++left) {
     EXPECT_TRUE(std::regex_match((*left)[1].str(), std::regex(R"(\d+s)"))) << (*left)[1];

@@ -5,6 +5,8 @@
 
 #include "jobs/SvgWriter.h"
 
+#include "jobs/SheetReader.h"
+
 #include <gtest/gtest.h>
 
 #include "SheetFixture.h"
@@ -234,6 +236,82 @@ TEST(SvgWriter, InkscapeReadsTheSameSheet) {
                shellQuote(png) + " " + shellQuote(file));
   ASSERT_EQ(result.status, 0) << result.err;
   EXPECT_EQ(pngSize(png), std::make_pair(1152, 648));
+}
+
+// Each part's paths are one group, so that a panel can be picked whole in
+// Inkscape; the bed's outline is a locked layer of its own; and `run` reads
+// the sheet back with every path.
+TEST(SvgWriter, EachPartIsAGroupAndTheBedALayerOfItsOwn) {
+  TempDir dir;
+  SheetDrawing sheet = sampleSheet();
+  for (DrawnPath& path : sheet.paths) {
+    if (path.operation == Operation::Outline) continue;
+    path.part = path.operation == Operation::Cut && path.points.size() == 5 ? "panel-17" : "panel-4";
+  }
+  const std::string svg = svgOf(sheet);
+  EXPECT_NE(svg.find("<g id=\"panel-17\">"), std::string::npos);
+  EXPECT_NE(svg.find("<g id=\"panel-4-score\">"), std::string::npos);
+  EXPECT_NE(svg.find("<g id=\"panel-4-etch\">"), std::string::npos);
+  std::smatch bed;
+  ASSERT_TRUE(std::regex_search(svg, bed, std::regex(R"(<g id="outline"[^>]*>)")));
+  const auto attributes = attributesOf(bed[0]);
+  EXPECT_EQ(attributes.at("inkscape:groupmode"), "layer");
+  EXPECT_EQ(attributes.at("inkscape:label"), "bed (not cut)");
+  EXPECT_EQ(attributes.at("sodipodi:insensitive"), "true");
+  const auto file = dir.write("sheet.svg", svg);
+  EXPECT_EQ(run("xmllint --noout " + shellQuote(file)).status, 0);
+
+  // Inkscape finds the panel's group, with the box of its cut.
+  const CommandResult result = run("HOME=" + shellQuote(dir.path()) + " inkscape --query-all " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err;
+  std::smatch box;
+  ASSERT_TRUE(std::regex_search(result.out, box, std::regex(R"(panel-17,([-0-9.]+),([-0-9.]+),([-0-9.]+),([-0-9.]+))")))
+      << result.out;
+  Box pentagon{1e9, 1e9, -1e9, -1e9};
+  for (const Point2& p : sheet.paths[0].points) {
+    pentagon.x0 = std::min(pentagon.x0, p.x()), pentagon.x1 = std::max(pentagon.x1, p.x());
+  }
+  EXPECT_NEAR(std::stod(box[1]) / 96, pentagon.x0, 0.002);
+  EXPECT_NEAR((std::stod(box[1]) + std::stod(box[3])) / 96, pentagon.x1, 0.002);
+
+  // Read back for `run`: the same paths, each of its operation (the file keeps them part by part).
+  const SheetDrawing read = readSheetSvg(file);
+  ASSERT_EQ(read.paths.size(), sheet.paths.size());
+  for (const DrawnPath& written : sheet.paths) {
+    const bool found = std::any_of(read.paths.begin(), read.paths.end(), [&](const DrawnPath& p) {
+      if (p.operation != written.operation || p.points.size() != written.points.size()) return false;
+      for (size_t k = 0; k < p.points.size(); ++k)
+        if ((p.points[k] - written.points[k]).norm() > 1e-9) return false;
+      return true;
+    });
+    EXPECT_TRUE(found);
+  }
+}
+
+// The preview is for people: wide strokes in dark colours on the material's
+// colour, which librsvg draws at the bed's size (plus the title).
+TEST(SvgWriter, ThePreviewShowsTheSheetToPeople) {
+  TempDir dir;
+  const SheetDrawing sheet = sampleSheet();
+  std::ostringstream out;
+  writeSvgPreview(sheet, out);
+  const auto file = dir.write("sheet.preview.svg", out.str());
+  EXPECT_EQ(run("xmllint --noout " + shellQuote(file)).status, 0);
+  EXPECT_EQ(out.str().find(" id=\""), std::string::npos) << "classes only: many previews share one HTML page";
+  const auto png = dir.path() / "preview.png";
+  const CommandResult result = run("rsvg-convert -f png -d 36 -p 36 -o " + shellQuote(png) + " " + shellQuote(file));
+  ASSERT_EQ(result.status, 0) << result.err;
+  EXPECT_EQ(pngSize(png).first, 1152);
+  const auto ps = dir.path() / "preview.ps", ppm = dir.path() / "preview.ppm";
+  ASSERT_EQ(run("rsvg-convert -f ps -o " + shellQuote(ps) + " " + shellQuote(file)).status, 0);
+  ASSERT_EQ(
+      run("gs -q -dNOPAUSE -dBATCH -dSAFER -sDEVICE=ppmraw -r36 -sOutputFile=" + shellQuote(ppm) + " " + shellQuote(ps))
+          .status,
+      0);
+  const Image image = readPpm(ppm);
+  int count = 0;
+  pixelBox(image, Rgb{0x1f, 0x3a, 0x93}, 36, sheet.height + 0.8, &count);
+  EXPECT_GT(count, 100) << "the cuts drawn wide enough to see at 36 dpi";
 }
 
 }  // namespace

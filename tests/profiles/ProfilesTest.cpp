@@ -57,6 +57,12 @@ TEST(Profiles, ShippedProfilesLoad) {
   EXPECT_EQ(workshop.bed.width, 32.0);
   EXPECT_EQ(workshop.bed.height, 18.0);
   EXPECT_EQ(workshop.bed.margin, 0.25);
+  // motion: 6000mm/min, 500mm/s2, 0.01mm, in inches and seconds.
+  const auto grbl = findMachine(catalogue, "grbl-diode-400");
+  ASSERT_TRUE(grbl.motion);
+  EXPECT_DOUBLE_EQ(grbl.motion->maxSpeed, 100 / 25.4);
+  EXPECT_DOUBLE_EQ(grbl.motion->acceleration, 500 / 25.4);
+  EXPECT_DOUBLE_EQ(grbl.motion->junctionDeviation, 0.01 / 25.4);
   EXPECT_EQ(workshop.driver, "spool");
   EXPECT_EQ(workshop.colours.size(), 8u);  // fig. 65's eight rows
   // The dissertation's colours: cut blue, score red, etch yellow, outline green.
@@ -119,7 +125,7 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
   const std::vector<Case> cases = {
       {"unknown key", replaced(good, "driver: spool", "drivr: spool"),
        "p.yaml:4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, connection, colours, "
-       "operations)"},
+       "operations, motion)"},
       {"wrong type", replaced(good, "width: 32in", "width: wide"),
        "p.yaml:3:14: bed.width: expected a length such as 0.25in, 6.35mm or 0.635cm, found 'wide'"},
       {"negative power", replaced(good, "power: 50", "power: -5"),
@@ -147,6 +153,12 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
        "p.yaml:4:9: driver: expected spool, grbl or m2nano, found 'lasersaur'"},
       {"connection for another driver", replaced(good, "connection: spool:out", "connection: grbl:///dev/ttyUSB0"),
        "p.yaml:5:13: connection: 'grbl:///dev/ttyUSB0' is not a spool device URI (expected spool:)"},
+      {"speed without a unit",
+       replaced(good, "driver: spool\n", "driver: spool\nmotion: {speed: 100/s, acceleration: 5in/s2}\n"),
+       "p.yaml:5:17: motion.speed: expected a speed such as 100mm/s, 6000mm/min or 4in/s, found '100/s'"},
+      {"acceleration as a speed",
+       replaced(good, "driver: spool\n", "driver: spool\nmotion: {speed: 4in/s, acceleration: 5in/s}\n"),
+       "p.yaml:5:38: motion.acceleration: expected an acceleration such as 500mm/s2 or 20in/s2, found '5in/s'"},
       {"syntax error", replaced(good, "colours:\n", "colours: [\n"), ""},
       {"not a map", "- just\n- a list\n", "p.yaml:1:1: profile: expected a map of keys (kind, name, ...)"},
   };

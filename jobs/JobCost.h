@@ -1,0 +1,32 @@
+#pragma once
+// What a job takes, for the summary and the manifest: the sheets of which
+// material, the fasteners to buy, and the cutting time.
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace rotafab::jobs {
+
+// What the job takes (SPEC's summary, "material use"): the sheets, the
+// fasteners to buy, and the cutting time of each sheet as its toolpath runs
+// on the machine of the profile (its `motion`).
+struct JobCost {
+  std::string material, materialDescription;
+  size_t sheets = 0;
+  double sheetWidth = 0, sheetHeight = 0;  // inches: the bed's
+  int fasteners = 0;
+  double fastenerDiameter = 0;         // inches
+  std::vector<double> cuttingSeconds;  // per sheet; empty when no toolpath could be planned
+  bool motionGiven = false;            // the machine profile gives its motion (else GRBL's defaults)
+  [[nodiscard]] double totalSeconds() const;
+};
+
+// The cost as manifest.json's "cost" (and the summary's), and back.
+nlohmann::ordered_json costJson(const JobCost& cost);
+JobCost costFromJson(const nlohmann::json& json);  // throws nlohmann::json::exception
+// "2 sheets of posterboard (32 x 18 in) and 298 fasteners of 0.125 in (3.2 mm); cutting about 12m 30s".
+std::string costLine(const JobCost& cost);
+
+}  // namespace rotafab::jobs
