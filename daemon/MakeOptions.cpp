@@ -27,6 +27,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   if (!options.kerf.empty()) request.kerf = lengthOption(options.kerf, "--kerf");
   request.seconds = options.seconds;
   request.order = orderOption(options.order);
+  request.freeOrderWhenItSavesSheets = !options.orderGiven;
   request.window = options.window;
   request.rows = options.layout == "rows";
   request.names = flagOf;
@@ -77,7 +78,10 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
   make.add_option("--time", options.seconds, "Nesting improvement budget in seconds")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
-  make.add_option("--order", options.order, "Cutting order: strict, window or free (see `rotafab nest`)")
+  make.add_option("--order", options.order,
+                  "Cutting order: strict, window or free (see `rotafab nest`); by default window, or free where\n"
+                  "keeping to the window would cost a sheet")
+      ->each([&options](const std::string&) { options.orderGiven = true; })
       ->capture_default_str()
       ->check(CLI::IsMember({"strict", "window", "free"}));
   make.add_option("--window", options.window, "With --order window: at most this many places from the assembly order")

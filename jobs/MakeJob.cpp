@@ -412,6 +412,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   plan.seconds = request.seconds;
   plan.order = request.order;
   plan.window = request.window;
+  plan.freeOrderWhenItSavesSheets = request.freeOrderWhenItSavesSheets;
   plan.rows = request.rows;
   plan.title = job.title;
   context.report({"nesting", "", 0, job.structure.panels.size()});
@@ -430,6 +431,12 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;
   job.seconds.nesting = lap();
+  if (job.sheets.windowSheets > 0) {
+    context.note(fmt::format(
+        "{}: cut in the free order: keeping each part within {} places of the assembly order took {} sheets, the "
+        "free order {} (manifest.json's `moved` says how far each part moved; --order window keeps the window)",
+        name, request.window, job.sheets.windowSheets, job.sheets.sheets.size()));
+  }
   job.cost = jobCost(job, request, context);
   return job;
 }

@@ -55,6 +55,7 @@ struct MakeRequest {
   double seconds = 5.0;
   OrderMode order = OrderMode::Window;
   int window = 8;
+  bool freeOrderWhenItSavesSheets = false;  // as PlanOptions'
   bool rows = false;
   // How messages name the options (the command line: by their flags).
   geometry::ParameterNames names = geometry::parameterInWords;

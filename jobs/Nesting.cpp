@@ -42,6 +42,12 @@ std::pair<Point2, Point2> rotatedBox(const Polygon2& outline, double degrees) {
 
 double polygonArea(const Polygon2& polygon) { return core::signedArea(polygon); }
 
+int sheetsTheAreaNeeds(const std::vector<NestingPart>& parts, const NestingOptions& options) {
+  double area = 0;
+  for (const NestingPart& part : parts) area += std::abs(polygonArea(part.outline));
+  return std::max(1, static_cast<int>(std::ceil(area / (options.width * options.height) - 1e-9)));
+}
+
 Polygon2 placedOutline(const NestingPart& part, const PartPlacement& placement) {
   Polygon2 out = rotated(part.outline, placement.rotation);
   for (Point2& p : out) p += Point2(placement.x, placement.y);

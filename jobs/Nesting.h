@@ -101,6 +101,10 @@ std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, c
 
 double polygonArea(const Polygon2& polygon);
 
+// The fewest sheets the parts' area fills (their outlines' area over the
+// usable area's, rounded up): no layout on beds has fewer.
+int sheetsTheAreaNeeds(const std::vector<NestingPart>& parts, const NestingOptions& options);
+
 // `p` turned counter-clockwise about the origin; quarter turns are exact.
 Point2 rotatedPoint(const Point2& p, double degrees);  // signed: positive counter-clockwise
 

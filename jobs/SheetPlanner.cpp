@@ -1,6 +1,7 @@
 #include "jobs/SheetPlanner.h"
 
 #include <cctype>
+#include <chrono>
 
 #include <fmt/format.h>
 
@@ -58,7 +59,17 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
-  const NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
+  const auto started = std::chrono::steady_clock::now();
+  NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
+  int windowSheets = 0;
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!options.rows && options.freeOrderWhenItSavesSheets && nesting.order == OrderMode::Window &&
+      nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting) && took <= std::max(10.0, 2 * options.seconds + 1)) {
+    NestingOptions free = nesting;
+    free.order = OrderMode::Free;
+    NestingResult loose = nest(nestingParts, free, context);
+    if (loose.sheets < nested.sheets) windowSheets = nested.sheets, nested = std::move(loose);
+  }
 
   SheetPlan plan;
   for (size_t i = 0; i < nested.placements.size(); ++i) {
@@ -66,6 +77,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
     plan.parts.push_back({p.part, p.sheet, p.x + bed.margin, p.y + bed.margin, p.rotation, static_cast<int>(i),
                           static_cast<int>(i) - parts[p.part].order});
   }
+  plan.windowSheets = windowSheets;
   for (const Part& part : parts) plan.partArea += std::abs(polygonArea(part.outline));
   plan.utilization = plan.partArea / (nested.sheets * nesting.width * nesting.height);
 

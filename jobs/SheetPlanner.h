@@ -22,6 +22,11 @@ struct PlanOptions {
   double seconds = 5.0;   // nesting improvement budget
   OrderMode order = OrderMode::Window;
   int window = 8;
+  // With the window: when the free order fits the parts on fewer sheets,
+  // take it (SheetPlan::windowSheets says so). Tried only when the first
+  // layout came quickly (within twice the time budget, or 10 s): a large
+  // job would wait twice as long for it.
+  bool freeOrderWhenItSavesSheets = false;
   unsigned seed = 1;
   bool rows = false;  // rowLayout() instead of nest(): seconds for any size, more sheets
   std::string title;  // "bunny (band)"; the sheet number is appended
@@ -41,6 +46,9 @@ struct SheetPlan {
   std::vector<PlannedPart> parts;  // in cutting order
   double partArea = 0;             // of the design outlines, square inches
   double utilization = 0;          // part area / usable area of all sheets
+  // The window order would have taken this many sheets, the free order took
+  // fewer; 0: the order asked was kept.
+  int windowSheets = 0;
 };
 
 // Throws std::invalid_argument naming the part that cannot be planned (larger

@@ -74,6 +74,11 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
   packer.accept();
   auto bestCost = layoutCost(best, parts);
   progress.improved(bestCost, {"nesting", "first layout", parts.size(), parts.size(), bestCost.first, bestCost.second});
+  // On beds, no layout has fewer sheets than the parts' area fills: once
+  // there, the search stops (what it could still do, shorten the last
+  // sheet, is not worth the user's wait).
+  const int sheetBound = jobs::sheetsTheAreaNeeds(parts, options);
+  const auto atBound = [&] { return !options.strip && bestCost.first <= sheetBound; };
   int evaluations = 1;
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
@@ -88,7 +93,8 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
     const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                       std::chrono::duration<double>(sequenceShare * options.seconds));
     const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
-    while (std::chrono::steady_clock::now() < deadline && (options.evaluations <= 0 || evaluations < lastEvaluation)) {
+    while (!atBound() && std::chrono::steady_clock::now() < deadline &&
+           (options.evaluations <= 0 || evaluations < lastEvaluation)) {
       context.check();
       std::vector<int> trial = sequence, trialShapes = shapeOf;
       const size_t i = random() % trial.size();
@@ -130,7 +136,7 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
       }
     }
   }
-  if (compaction) {
+  if (compaction && !atBound()) {
     const auto deadline = start + std::chrono::duration<double>(options.seconds);
     const auto goOn = [&] {
       return !context.cancelled() && std::chrono::steady_clock::now() < deadline &&

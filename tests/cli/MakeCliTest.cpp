@@ -376,6 +376,27 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
       << missing.err;
 }
 
+// The default order keeps each part near its place in the assembly, but not
+// at the cost of a sheet: the soccer ball's 32 panels fit one sheet in the
+// free order, and that is taken, and said; --order window keeps the window.
+TEST(MakeCli, TheOrderDoesNotCostASheet) {
+  TempDir dir;
+  const std::string ball = quoted(kSource / "examples/soccer-ball.obj");
+  const CommandResult free =
+      run(kCli + " make " + ball + " --structure band --time 2 --json --out " + quoted(dir.path() / "a"));
+  ASSERT_EQ(free.status, 0) << free.err;
+  EXPECT_EQ(nlohmann::json::parse(free.out).at("sheets"), 1);
+  EXPECT_NE(free.err.find("cut in the free order: keeping each part within 8 places of the assembly order took 2 "
+                          "sheets, the free order 1"),
+            std::string::npos)
+      << free.err;
+  const CommandResult window = run(kCli + " make " + ball + " --structure band --time 2 --order window --json --out " +
+                                   quoted(dir.path() / "b"));
+  ASSERT_EQ(window.status, 0) << window.err;
+  EXPECT_EQ(nlohmann::json::parse(window.out).at("sheets"), 2);
+  EXPECT_EQ(window.err.find("free order"), std::string::npos);
+}
+
 // A second make into the same folder replaces the first's files, stale sheets included;
 // an open mesh is built open (boundary edges get no band) or with its holes filled.
 TEST(MakeCli, ReusedFolderAndOpenMeshes) {

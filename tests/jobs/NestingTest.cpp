@@ -202,6 +202,22 @@ TEST(Nesting, BedCompactionShortensTheLastSheet) {
   EXPECT_NEAR(lastLength, best->second, 0.005);
 }
 
+// Once a layout has the fewest sheets the parts' area allows, the search
+// stops: a few small parts on one bed do not spend the whole budget.
+TEST(Nesting, TheSearchStopsAtTheAreaBound) {
+  const auto parts = randomParts(6, 3);
+  NestingOptions options;
+  options.width = 30;
+  options.height = 17;
+  options.seconds = 60;  // (never reached: the first layout is on one sheet)
+  ASSERT_EQ(sheetsTheAreaNeeds(parts, options), 1);
+  options.threads = 2;
+  const NestingResult result = nest(parts, options, test::context());
+  EXPECT_EQ(result.sheets, 1);
+  EXPECT_EQ(result.evaluations, 2) << "only the first layout of each search";
+  expectValid(parts, result, options);
+}
+
 TEST(Nesting, SameSeedNoBudgetSameLayout) {
   const auto parts = randomParts(11, 12);
   NestingOptions options;
@@ -213,7 +229,8 @@ TEST(Nesting, SameSeedNoBudgetSameLayout) {
 TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
   const auto parts = randomParts(12, 10);
   NestingOptions options;
-  options.seconds = 600;  // never the limit here
+  options.width = 15, options.height = 6;  // small beds: layouts above the area bound, so that the search goes on
+  options.seconds = 600;                   // never the limit here
   options.evaluations = 25;
   options.seed = 9;
   options.threads = 2;
