@@ -15,19 +15,57 @@ namespace {
 struct SimAddress : DeviceAddress {
   using DeviceAddress::DeviceAddress;
   double speed = 1;  // simulated seconds per real second
+  // A fault to rehearse (sim:grbl only), once `after` lines have run.
+  std::string fault;
+  size_t after = 20;
 };
 
-// sim:NAME[?speed=N]
-std::unique_ptr<SimAddress> parseSim(const std::string& uri) {
+// The faults a simulated GRBL can be told to have, for a drill of what the
+// operator sees (and for the command line's tests).
+constexpr const char* kGrblFaults = "stall, noise, garbage, alarm, silence or unplug";
+
+// sim:NAME[?speed=N][&fault=KIND[&after=LINES]]
+std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
   auto parsed = std::make_unique<SimAddress>(uri);
-  if (uri.find('?') != std::string::npos) {
-    const std::string option = splitQuery(uri).second;
-    const auto speed = wholeNumber<double>(option.starts_with("speed=") ? option.substr(6) : "");
-    if (!speed || !(*speed > 0))
-      throw uriError(uri, fmt::format("\"{}\": the simulator takes speed=N, a positive number", option));
-    parsed->speed = *speed;
+  std::string query = splitQuery(uri).second;
+  const std::string takes =
+      faults ? fmt::format("speed=N, fault=KIND ({}) and after=LINES", kGrblFaults) : "speed=N, a positive number";
+  while (!query.empty()) {
+    const size_t end = query.find('&');
+    const std::string option = query.substr(0, end);
+    query = end == std::string::npos ? "" : query.substr(end + 1);
+    const size_t equals = option.find('=');
+    const std::string key = option.substr(0, equals),
+                      value = equals == std::string::npos ? "" : option.substr(equals + 1);
+    if (key == "speed") {
+      const auto speed = wholeNumber<double>(value);
+      if (!speed || !(*speed > 0)) throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
+      parsed->speed = *speed;
+    } else if (faults && key == "fault" &&
+               (value == "stall" || value == "noise" || value == "garbage" || value == "alarm" || value == "silence" ||
+                value == "unplug")) {
+      parsed->fault = value;
+    } else if (faults && key == "after" && wholeNumber<size_t>(value)) {
+      parsed->after = *wholeNumber<size_t>(value);
+    } else {
+      throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
+    }
   }
   return parsed;
+}
+
+// Injects the fault of `address` into `simulator`.
+void rehearse(const SimAddress& address, GrblSimulator& simulator) {
+  if (address.fault.empty()) return;
+  simulator.afterLines(address.after, [fault = address.fault](GrblSimulator& s) {
+    if (fault == "stall") s.stall();
+    if (fault == "noise") s.garbleNextStatus(), s.sendGarbage();  // line noise once: the job goes on
+    if (fault == "garbage")
+      for (int i = 0; i < 3; ++i) s.sendGarbage();
+    if (fault == "alarm") s.raiseAlarm(1);
+    if (fault == "silence") s.mute(true);
+    if (fault == "unplug") s.unplug();
+  });
 }
 
 bool isSim(std::string_view uri, std::string_view name) {
@@ -52,11 +90,16 @@ class SimGrblEntry : public DriverEntry {
   [[nodiscard]] std::string_view scheme() const override { return "sim:grbl"; }
   [[nodiscard]] bool simulated() const override { return true; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "grbl"); }
-  [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override { return parseSim(uri); }
+  [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
+    return parseSim(uri, true);
+  }
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup&) const override {
+    const auto& sim = dynamic_cast<const SimAddress&>(address);
     GrblSimulatorOptions options;
-    options.timeScale = dynamic_cast<const SimAddress&>(address).speed;
-    return std::make_unique<SimulatedGrbl>(std::make_unique<GrblSimulator>(options), options.timeScale);
+    options.timeScale = sim.speed;
+    auto simulator = std::make_unique<GrblSimulator>(options);
+    rehearse(sim, *simulator);
+    return std::make_unique<SimulatedGrbl>(std::move(simulator), options.timeScale);
   }
   // The simulator is asked for its settings ($30, $110), as a real GRBL cannot be for a dry run.
   [[nodiscard]] bool connectsForDryRun(const DeviceAddress&) const override { return true; }
@@ -86,7 +129,9 @@ class SimM2NanoEntry : public DriverEntry {
   [[nodiscard]] std::string_view scheme() const override { return "sim:m2nano"; }
   [[nodiscard]] bool simulated() const override { return true; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "m2nano"); }
-  [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override { return parseSim(uri); }
+  [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
+    return parseSim(uri, false);
+  }
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup&) const override {
     return std::make_unique<SimulatedM2Nano>(dynamic_cast<const SimAddress&>(address).speed);
   }

@@ -56,6 +56,36 @@ TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
   }
 }
 
+// The controller's faults as the operator meets them, on the simulated GRBL
+// told to have them: a stall (Run, standing still) and a run of garbage stop
+// the job with the laser confirmed off (exit 3, where the job stopped); line
+// noise once (a garbled report and line) is skipped and the job ends.
+TEST(RunCli, FaultsOfTheControllerAsTheOperatorMeetsThem) {
+  struct Case {
+    const char* fault;
+    int status;
+    const char* says;
+  };
+  for (const Case& c : {Case{"stall", 3, "the machine stopped moving: it says Run"},
+                        Case{"garbage", 3, "3 lines in a row that are no GRBL reply"}, Case{"noise", 0, ""}}) {
+    SCOPED_TRACE(c.fault);
+    const CommandResult r =
+        run(kCli + " run " + quoted(cubeJob()) + " --device 'sim:grbl?speed=50&fault=" + c.fault + "&after=30'");
+    EXPECT_EQ(r.status, c.status) << r.err;
+    if (c.status == 0) {
+      EXPECT_NE(r.out.find("1 sheet cut on sim:grbl"), std::string::npos) << r.out;
+      continue;
+    }
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("the controller confirmed the laser off"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("stopped at sheet 1 of 1"), std::string::npos) << r.err;
+  }
+  const CommandResult typo = run(kCli + " run " + quoted(cubeJob()) + " --device 'sim:grbl?fault=fire'");
+  EXPECT_EQ(typo.status, 1);
+  EXPECT_NE(typo.err.find("fault=KIND (stall, noise, garbage, alarm, silence or unplug)"), std::string::npos)
+      << typo.err;
+}
+
 TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
   TempDir dir;
   const auto file = dir.path() / "cube.gcode";
