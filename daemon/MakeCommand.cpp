@@ -101,8 +101,9 @@ void addMakeCommand(CLI::App& app, int& status) {
   CLI::App* make = app.add_subcommand("make", "Turn a mesh into numbered, drilled panels on laser sheets");
   addMakeOptions(*make, *options);
   make->footer(
-      "Writes into the output folder: sheet-001.eps/.svg/.dxf, ... (one set per sheet), manifest.json (SPEC),\n"
-      "manifest.txt (the assembly steps), structure.obj (the panels in 3D). Lengths take in, mm or cm.\n"
+      "Writes into the output folder: sheet-001.eps/.svg/.dxf, ... (one set per sheet, for the cutter) and\n"
+      "sheet-001.preview.svg (for people), manifest.json (SPEC), manifest.txt (what it takes, and the assembly\n"
+      "steps), structure.obj (the panels in 3D, a group per panel). Lengths take in, mm or cm.\n"
       "Default scale: the mean edge becomes 2 in. Ctrl-C stops at once and writes nothing.\n\n"
       "Examples:\n"
       "  rotafab make examples/bunny.obj --structure band\n"
