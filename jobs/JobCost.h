@@ -13,7 +13,7 @@ namespace rotafab::jobs {
 // fasteners to buy, and the cutting time of each sheet as its toolpath runs
 // on the machine of the profile (its `motion`).
 struct JobCost {
-  std::string material, materialDescription;
+  std::string material;
   size_t sheets = 0;
   double sheetWidth = 0, sheetHeight = 0;  // inches: the bed's
   int fasteners = 0;

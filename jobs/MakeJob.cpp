@@ -7,10 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <numeric>
 #include <regex>
 
-#include "core/Duration.h"
 #include "core/UserError.h"
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
@@ -359,7 +357,6 @@ std::filesystem::path defaultOutputFolder(const MakeRequest& request) {
 JobCost jobCost(const PlannedJob& job, const MakeRequest& request, const core::WorkContext& context) {
   JobCost cost;
   cost.material = request.material.name;
-  cost.materialDescription = request.material.description;
   cost.sheets = job.sheets.sheets.size();
   cost.sheetWidth = request.machine.bed.width, cost.sheetHeight = request.machine.bed.height;
   cost.fasteners = job.structure.fasteners;

@@ -23,6 +23,15 @@ namespace {
 
 constexpr const char* kBanner = "\r\nGrbl 1.1h ['$' for help]\r\n";
 
+// A line as GRBL's parser sees it: spaces dropped, letters upper case.
+std::string normalised(const std::string& raw) {
+  std::string line;
+  for (char c : raw) {
+    if (c != ' ') line += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  }
+  return line;
+}
+
 }  // namespace
 
 GrblSimulator::GrblSimulator(GrblSimulatorOptions options) : options_(options) {
@@ -192,10 +201,7 @@ void GrblSimulator::takeLines() {
 // gcode.c, laser mode: a change of M3/M4/M5 is synced; so is a new S on a
 // line without motion while the spindle is on.
 bool GrblSimulator::needsSync(const std::string& raw) const {
-  std::string line;
-  for (char c : raw) {
-    if (c != ' ') line += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  }
+  const std::string line = normalised(raw);
   if (line.empty() || line[0] == '$') return false;
   bool motion = false;
   std::optional<double> s;
@@ -215,10 +221,7 @@ bool GrblSimulator::needsSync(const std::string& raw) const {
 }
 
 void GrblSimulator::executeLine(const std::string& raw) {
-  std::string line;
-  for (char c : raw) {
-    if (c != ' ') line += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  }
+  const std::string line = normalised(raw);
   record_.lines.push_back(line);
   if (line.empty()) return reply("ok\r\n");
   if (line[0] == '$') {
