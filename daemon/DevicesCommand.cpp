@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "daemon/ExitCode.h"
+#include "daemon/QueueCommands.h"
 #include "devices/Discovery.h"
 
 namespace rotafab::cli {
@@ -53,11 +54,23 @@ int runDevices(bool json) {
 
 void addDevicesCommand(CLI::App& app, int& status) {
   auto json = std::make_shared<bool>(false);
+  auto daemon = std::make_shared<bool>(false);
+  auto server = std::make_shared<std::string>();
+  auto token = std::make_shared<std::string>();
   CLI::App* devicesCommand =
       app.add_subcommand("devices", "List the serial ports and cutters plugged in, and the driver for each");
   devicesCommand->add_flag("--json", *json,
                            "Print one JSON array: port, description, usb {vendor, product, serial}, driver, uri");
-  devicesCommand->callback([json, &status] { status = runDevices(*json); });
+  devicesCommand->add_flag("--daemon", *daemon, "The daemon's devices instead: each with its state and job");
+  devicesCommand->add_option("--server", *server, "With --daemon: unix:PATH or http://HOST:PORT (default: the socket)");
+  devicesCommand->add_option("--token", *token, "With --daemon: the bearer token a TCP listener asks for");
+  devicesCommand->footer(
+      "Examples:\n"
+      "  rotafab devices\n"
+      "  rotafab devices --daemon");
+  devicesCommand->callback([json, daemon, server, token, &status] {
+    status = *daemon || !server->empty() ? runDaemonDevices(*json, *server, *token) : runDevices(*json);
+  });
 }
 
 }  // namespace rotafab::cli

@@ -17,13 +17,13 @@
 #include "daemon/ManifestCommand.h"
 #include "daemon/NestCommand.h"
 #include "daemon/ProfilesCommand.h"
+#include "daemon/QueueCommands.h"
 #include "daemon/RunCommand.h"
 
 namespace {
 
-// The commands of SPEC's command line that are not built yet: the daemon's.
-constexpr std::string_view kDaemonVerbs[] = {"submit", "jobs",  "status", "cancel", "pause",
-                                             "resume", "start", "next",   "move",   "dashboard"};
+// The commands of SPEC's command line that are not built yet: the workshop page's.
+constexpr std::string_view kDaemonVerbs[] = {"dashboard"};
 // Options of SPEC's `make` that only the woven structure takes.
 constexpr std::string_view kWeaveOptions[] = {"--width", "--curve", "--offset", "--cycles"};
 
@@ -66,6 +66,7 @@ int main(int argc, char** argv) {
   addProfilesCommand(app, status);
   addDevicesCommand(app, status);
   addRunCommand(app, status);
+  addQueueCommands(app, status);
   // The command named, if it is one: usage errors point to its own --help.
   std::vector<std::string> verbs;
   for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
@@ -78,8 +79,8 @@ int main(int argc, char** argv) {
     if (std::find(verbs.begin(), verbs.end(), word) != verbs.end()) {
       verb = word;
     } else if (std::find(std::begin(kDaemonVerbs), std::end(kDaemonVerbs), word) != std::end(kDaemonVerbs)) {
-      return usageError(fmt::format("`rotafab {}` is a command of the fabrication daemon, which is not built yet; "
-                                    "`rotafab make` and `rotafab run` work without it",
+      return usageError(fmt::format("`rotafab {}` is a command of the workshop page, which is not built yet; "
+                                    "`rotafab jobs` and `rotafab status JOB --follow` show the queue",
                                     word),
                         "rotafab --help");
     } else {

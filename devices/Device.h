@@ -84,6 +84,11 @@ class Device {
   virtual void pause() = 0;
   virtual void resume() = 0;
   virtual DeviceStatus status() = 0;
+  // Stops the machine and turns its laser off (GRBL: feed hold, reset,
+  // M5), connected or not; returns whether the controller confirmed the
+  // laser off. Never throws. A daemon calls it on every device it starts
+  // with, whatever a run before it left behind.
+  virtual bool stopSafely() noexcept = 0;
   virtual void disconnect() = 0;
   // What the machine can do, for planning its toolpaths (once connected, as
   // the controller reports it).

@@ -118,6 +118,19 @@ std::string GrblDriver::expectLine(Millis timeout, const char* waitingFor) {
 }
 
 std::string GrblDriver::connect() {
+  // The link is kept only once the controller has answered as a GRBL in
+  // laser mode: a half-set-up one would let run() and status() skip
+  // connecting, and would hold the port open.
+  link_.reset();
+  struct Keep {
+    std::unique_ptr<Link>& link;
+    bool connected = false;
+    ~Keep() {
+      if (connected || !link) return;
+      link->close();
+      link.reset();
+    }
+  } keep{link_};
   link_ = open_();
   // An Arduino resets when its port opens and prints the banner; a board
   // reached over TCP does not, so it is reset once.
@@ -175,6 +188,7 @@ std::string GrblDriver::connect() {
                                                        "80 would never fit",
                                                        link_->name(), receiveBuffer_));
   }
+  keep.connected = true;
   return fmt::format("{} (receive buffer {} bytes, laser mode on)", banner, receiveBuffer_);
 }
 

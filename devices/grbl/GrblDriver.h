@@ -46,6 +46,7 @@ class GrblDriver : public Device {
   void pause() override { holdRequested_ = true; }
   void resume() override { resumeRequested_ = true; }
   DeviceStatus status() override;
+  bool stopSafely() noexcept override;
   void disconnect() override;
 
   // What the controller reported at connect().
@@ -69,7 +70,6 @@ class GrblDriver : public Device {
   // Feed hold; once the machine has stopped (Hold:0), soft reset, which
   // turns the laser off without the alarm a reset in motion raises; then
   // M5 S0. Returns whether the controller answered it all. Never throws.
-  bool stopSafely() noexcept;
 
   std::function<std::unique_ptr<Link>()> open_;
   GrblTimeouts timeouts_;

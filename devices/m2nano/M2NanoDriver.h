@@ -47,6 +47,7 @@ class M2NanoDriver : public Device {
   void pause() override { holdWanted_ = true; }
   void resume() override { holdWanted_ = false; }
   DeviceStatus status() override;
+  bool stopSafely() noexcept override;
   void disconnect() override;
 
   // The M2's limits (a profile's 100% speed is 100 mm/s), its LHYMICRO-GL
@@ -67,7 +68,6 @@ class M2NanoDriver : public Device {
   // Polls until the board reports the job finished (236).
   void waitFinished(Millis limit, const core::Cancellation* cancel);
   // "I", then a home; whether the board confirmed both. Never throws.
-  bool stopSafely() noexcept;
 
   std::function<std::unique_ptr<UsbLink>()> open_;
   M2NanoTimeouts timeouts_;

@@ -149,6 +149,8 @@ void serveDevice(Device& device, int input, int output) {
       } else if (op == "status") {
         const DeviceStatus status = device.status();
         pipe.writeLine(reply(id, {{"status", {{"state", status.state}, {"x", status.x}, {"y", status.y}}}}).dump());
+      } else if (op == "stop") {
+        pipe.writeLine(reply(id, {{"confirmed", device.stopSafely()}}).dump());
       } else if (op == "disconnect") {
         device.disconnect();
         pipe.writeLine(reply(id).dump());

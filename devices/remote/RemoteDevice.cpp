@@ -171,6 +171,15 @@ DeviceStatus RemoteDevice::status() {
   return {status.at("state").get<std::string>(), status.at("x").get<double>(), status.at("y").get<double>()};
 }
 
+bool RemoteDevice::stopSafely() noexcept {
+  try {
+    if (!pipe_) start();
+    return call({{"op", "stop"}}, timeouts_.home).value("confirmed", false);
+  } catch (...) {
+    return false;  // the helper is gone: nothing can be said to the device
+  }
+}
+
 void RemoteDevice::disconnect() {
   if (!pipe_) return;
   try {

@@ -47,6 +47,7 @@ class RemoteDevice : public Device {
   void pause() override;
   void resume() override;
   DeviceStatus status() override;
+  bool stopSafely() noexcept override;
   void disconnect() override;
 
  private:

@@ -2,7 +2,8 @@
 // The line protocol between a RemoteDevice and the DeviceHost in its helper
 // process: one JSON object a line, each way.
 //
-//   to the host:   {"op": "connect" | "home" | "status" | "disconnect"}
+//   to the host:   {"op": "connect" | "home" | "status" | "stop" | "disconnect"}
+//                  (stop: Device::stopSafely(), replied {"ok": true, "confirmed": BOOL})
 //                  {"op": "frame" | "run", "toolpath": TOOLPATH}
 //                  {"op": "pause" | "resume" | "cancel"}       (while a run goes on; no reply)
 //   to the device: {"ok": true, "identity": "...", "status": {...}} (the reply to a request)

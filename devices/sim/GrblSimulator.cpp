@@ -353,7 +353,7 @@ void GrblSimulator::replan() {
 }
 
 void GrblSimulator::advance(double seconds) {
-  record_.laserOn = false;
+  setLaser(false);
   clock_ += seconds;
   if (held_) {
     holdSettle_ = std::max(0.0, holdSettle_ - seconds);
@@ -389,7 +389,7 @@ void GrblSimulator::advance(double seconds) {
     blockDone_ += step;
     seconds -= used;
     if (block.lit) record_.litSeconds += used;
-    record_.laserOn = block.lit;
+    setLaser(block.lit);
     if (blockDone_ >= block.length - 1e-9) {
       record_.x = block.x, record_.y = block.y;
       planner_.erase(planner_.begin());
@@ -405,7 +405,7 @@ void GrblSimulator::advance(double seconds) {
       record_.x = startX_ + (block.x - startX_) * t, record_.y = startY_ + (block.y - startY_) * t;
     }
   }
-  if (planner_.empty() || held_ || alarm_) record_.laserOn = false;
+  if (planner_.empty() || held_ || alarm_) setLaser(false);
 }
 
 void GrblSimulator::reset() {
@@ -417,7 +417,7 @@ void GrblSimulator::reset() {
   stalled_ = false;
   wcoCounter_ = 0, overrideCounter_ = 0;
   held_ = false, laserModal_ = false, spindle_ = 0, feedSet_ = false, rapid_ = true, spindleMode_ = 5;
-  record_.laserOn = false;
+  setLaser(false);
   if (moving) {
     alarm_ = true;
     reply("ALARM:3\r\n");
@@ -487,6 +487,12 @@ void GrblSimulator::sendGarbage() {
   reply("\x07\x1b[2J\xfe\xff%%garbage%%\r\n");
 }
 
+void GrblSimulator::setLaser(bool lit) {
+  const bool changed = record_.laserOn != lit;
+  record_.laserOn = lit;
+  if (changed && options_.laserChanged) options_.laserChanged(lit);
+}
+
 void GrblSimulator::raiseAlarm(int code) {
   const std::lock_guard lock(mutex_);
   planner_.clear();
@@ -495,7 +501,7 @@ void GrblSimulator::raiseAlarm(int code) {
   syncing_.reset();
   speed_ = 0;
   alarm_ = true, held_ = false, laserModal_ = false, spindleMode_ = 5;
-  record_.laserOn = false;
+  setLaser(false);
   reply(fmt::format("ALARM:{}\r\n", code));
 }
 

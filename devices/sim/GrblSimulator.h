@@ -40,6 +40,9 @@ struct GrblSimulatorOptions {
   size_t plannerBlocks = 15;
   unsigned baud = 0;  // > 0: bytes from the driver arrive no faster than this serial line carries (10 bits a byte)
   std::chrono::milliseconds replyLatency{0};  // each reply reaches the driver this much later (a USB adapter's)
+  // Told each time the laser goes on or off (from the simulator's thread):
+  // a witness outside the process that drives it (sim:grbl?witness=FILE).
+  std::function<void(bool lit)> laserChanged;
 };
 
 // What a test checks after a run.
@@ -82,6 +85,8 @@ class GrblSimulator {
   void afterLines(size_t lines, std::function<void(GrblSimulator&)> fault);  // inject once that many lines ran
 
  private:
+  // The laser's state now, with laserChanged told of a change.
+  void setLaser(bool lit);
   void loop();
   void receive(char byte);
   void takeLines();

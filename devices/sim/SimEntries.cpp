@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cstdio>
+
 #include "core/ProgramFolders.h"
 #include "devices/UriParts.h"
 #include "devices/grbl/GrblDriver.h"
@@ -18,6 +20,9 @@ struct SimAddress : DeviceAddress {
   // A fault to rehearse (sim:grbl only), once `after` lines have run.
   std::string fault;
   size_t after = 20;
+  // A file the simulated laser's every change is appended to ("on", "off"),
+  // for a test that watches the laser from outside the process.
+  std::string witness;
 };
 
 // The faults a simulated GRBL can be told to have, for a drill of what the
@@ -28,8 +33,8 @@ constexpr const char* kGrblFaults = "stall, noise, garbage, alarm, silence or un
 std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
   auto parsed = std::make_unique<SimAddress>(uri);
   std::string query = splitQuery(uri).second;
-  const std::string takes =
-      faults ? fmt::format("speed=N, fault=KIND ({}) and after=LINES", kGrblFaults) : "speed=N, a positive number";
+  const std::string takes = faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES and witness=FILE", kGrblFaults)
+                                   : "speed=N, a positive number";
   while (!query.empty()) {
     const size_t end = query.find('&');
     const std::string option = query.substr(0, end);
@@ -47,6 +52,8 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
       parsed->fault = value;
     } else if (faults && key == "after" && wholeNumber<size_t>(value)) {
       parsed->after = *wholeNumber<size_t>(value);
+    } else if (faults && key == "witness" && !value.empty()) {
+      parsed->witness = value;
     } else {
       throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
     }
@@ -97,6 +104,15 @@ class SimGrblEntry : public DriverEntry {
     const auto& sim = dynamic_cast<const SimAddress&>(address);
     GrblSimulatorOptions options;
     options.timeScale = sim.speed;
+    if (!sim.witness.empty()) {
+      options.laserChanged = [file = sim.witness](bool lit) {
+        // Appended and closed at once: what is written survives a kill of the process.
+        if (FILE* out = std::fopen(file.c_str(), "a")) {
+          std::fputs(lit ? "on\n" : "off\n", out);
+          std::fclose(out);
+        }
+      };
+    }
     auto simulator = std::make_unique<GrblSimulator>(options);
     rehearse(sim, *simulator);
     return std::make_unique<SimulatedGrbl>(std::move(simulator), options.timeScale);

@@ -31,6 +31,7 @@ class SpoolDevice : public Device {
   void pause() override {}
   void resume() override {}
   DeviceStatus status() override { return {"Idle", 0, 0}; }
+  bool stopSafely() noexcept override { return true; }  // a spool lights no laser
   void disconnect() override {}
   // Each sheet's EPS, one after another.
   [[nodiscard]] std::string program(const std::vector<jobs::Toolpath>& toolpaths) const override;

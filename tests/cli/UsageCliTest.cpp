@@ -24,13 +24,18 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
   expectUsage("bake " + cube, "bake is not a rotafab command; did you mean `rotafab make`?", "rotafab --help");
   expectUsage("fabricate " + cube,
               "fabricate is not a rotafab command (the commands: inspect, make, manifest, nest, profiles, devices, "
-              "run)",
+              "run, submit, jobs, status, cancel, pause, resume, start, next, move)",
               "rotafab --help");
-  expectUsage("", "give a command: inspect, make, manifest, nest, profiles, devices, run", "rotafab --help");
-  expectUsage("submit " + cube,
-              "`rotafab submit` is a command of the fabrication daemon, which is not built yet; `rotafab make` and "
-              "`rotafab run` work without it",
+  expectUsage("",
+              "give a command: inspect, make, manifest, nest, profiles, devices, run, submit, jobs, status, cancel, "
+              "pause, resume, start, next, move",
               "rotafab --help");
+  expectUsage("dashboard",
+              "`rotafab dashboard` is a command of the workshop page, which is not built yet; `rotafab jobs` and "
+              "`rotafab status JOB --follow` show the queue",
+              "rotafab --help");
+  // A mesh is planned by the daemon with `make`'s options, --structure first.
+  expectUsage("submit " + cube, "--structure is required to plan a mesh (band or weave)", "rotafab submit --help");
   expectUsage("make " + cube + " --structure band --width 0.5in",
               "--width is an option of the plain-woven structure (--structure weave, dissertation ch. IV), which is "
               "not built yet",

@@ -1,0 +1,461 @@
+#include "daemon/QueueCommands.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "core/Duration.h"
+#include "daemon/CommandSupport.h"
+#include "daemon/DaemonClient.h"
+#include "daemon/MakeOptions.h"
+#include "jobs/Manifest.h"
+
+namespace rotafab::cli {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+struct ClientOptions {
+  std::string server, token;
+  bool json = false;
+};
+
+void addClientOptions(CLI::App& verb, ClientOptions& options, bool jsonFlag = true) {
+  verb.add_option("--server", options.server,
+                  "The daemon: unix:PATH or http://HOST:PORT (default: the Unix socket, "
+                  "$XDG_RUNTIME_DIR/rotafab/rotafabd.sock)");
+  verb.add_option("--token", options.token, "The bearer token a TCP listener asks for");
+  if (jsonFlag) verb.add_flag("--json", options.json, "Print the daemon's JSON answer");
+}
+
+DaemonClient clientOf(const ClientOptions& options) {
+  return DaemonClient(serverAddress(options.server, options.token));
+}
+
+// Runs a verb's body and reports its errors as one line, exit status 1.
+template <typename Body>
+int talking(Body&& body) {
+  try {
+    return body();
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+    return kUserError;
+  }
+}
+
+std::string sheetsOf(const json& job) {
+  const int sheets = job.value("sheets", 0);
+  if (sheets == 0) return "-";
+  const std::string state = job.value("state", "");
+  if (state == "done") return fmt::format("{}/{}", sheets, sheets);
+  if (state == "running" || state == "paused" || state == "interrupted" || state == "failed") {
+    return fmt::format("{}/{}", std::max(0, job.value("sheet", 0) - 1), sheets);
+  }
+  return fmt::format("0/{}", sheets);
+}
+
+std::string shortened(const std::string& text, size_t width) {
+  return text.size() <= width ? text : text.substr(0, width - 3) + "...";
+}
+
+void printJobs(const json& jobs) {
+  if (jobs.empty()) {
+    fmt::print("no jobs; submit one with `rotafab submit MESH --structure band`\n");
+    return;
+  }
+  fmt::print("{:>4}  {:<11}  {:<10}  {:>6}  {:<10}  {:<22}  {}\n", "ID", "STATE", "DEVICE", "SHEETS", "OWNER", "SOURCE",
+             "NOTE");
+  for (const json& job : jobs) {
+    const std::string device = job["device"].is_string() ? job["device"].get<std::string>() : "any";
+    std::string state = job.value("state", "");
+    if (job.value("waiting_for_next", false)) state += "*";
+    fmt::print("{:>4}  {:<11}  {:<10}  {:>6}  {:<10}  {:<22}  {}\n", job.value("id", 0), state, device, sheetsOf(job),
+               shortened(job.value("owner", ""), 10),
+               shortened(fs::path(job.value("source", "")).filename().string(), 22),
+               shortened(job.value("message", ""), 70));
+  }
+  if (std::any_of(jobs.begin(), jobs.end(), [](const json& job) { return job.value("waiting_for_next", false); })) {
+    fmt::print("* waiting for the next sheet to be loaded: `rotafab next ID` once it is\n");
+  }
+}
+
+std::string progressLine(const json& progress) {
+  if (progress.value("phase", "") == "cutting") {
+    const double strokes = std::max(1.0, progress.value("strokes", 0.0));
+    const int percent = static_cast<int>(100 * progress.value("stroke", 0.0) / strokes);
+    const int filled = percent / 5;
+    return fmt::format("sheet {} of {} [{}{}] {:3}%  stroke {} of {}, {} left", progress.value("sheet", 0),
+                       progress.value("sheets", 0), std::string(filled, '#'), std::string(20 - filled, '.'), percent,
+                       progress.value("stroke", 0), progress.value("strokes", 0),
+                       core::minutes(progress.value("seconds_left", 0.0)));
+  }
+  std::string line = fmt::format("planning: {}", progress.value("phase", ""));
+  if (!progress.value("step", "").empty()) line += ": " + progress.value("step", "");
+  if (progress.value("total", 0) > 0)
+    line += fmt::format(" {} of {}", progress.value("done", 0), progress.value("total", 0));
+  if (progress.contains("layout_sheets")) line += fmt::format(", {} sheets", progress.value("layout_sheets", 0));
+  return line;
+}
+
+void printStatus(const json& job) {
+  const std::string device = job["device"].is_string() ? job["device"].get<std::string>() : "any device that fits";
+  fmt::print("job {}: {} ({}), {}\n", job.value("id", 0), job.value("source", ""), job.value("kind", ""),
+             job.value("state", ""));
+  fmt::print("  owner {}, device {}, priority {}, submitted {}\n", job.value("owner", ""), device,
+             job.value("priority", 0), job.value("submitted", ""));
+  if (job.contains("summary") && job["summary"].is_object()) {
+    const json& summary = job["summary"];
+    std::string line =
+        fmt::format("  {} sheet{}", summary.value("sheets", 0), summary.value("sheets", 0) == 1 ? "" : "s");
+    if (summary.contains("panels")) line += fmt::format(", {} panels", summary.value("panels", 0));
+    if (summary.contains("fasteners")) line += fmt::format(", {} fasteners", summary.value("fasteners", 0));
+    if (summary.contains("utilization"))
+      line += fmt::format(", {:.0f}% of the material", 100 * summary.value("utilization", 0.0));
+    if (summary.contains("cost") && summary["cost"].contains("cutting_seconds")) {
+      line += fmt::format(", about {} to cut", core::minutes(summary["cost"].value("cutting_seconds", 0.0)));
+    }
+    fmt::print("{}\n", line);
+  }
+  if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
+  if (job.value("waiting_for_next", false)) {
+    fmt::print("  waiting: load sheet {} and run `rotafab next {}`\n", job.value("sheet", 0) + 1, job.value("id", 0));
+  }
+  fmt::print("  {}\n", job.value("message", ""));
+  if (job.contains("transitions")) {
+    fmt::print("  history:\n");
+    for (const json& t : job["transitions"]) {
+      fmt::print("    {}  {:<11} {}\n", t.value("at", ""), t.value("to", ""), t.value("reason", ""));
+    }
+  }
+}
+
+bool settled(const json& job) {
+  const std::string state = job.value("state", "");
+  return state == "done" || state == "failed" || state == "cancelled" || state == "interrupted" || state == "ready";
+}
+
+// Follows a job's events until it settles: done, failed, cancelled,
+// interrupted, or ready (planned: an operator starts it).
+int follow(const DaemonClient& client, long long id) {
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  json job = client.get(fmt::format("/api/jobs/{}", id));
+  printStatus(job);
+  if (settled(job)) return job.value("state", "") == "failed" ? kDeviceFault : kSuccess;
+  std::string lastState = job.value("state", "");
+  bool barShown = false;
+  int lastSheet = 0;
+  const auto endBar = [&] {
+    if (barShown && terminal) fmt::print(stderr, "\n");
+    barShown = false;
+  };
+  int status = kSuccess;
+  client.events(fmt::format("/api/events?job={}", id), [&](const std::string& type, const json& data) {
+    if (type == "progress") {
+      if (data.value("phase", "") == "cutting" && data.value("sheet", 0) != lastSheet) {
+        endBar();
+        lastSheet = data.value("sheet", 0);
+      }
+      const std::string line = progressLine(data);
+      if (terminal) {
+        fmt::print(stderr, "\r{:<90}", line);
+        barShown = true;
+      } else if (data.value("stroke", 1) == data.value("strokes", 0) || data.value("phase", "") != "cutting") {
+        fmt::print(stderr, "{}\n", line);
+      }
+      return true;
+    }
+    if (type != "job") return true;
+    const std::string state = data.value("state", "");
+    if (state != lastState || data.value("waiting_for_next", false)) {
+      endBar();
+      fmt::print(stderr, "job {}: {}: {}\n", id, state, data.value("message", ""));
+      if (data.value("waiting_for_next", false)) {
+        fmt::print(stderr, "job {}: load sheet {} and run `rotafab next {}`\n", id, data.value("sheet", 0) + 1, id);
+      }
+      lastState = state;
+    }
+    if (settled(data)) {
+      status = state == "failed" ? kDeviceFault : kSuccess;
+      return false;
+    }
+    return true;
+  });
+  return status;
+}
+
+long long jobNumber(const std::string& text) {
+  try {
+    size_t used = 0;
+    const long long id = std::stoll(text, &used);
+    if (used == text.size() && id > 0) return id;
+  } catch (const std::exception&) {
+  }
+  throw UserError(fmt::format("{}: expected a job number (see `rotafab jobs`)", text));
+}
+
+// The make options given to `submit`, as the words `rotafab make` takes.
+std::vector<std::string> makeWords(const CLI::App& submit) {
+  std::vector<std::string> words;
+  for (const CLI::Option* option : submit.get_options()) {
+    const std::string name = option->get_name();
+    if (option->count() == 0 || !name.starts_with("--")) continue;
+    if (name == "--json" || name == "--server" || name == "--token" || name == "--device" || name == "--priority" ||
+        name == "--help" || name == "--follow") {
+      continue;
+    }
+    if (option->get_expected_max() == 0) {
+      words.push_back(name);
+      continue;
+    }
+    for (const std::string& value : option->results()) words.push_back(name), words.push_back(value);
+  }
+  return words;
+}
+
+// The job as an action left it ("job 7: running: started by alice"), or,
+// for a cancel the daemon answered before the device or the plan stopped, that it is stopping.
+void printAnswer(const json& answer, const std::string& action, bool asJson) {
+  const std::string state = answer.value("state", "");
+  if (asJson) {
+    std::cout << answer.dump() << '\n';
+  } else if (action == "cancel" && state != "cancelled") {
+    fmt::print("job {}: stopping (`rotafab status {}` says when it has)\n", answer.value("id", 0),
+               answer.value("id", 0));
+  } else {
+    fmt::print("job {}: {}: {}\n", answer.value("id", 0), state, answer.value("message", ""));
+  }
+}
+
+}  // namespace
+
+int runDaemonDevices(bool asJson, const std::string& server, const std::string& token) {
+  return talking([&]() -> int {
+    const json answer = DaemonClient(serverAddress(server, token)).get("/api/devices");
+    if (asJson) {
+      std::cout << answer.dump(1) << '\n';
+      return kSuccess;
+    }
+    fmt::print("{:<10}  {:<9}  {:<16}  {:>4}  {}\n", "DEVICE", "STATE", "MACHINE", "JOB", "URI / MESSAGE");
+    for (const json& device : answer["devices"]) {
+      fmt::print("{:<10}  {:<9}  {:<16}  {:>4}  {}{}\n", device.value("name", ""), device.value("state", ""),
+                 device.value("machine", ""),
+                 device["job"].is_null() ? "-" : std::to_string(device["job"].get<long long>()),
+                 device.value("uri", ""), device.contains("message") ? ": " + device.value("message", "") : "");
+    }
+    return kSuccess;
+  });
+}
+
+int runDaemonManifest(long long job, const std::string& format, const std::string& server, const std::string& token) {
+  return talking([&]() -> int {
+    const json manifest = DaemonClient(serverAddress(server, token)).get(fmt::format("/api/jobs/{}/manifest", job));
+    if (format == "json") {
+      std::cout << manifest.dump(1) << '\n';
+    } else if (format == "html") {
+      throw UserError("--format html needs the sheets beside the manifest: run it on a `make` output folder");
+    } else {
+      std::cout << jobs::manifestText(manifest);
+    }
+    return kSuccess;
+  });
+}
+
+void addQueueCommands(CLI::App& app, int& status) {
+  // submit
+  {
+    auto client = std::make_shared<ClientOptions>();
+    auto make = std::make_shared<MakeOptions>();
+    auto device = std::make_shared<std::string>();
+    auto priority = std::make_shared<int>(0);
+    auto follows = std::make_shared<bool>(false);
+    CLI::App* submit = app.add_subcommand(
+        "submit", "Queue a mesh (planned with `make` options) or a `make` output folder on the daemon");
+    addMakeOptions(*submit, *make);
+    submit->get_option("MESH")->description(
+        "A mesh file (uploaded), or a `make` output folder on the daemon's machine");
+    submit->get_option("--structure")->required(false);
+    submit->get_option("--out")->description("(not for submit: the daemon keeps the job's files)");
+    submit->get_option("--json")->description("Print the job as the daemon's JSON");
+    submit->add_option("--device", *device, "The device to cut on (default: any device whose machine profile fits)");
+    submit->add_option("--priority", *priority, "Higher is cut first (default 0)");
+    submit->add_flag("--follow", *follows, "Then follow the job until it is planned (or fails)");
+    addClientOptions(*submit, *client, false);
+    submit->footer(
+        "The job is planned once, against its device's machine profile; it is cut only after `rotafab start JOB`\n"
+        "(unless the device has auto_start), with a stop before each sheet after the first (`rotafab next JOB`).\n\n"
+        "Examples:\n"
+        "  rotafab submit examples/bunny.obj --structure band --follow\n"
+        "  rotafab submit examples/cube.obj --structure band --device laser1 --priority 5\n"
+        "  rotafab submit $PWD/cube-band/          # a folder `rotafab make` wrote, cut as it is");
+    submit->callback([submit, client, make, device, priority, follows, &status] {
+      std::error_code isFolder;
+      if (make->structure.empty() && !fs::is_directory(make->mesh, isFolder)) {
+        throw CLI::ValidationError("--structure is required to plan a mesh (band or weave)");
+      }
+      status = talking([&]() -> int {
+        if (!make->out.empty())
+          throw UserError("--out: the daemon keeps a submitted job's files; `rotafab make` writes a folder");
+        const DaemonClient daemon = clientOf(*client);
+        const std::vector<std::string> words = makeWords(*submit);
+        std::error_code error;
+        json job;
+        if (fs::is_directory(make->mesh, error)) {
+          if (!words.empty()) {
+            throw UserError(fmt::format("{}: a planned folder is cut as `make` made it; {} is an option for a mesh",
+                                        make->mesh, words.front()));
+          }
+          json body{{"path", fs::absolute(make->mesh).lexically_normal().string()}, {"priority", *priority}};
+          if (!device->empty()) body["device"] = *device;
+          job = daemon.post("/api/jobs", body);
+        } else {
+          std::ifstream in(make->mesh, std::ios::binary);
+          if (!in) throw UserError(fmt::format("{}: cannot read the file", make->mesh));
+          std::ostringstream bytes;
+          bytes << in.rdbuf();
+          std::vector<std::pair<std::string, std::string>> fields{{"options", json(words).dump()},
+                                                                  {"priority", std::to_string(*priority)}};
+          if (!device->empty()) fields.emplace_back("device", *device);
+          job = daemon.upload("/api/jobs", fs::path(make->mesh).filename().string(), bytes.str(), fields);
+        }
+        if (make->json) {
+          std::cout << job.dump() << '\n';
+        } else {
+          fmt::print("job {}: {} queued{}\n", job.value("id", 0), job.value("source", ""),
+                     job["device"].is_string() ? " for " + job["device"].get<std::string>() : "");
+        }
+        if (*follows) return follow(daemon, job.value("id", 0LL));
+        if (!make->json) fmt::print("follow it with `rotafab status {} --follow`\n", job.value("id", 0));
+        return kSuccess;
+      });
+    });
+  }
+  // jobs
+  {
+    auto client = std::make_shared<ClientOptions>();
+    CLI::App* jobs = app.add_subcommand("jobs", "List the daemon's jobs in queue order");
+    addClientOptions(*jobs, *client);
+    jobs->callback([client, &status] {
+      status = talking([&]() -> int {
+        const json answer = clientOf(*client).get("/api/jobs");
+        if (client->json) {
+          std::cout << answer.dump(1) << '\n';
+        } else {
+          printJobs(answer["jobs"]);
+        }
+        return kSuccess;
+      });
+    });
+  }
+  // status
+  {
+    auto client = std::make_shared<ClientOptions>();
+    auto job = std::make_shared<std::string>();
+    auto follows = std::make_shared<bool>(false);
+    CLI::App* statusVerb = app.add_subcommand("status", "A job's state, progress and history");
+    statusVerb->add_option("JOB", *job, "The job's number")->required();
+    statusVerb->add_flag("--follow", *follows,
+                         "Show live progress until the job is done, fails, is cancelled or interrupted, or is planned");
+    addClientOptions(*statusVerb, *client);
+    statusVerb->callback([client, job, follows, &status] {
+      status = talking([&]() -> int {
+        const long long id = jobNumber(*job);
+        const DaemonClient daemon = clientOf(*client);
+        if (*follows) return follow(daemon, id);
+        const json answer = daemon.get(fmt::format("/api/jobs/{}", id));
+        if (client->json) {
+          std::cout << answer.dump(1) << '\n';
+        } else {
+          printStatus(answer);
+        }
+        return kSuccess;
+      });
+    });
+  }
+  // cancel, pause, start, next: a job number and nothing else
+  const auto addSimple = [&app, &status](const char* verb, const char* help) {
+    auto client = std::make_shared<ClientOptions>();
+    auto job = std::make_shared<std::string>();
+    CLI::App* command = app.add_subcommand(verb, help);
+    command->add_option("JOB", *job, "The job's number")->required();
+    addClientOptions(*command, *client);
+    const std::string name = verb;
+    command->callback([client, job, name, &status] {
+      status = talking([&]() -> int {
+        const json answer =
+            clientOf(*client).post(fmt::format("/api/jobs/{}/{}", jobNumber(*job), name), json::object());
+        printAnswer(answer, name, client->json);
+        return kSuccess;
+      });
+    });
+  };
+  addSimple("cancel", "Cancel a job; a cut stops with the laser off");
+  addSimple("pause", "Hold a running cut (feed hold); `rotafab resume JOB` goes on");
+  // resume
+  {
+    auto client = std::make_shared<ClientOptions>();
+    auto job = std::make_shared<std::string>();
+    auto fromSheet = std::make_shared<std::optional<int>>();
+    CLI::App* resume =
+        app.add_subcommand("resume", "Go on with a paused job, or an interrupted or failed one from a sheet");
+    resume->add_option("JOB", *job, "The job's number")->required();
+    resume
+        ->add_option("--from-sheet", *fromSheet,
+                     "For an interrupted or failed job: the sheet to cut again from (loaded, fresh)")
+        ->check(CLI::PositiveNumber);
+    addClientOptions(*resume, *client);
+    resume->footer(
+        "A job the daemon was cutting when it stopped comes back interrupted and never restarts by itself:\n"
+        "check the machine, load the sheet, then resume it from that sheet.\n\n"
+        "Examples:\n"
+        "  rotafab resume 7\n"
+        "  rotafab resume 7 --from-sheet 3");
+    resume->callback([client, job, fromSheet, &status] {
+      status = talking([&]() -> int {
+        json body = json::object();
+        if (*fromSheet) body["from_sheet"] = **fromSheet;
+        printAnswer(clientOf(*client).post(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body), "resume",
+                    client->json);
+        return kSuccess;
+      });
+    });
+  }
+  addSimple("start", "Cut a planned job on its device, from its first sheet (load it first)");
+  addSimple("next", "Say the next sheet is loaded: the job cuts it");
+  // move
+  {
+    auto client = std::make_shared<ClientOptions>();
+    auto job = std::make_shared<std::string>();
+    auto before = std::make_shared<std::string>();
+    auto priority = std::make_shared<std::optional<int>>();
+    CLI::App* move = app.add_subcommand("move", "Reorder the queue: a job before another, or a new priority");
+    move->add_option("JOB", *job, "The job's number")->required();
+    auto* beforeOption = move->add_option("--before", *before, "Put it just before this job (and at its priority)");
+    move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
+    addClientOptions(*move, *client);
+    move->callback([client, job, before, priority, &status] {
+      status = talking([&]() -> int {
+        json body = json::object();
+        if (!before->empty()) body["before"] = jobNumber(*before);
+        if (*priority) body["priority"] = **priority;
+        if (body.empty()) throw UserError("move: give --before OTHER or --priority P");
+        const DaemonClient daemon = clientOf(*client);
+        daemon.post(fmt::format("/api/jobs/{}/move", jobNumber(*job)), body);
+        const json answer = daemon.get("/api/jobs");
+        if (client->json) {
+          std::cout << answer.dump(1) << '\n';
+        } else {
+          printJobs(answer["jobs"]);
+        }
+        return kSuccess;
+      });
+    });
+  }
+}
+
+}  // namespace rotafab::cli

@@ -1,0 +1,64 @@
+#pragma once
+// The daemon's configuration (SPEC, "Daemon"): `rotafabd --config FILE`,
+// YAML, validated as the profiles are (one line, "FILE:LINE:COL: key: what
+// is wrong"), every key optional. With no file at all the daemon runs with
+// the defaults: state in $XDG_STATE_HOME/rotafab (else
+// ~/.local/state/rotafab), one simulated GRBL, the Unix socket.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace rotafab::service {
+
+struct DeviceConfig {
+  std::string name;                      // how people and the API call it: "laser1"
+  std::string machine;                   // its machine profile: what jobs for it are planned against
+  std::string uri;                       // SPEC's device URI
+  std::string material = "posterboard";  // the power and speed overrides its jobs are cut with
+  bool autoStart = false;                // cut a job once planned, with no operator's `start`
+};
+
+struct TokenConfig {
+  std::string name;  // who holds it: the owner of what they submit
+  std::string hash;  // "sha256$SALT$HEX" (hashToken())
+};
+
+struct DaemonConfig {
+  std::filesystem::path file;  // the file it was read from; empty: the defaults
+  std::filesystem::path stateDir;
+  std::string host;  // this daemon's name (default: the host name)
+  // "unix:PATH" and "tcp://HOST:PORT"; the first Unix one is where `rotafab` looks.
+  std::vector<std::string> listen;
+  std::vector<TokenConfig> tokens;
+  std::vector<DeviceConfig> devices;
+  size_t uploadLimit = 256u << 20;  // bytes of one request's body
+  size_t connectionLimit = 64;
+  double headerTimeout = 10;  // seconds for a request's header to arrive
+  double bodyTimeout = 120;   // seconds for its body
+  unsigned planners = 1;      // jobs planned at once (each on every core)
+};
+
+// $XDG_STATE_HOME/rotafab, else ~/.local/state/rotafab.
+std::filesystem::path defaultStateDir();
+// $XDG_RUNTIME_DIR/rotafab/rotafabd.sock, else rotafabd.sock in `stateDir`.
+std::filesystem::path defaultSocket(const std::filesystem::path& stateDir);
+
+// The defaults: what the daemon runs with when no file is given.
+DaemonConfig defaultConfig();
+
+// Reads `file`; throws ConfigError (one line, FILE:LINE:COL: key: what is wrong).
+DaemonConfig loadConfig(const std::filesystem::path& file);
+
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A token's salted hash as the configuration keeps it: "sha256$SALT$HEX".
+std::string hashToken(const std::string& token, const std::string& salt);
+// Whether `token` is the one `hash` was made from; compares in constant time.
+bool tokenMatches(const std::string& token, const std::string& hash);
+
+}  // namespace rotafab::service

@@ -1,0 +1,118 @@
+#pragma once
+// Where the daemon keeps its jobs (SPEC, "Daemon"): jobs, every transition
+// of each with its time and reason, and events. A small interface of its
+// own so that another engine can stand behind it (a store shared by several
+// hosts); SqliteStore.h is the one there is. Every call is one transaction:
+// when it returns, what it wrote survives a kill of the process and a loss
+// of power (the engine syncs before it returns). Calls come from one thread
+// at a time (the daemon's state strand).
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "daemon/service/JobState.h"
+
+namespace rotafab::service {
+
+using JobId = int64_t;
+
+// What a job is made from: a mesh to plan with `make` options, or an already planned `make` output folder.
+enum class JobKind { Mesh, Planned };
+std::string_view kindName(JobKind kind);
+
+struct NewJob {
+  JobKind kind = JobKind::Mesh;
+  std::string source;   // the mesh file or folder as the submitter named it (for people)
+  std::string owner;    // who submitted it
+  std::string device;   // the device asked for; empty: any device whose machine profile fits
+  int priority = 0;     // higher first
+  std::string options;  // the `make` options, as JSON (an array of command-line words)
+  std::string spool;    // its folder in the spool, relative to the spool directory; durable before the job is added
+};
+
+struct JobRecord {
+  JobId id = 0;
+  JobState state = JobState::Queued;
+  JobKind kind = JobKind::Mesh;
+  std::string source, owner, device, options, spool;
+  int priority = 0;
+  double position = 0;                // the order within a priority, lower first
+  double submitted = 0, updated = 0;  // Unix seconds
+  // Once planned: the sheets, and a summary (JSON: panels, sheets, utilization, estimate).
+  int sheets = 0;
+  std::string summary;
+  // How far the cut got: the sheet (1-based; 0 before the first) and the strokes of it acknowledged.
+  int sheet = 0;
+  int64_t stroke = 0, strokes = 0;
+  std::string message;  // the reason of the last transition
+};
+
+// Fields a transition or a progress report changes with it (unset: unchanged).
+struct JobChange {
+  std::optional<std::string> device, summary;
+  std::optional<int> sheets, sheet;
+  std::optional<int64_t> stroke, strokes;
+};
+
+struct Transition {
+  JobId job = 0;
+  std::optional<JobState> from;  // none: the job's submission
+  JobState to = JobState::Queued;
+  double at = 0;
+  std::string reason;
+};
+
+struct Event {
+  int64_t id = 0;
+  std::optional<JobId> job;
+  double at = 0;
+  std::string kind, text;
+};
+
+// The store cannot do what it was asked (the disk is full, the file is not
+// a database, the schema is newer than this program): one line.
+class StoreError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class JobStore {
+ public:
+  virtual ~JobStore() = default;
+  // Adds a queued job (last in its priority) and its submission as its first transition.
+  virtual JobRecord addJob(const NewJob& job, std::string_view reason) = 0;
+  [[nodiscard]] virtual std::optional<JobRecord> job(JobId id) = 0;
+  // Every job in queue order: priority (higher first), then position.
+  [[nodiscard]] virtual std::vector<JobRecord> jobs() = 0;
+  // Moves a job to `to` if the table allows it from the state it is in
+  // (JobState.h; TransitionRefused otherwise, naming both), with `change`,
+  // and records the transition, all in one transaction.
+  virtual JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change = {}) = 0;
+  // Progress without a change of state.
+  virtual void update(JobId id, const JobChange& change) = 0;
+  // A new place in the queue.
+  virtual void reorder(JobId id, int priority, double position) = 0;
+  [[nodiscard]] virtual std::vector<Transition> transitions(JobId id) = 0;
+  virtual void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) = 0;
+  [[nodiscard]] virtual std::vector<Event> events(std::optional<JobId> job, size_t newest) = 0;
+  // The schema version of the store as opened.
+  [[nodiscard]] virtual int schemaVersion() = 0;
+  // Whether the engine finds the store sound ("ok"), or what it finds wrong.
+  [[nodiscard]] virtual std::string integrityCheck() = 0;
+};
+
+// SQLite in WAL mode with synchronous=FULL, in `file` (created when missing),
+// migrated to the newest schema. `upToVersion` stops the migrations there
+// (for the tests of each one). Throws StoreError.
+std::unique_ptr<JobStore> openSqliteStore(const std::filesystem::path& file,
+                                          std::optional<int> upToVersion = std::nullopt);
+// The newest schema version this program knows.
+int newestSchemaVersion();
+
+}  // namespace rotafab::service

@@ -1,0 +1,1129 @@
+#include "daemon/service/Service.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <boost/asio/post.hpp>
+#include <chrono>
+#include <fstream>
+#include <future>
+#include <set>
+#include <thread>
+
+#include "core/Executor.h"
+#include "core/UserError.h"
+#include "core/WorkContext.h"
+#include "daemon/MakeOptions.h"
+#include "devices/Device.h"
+#include "devices/DriverEntry.h"
+#include "devices/JobRun.h"
+#include "geometry/PolygonMesh.h"
+#include "jobs/JobSheets.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::service {
+namespace asio = boost::asio;
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+std::string isoTime(double unixSeconds) {
+  const auto seconds = static_cast<std::time_t>(unixSeconds);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[32];
+  std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+// The `make` options a job may carry: those of `rotafab make` but the
+// output folder and the summary's form, which are the daemon's to choose.
+void checkSubmittedOptions(const CLI::App& make) {
+  for (const char* own : {"--out", "--json"}) {
+    if (make.count(own) > 0) {
+      throw ApiError(400, fmt::format("{} is not a submission's option: the daemon keeps the job's files and "
+                                      "`rotafab status --json` gives its summary",
+                                      own));
+    }
+  }
+}
+
+// Parses the words as `rotafab make MESH WORDS...` would.
+cli::MakeOptions parseMakeOptions(const std::string& mesh, const std::vector<std::string>& words, bool& machineGiven,
+                                  bool& materialGiven) {
+  cli::MakeOptions options;
+  CLI::App make{"make"};
+  cli::addMakeOptions(make, options);
+  std::vector<std::string> arguments(words.rbegin(), words.rend());
+  arguments.push_back(mesh);
+  try {
+    make.parse(arguments);
+  } catch (const CLI::ParseError& error) {
+    throw ApiError(400, fmt::format("make options: {}", error.what()));
+  }
+  checkSubmittedOptions(make);
+  machineGiven = make.count("--machine") > 0;
+  materialGiven = make.count("--material") > 0;
+  return options;
+}
+
+// A message about a file in the spool, in the words of the file the submitter named.
+std::string inSubmittersWords(std::string message, const fs::path& folder) {
+  const std::string prefix = folder.string() + "/";
+  for (size_t at = message.find(prefix); at != std::string::npos; at = message.find(prefix)) {
+    message.erase(at, prefix.size());
+  }
+  return message;
+}
+
+std::string sheetWhere(int sheet, int sheets, int64_t stroke, int64_t strokes) {
+  if (sheet <= 0) return "before the first sheet";
+  return fmt::format("at sheet {} of {}, after stroke {} of {}", sheet, sheets, stroke, strokes);
+}
+
+}  // namespace
+
+// Between a running job's driver thread and the strand.
+struct RunControl {
+  core::Cancellation cancel;
+  std::atomic<bool> shutdown{false};
+  std::atomic<devices::JobRun*> run{nullptr};
+};
+
+struct Service::Impl {
+  struct Device {
+    DeviceConfig config;
+    profiles::MachineProfile machine;
+    profiles::MaterialProfile material;
+    std::string state = "checking";  // checking, idle, running, paused, offline, fault
+    std::string message;
+    std::string checked;  // what the check at the daemon's start found
+    std::optional<JobId> job;
+  };
+  struct Planning {
+    std::shared_ptr<core::Cancellation> cancel;
+    json progress;
+    std::string cancelledBy;  // who asked; empty: the daemon stopping
+  };
+  struct Cut {
+    std::shared_ptr<RunControl> control;
+    std::thread thread;
+    size_t device = 0;
+    int firstSheet = 1;
+    json progress;
+    std::optional<std::promise<bool>> waiting;  // set while the job waits for `next`
+    std::string cancelledBy;
+    Clock::time_point lastStored{}, lastSent{};
+  };
+
+  Impl(asio::io_context& io, const DaemonConfig& config, std::shared_ptr<spdlog::logger> log)
+      : io(io),
+        config(config),
+        log(std::move(log)),
+        planners(config.planners),
+        executor(std::make_unique<core::Executor>(std::max(1u, std::thread::hardware_concurrency()))) {}
+
+  asio::io_context& io;
+  const DaemonConfig& config;
+  std::shared_ptr<spdlog::logger> log;
+  asio::thread_pool state{1};
+  asio::strand<asio::thread_pool::executor_type> strand{state.get_executor()};
+  asio::thread_pool workers{2};
+  asio::thread_pool planners;
+  std::unique_ptr<core::Executor> executor;
+  std::unique_ptr<JobStore> store;
+  std::unique_ptr<Spool> spool;
+  profiles::ProfileCatalogue catalogue;
+  std::vector<Device> devices;
+  std::map<JobId, Planning> planning;
+  std::map<JobId, std::unique_ptr<Cut>> cuts;
+  std::vector<std::thread> checks;
+  std::map<size_t, std::function<void(const ServiceEvent&)>> subscribers;
+  size_t nextSubscriber = 1;
+  bool stopping = false;
+  std::function<void()> stopped;
+
+  template <typename Work>
+  void onStrand(Work&& work) {
+    asio::post(strand, std::forward<Work>(work));
+  }
+
+  // Runs `work` on the strand and replies with what it returns, or the error it throws.
+  void answer(ReplyHandler done, std::function<Reply()> work) {
+    onStrand([this, done = std::move(done), work = std::move(work)] { done(guarded(work)); });
+  }
+
+  Reply guarded(const std::function<Reply()>& work) {
+    try {
+      return work();
+    } catch (const ApiError& error) {
+      return {error.status, {{"error", error.what()}}};
+    } catch (const TransitionRefused& error) {
+      return {409, {{"error", error.what()}}};
+    } catch (const StoreError& error) {
+      log->error("{}", error.what());
+      return {507, {{"error", error.what()}}};
+    } catch (const std::exception& error) {
+      log->error("{}", error.what());
+      return {500, {{"error", error.what()}}};
+    }
+  }
+
+  void publish(const std::string& type, json data) {
+    const ServiceEvent event{type, std::move(data)};
+    for (const auto& [id, sink] : subscribers) sink(event);
+  }
+
+  Device* deviceNamed(const std::string& name) {
+    for (Device& device : devices) {
+      if (device.config.name == name) return &device;
+    }
+    return nullptr;
+  }
+
+  std::string deviceNames() const {
+    std::string names;
+    for (const Device& device : devices) names += (names.empty() ? "" : ", ") + device.config.name;
+    return names;
+  }
+
+  JobRecord jobOrThrow(JobId id) {
+    auto job = store->job(id);
+    if (!job) throw ApiError(404, fmt::format("there is no job {}", id));
+    return *job;
+  }
+
+  fs::path plannedFolder(const JobRecord& job) const {
+    const fs::path folder = spool->pathOf(job.spool);
+    return job.kind == JobKind::Planned ? folder : folder / "planned";
+  }
+
+  json deviceJson(const Device& device) const {
+    json out{{"name", device.config.name},
+             {"uri", device.config.uri},
+             {"machine", device.machine.name},
+             {"material", device.material.name},
+             {"auto_start", device.config.autoStart},
+             {"state", device.state}};
+    if (!device.message.empty()) out["message"] = device.message;
+    if (!device.checked.empty()) out["checked"] = device.checked;
+    out["job"] = device.job ? json(*device.job) : json(nullptr);
+    return out;
+  }
+
+  json jobJson(const JobRecord& job) const {
+    json out{{"id", job.id},
+             {"state", stateName(job.state)},
+             {"kind", kindName(job.kind)},
+             {"source", job.source},
+             {"owner", job.owner},
+             {"device", job.device.empty() ? json(nullptr) : json(job.device)},
+             {"priority", job.priority},
+             {"submitted", isoTime(job.submitted)},
+             {"updated", isoTime(job.updated)},
+             {"sheets", job.sheets},
+             {"sheet", job.sheet},
+             {"stroke", job.stroke},
+             {"strokes", job.strokes},
+             {"message", job.message}};
+    out["options"] = json::parse(job.options.empty() ? "[]" : job.options, nullptr, false);
+    if (!job.summary.empty()) out["summary"] = json::parse(job.summary, nullptr, false);
+    if (const auto p = planning.find(job.id); p != planning.end() && !p->second.progress.is_null()) {
+      out["progress"] = p->second.progress;
+    }
+    if (const auto c = cuts.find(job.id); c != cuts.end()) {
+      if (!c->second->progress.is_null()) out["progress"] = c->second->progress;
+      out["waiting_for_next"] = c->second->waiting.has_value();
+    }
+    return out;
+  }
+
+  void jobChanged(const JobRecord& job) { publish("job", jobJson(job)); }
+
+  void deviceChanged(const Device& device) { publish("device", deviceJson(device)); }
+
+  // ---- start ----
+
+  void open() {
+    std::error_code error;
+    fs::create_directories(config.stateDir, error);
+    if (error) {
+      throw StoreError(
+          fmt::format("{}: cannot create the state directory: {}", config.stateDir.string(), error.message()));
+    }
+    store = openSqliteStore(config.stateDir / "jobs.sqlite3");
+    spool = std::make_unique<Spool>(config.stateDir / "spool");
+    catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+    const std::string where = config.file.empty() ? std::string("the default configuration") : config.file.string();
+    for (const DeviceConfig& deviceConfig : config.devices) {
+      Device device;
+      device.config = deviceConfig;
+      devices::ParsedUri uri;
+      try {
+        uri = devices::parseDeviceUri(deviceConfig.uri);
+      } catch (const std::invalid_argument& bad) {
+        throw ConfigError(fmt::format("{}: device {}: {}", where, deviceConfig.name, bad.what()));
+      }
+      try {
+        if (deviceConfig.machine.empty()) {
+          const auto machine = profiles::firstMachineFor(catalogue, uri.driver->name());
+          if (!machine) {
+            throw ConfigError(fmt::format("{}: device {}: no machine profile for the {} driver; give machine:", where,
+                                          deviceConfig.name, uri.driver->name()));
+          }
+          device.machine = *machine;
+        } else {
+          device.machine = profiles::findMachine(catalogue, deviceConfig.machine);
+        }
+        device.material = profiles::findMaterial(catalogue, deviceConfig.material);
+      } catch (const profiles::ProfileError& bad) {
+        throw ConfigError(fmt::format("{}: device {}: {}", where, deviceConfig.name, bad.what()));
+      }
+      if (device.machine.driver != uri.driver->name()) {
+        throw ConfigError(fmt::format("{}: device {}: machine {} is driven by {}, not by {}'s {} driver", where,
+                                      deviceConfig.name, device.machine.name, device.machine.driver, deviceConfig.uri,
+                                      uri.driver->name()));
+      }
+      devices.push_back(std::move(device));
+    }
+  }
+
+  // What a stop of the daemon left: jobs it was cutting become interrupted
+  // (never restarted), plans it was making are made again.
+  void recover() {
+    std::set<std::string> named;
+    for (const JobRecord& job : store->jobs()) {
+      named.insert(job.spool);
+      if (holdsDevice(job.state)) {
+        const std::string where = sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes);
+        const std::string reason = fmt::format(
+            "the daemon stopped while it cut, {}; check the machine and the sheet, then go on with `rotafab resume "
+            "{} --from-sheet {}`",
+            where, job.id, std::max(1, job.sheet));
+        store->transition(job.id, JobState::Interrupted, reason);
+        log->warn("job {}: {}", job.id, reason);
+      } else if (job.state == JobState::Planning) {
+        store->transition(job.id, JobState::Queued, "the daemon stopped while it planned; it is planned again");
+      }
+    }
+    if (const size_t removed = spool->removeOrphans(named); removed > 0) {
+      log->info("removed {} spool folder{} that no job names (left by a stop mid-submission)", removed,
+                removed == 1 ? "" : "s");
+    }
+  }
+
+  // Every device is stopped safely before anything is cut: whatever a run
+  // before this daemon left behind (a kill -9 mid-cut leaves a real GRBL
+  // burning through what it had buffered), its laser is off.
+  void checkDevices() {
+    for (size_t index = 0; index < devices.size(); ++index) {
+      const std::string uri = devices[index].config.uri;
+      const profiles::MachineProfile machine = devices[index].machine;
+      checks.emplace_back([this, index, uri, machine] {
+        std::string state = "idle", message;
+        try {
+          devices::ParsedUri parsed = devices::parseDeviceUri(uri);
+          devices::DeviceSetup setup;
+          for (profiles::Operation operation : profiles::kAllOperations) {
+            setup.colours[operation] = machine.settingFor(operation).rgb;
+          }
+          auto device = parsed.driver->open(*parsed.address, setup);
+          const std::string identity = device->connect();
+          const bool off = device->stopSafely();
+          device->disconnect();
+          message = off ? fmt::format("{}; stopped, laser off confirmed", identity)
+                        : fmt::format("{}; stopped, but the controller did not confirm its laser off", identity);
+        } catch (const devices::DeviceFault& fault) {
+          state = "offline";
+          message = fault.what();
+        } catch (const std::exception& error) {
+          state = "offline";
+          message = error.what();
+        }
+        onStrand([this, index, state, message] {
+          Device& device = devices[index];
+          if (device.state == "checking") device.state = state;
+          if (state == "offline") device.message = message;
+          device.checked = message;
+          if (state == "offline") {
+            log->warn("device {}: offline: {}", device.config.name, message);
+          } else {
+            log->info("device {}: {}", device.config.name, message);
+          }
+          store->addEvent(std::nullopt, "device", fmt::format("{}: {}: {}", device.config.name, state, message));
+          deviceChanged(device);
+          pump();
+        });
+      });
+    }
+  }
+
+  // ---- the queue ----
+
+  // Starts what can start: plans for queued jobs while a planner is free,
+  // and cuts of ready jobs on idle devices configured to start by themselves.
+  void pump() {
+    if (stopping) return;
+    std::vector<JobRecord> all;
+    try {
+      all = store->jobs();
+    } catch (const StoreError& error) {
+      log->error("{}", error.what());
+      return;
+    }
+    for (const JobRecord& job : all) {
+      if (planning.size() >= config.planners) break;
+      if (job.state == JobState::Queued) startPlanning(job);
+    }
+    for (size_t index = 0; index < devices.size(); ++index) {
+      Device& device = devices[index];
+      if (!device.config.autoStart || device.state != "idle" || device.job) continue;
+      for (const JobRecord& job : all) {
+        if (job.state == JobState::Ready && job.device == device.config.name) {
+          try {
+            startCut(store->job(job.id).value(), 1,
+                     fmt::format("started by itself: {} has auto_start", device.config.name));
+          } catch (const std::exception& error) {
+            log->error("job {}: {}", job.id, error.what());
+          }
+          break;
+        }
+      }
+    }
+  }
+
+  // The device a job is planned against: the one it names, or the first
+  // whose machine profile the job's options do not rule out.
+  Device* deviceFor(const JobRecord& job, std::string& why) {
+    if (!job.device.empty()) {
+      Device* device = deviceNamed(job.device);
+      if (!device) why = fmt::format("there is no device {} now (the devices: {})", job.device, deviceNames());
+      return device;
+    }
+    if (devices.empty()) {
+      why = "the daemon has no devices";
+      return nullptr;
+    }
+    const json words = json::parse(job.options.empty() ? "[]" : job.options, nullptr, false);
+    std::string machine;
+    if (words.is_array()) {
+      for (size_t i = 0; i + 1 < words.size(); ++i) {
+        if (words[i] == "--machine") machine = words[i + 1].get<std::string>();
+      }
+    }
+    for (Device& device : devices) {
+      if (machine.empty() || device.machine.name == machine) return &device;
+    }
+    why = fmt::format("no device has the machine profile {} (the devices: {})", machine, deviceNames());
+    return nullptr;
+  }
+
+  void startPlanning(const JobRecord& queued) {
+    std::string why;
+    Device* device = deviceFor(queued, why);
+    if (!device) {
+      jobChanged(store->transition(queued.id, JobState::Planning, "planning"));
+      jobChanged(store->transition(queued.id, JobState::Failed, why));
+      return;
+    }
+    JobChange change;
+    change.device = device->config.name;
+    const JobRecord job =
+        store->transition(queued.id, JobState::Planning,
+                          fmt::format("planning against {} ({})", device->config.name, device->machine.name), change);
+    jobChanged(job);
+    auto cancel = std::make_shared<core::Cancellation>();
+    planning[job.id] = Planning{cancel, json(), ""};
+    asio::post(planners, [this, job, machine = device->machine, material = device->material, cancel] {
+      plan(job, machine, material, cancel);
+    });
+  }
+
+  // On a planner: the job's plan, against its device's profiles.
+  void plan(const JobRecord& job, const profiles::MachineProfile& machine, const profiles::MaterialProfile& material,
+            const std::shared_ptr<core::Cancellation>& cancel) {
+    const fs::path folder = spool->pathOf(job.spool);
+    int sheets = 0;
+    json summary;
+    std::optional<std::string> failure;
+    bool cancelled = false;
+    try {
+      if (job.kind == JobKind::Planned) {
+        const auto planned = jobs::readJobSheets(folder, std::nullopt);
+        jobs::checkSheetsFitBed(planned, machine);
+        sheets = static_cast<int>(planned.size());
+        summary = {{"sheets", sheets}};
+        std::ifstream manifestFile(folder / "manifest.json");
+        const json manifest = json::parse(manifestFile, nullptr, false);
+        if (manifest.is_object()) {
+          if (manifest.contains("panels") && manifest["panels"].is_array()) {
+            summary["panels"] = manifest["panels"].size();
+          }
+          if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
+        }
+      } else {
+        const json words = json::parse(job.options.empty() ? "[]" : job.options);
+        bool machineGiven = false, materialGiven = false;
+        cli::MakeOptions options = parseMakeOptions((folder / job.source).string(),
+                                                    words.get<std::vector<std::string>>(), machineGiven, materialGiven);
+        if (machineGiven && options.machine != machine.name) {
+          throw ApiError(400,
+                         fmt::format("--machine {}: device {} is a {}", options.machine, job.device, machine.name));
+        }
+        options.machine = machine.name;
+        if (!materialGiven) options.material = material.name;
+        jobs::MakeRequest request = cli::requestOf(options, catalogue);
+        const JobId id = job.id;
+        auto last = std::make_shared<Clock::time_point>();
+        const core::WorkContext context(
+            *executor, *cancel,
+            [this, id, last](const core::Progress& progress) {
+              const auto now = Clock::now();
+              if (now - *last < std::chrono::milliseconds(250) && progress.total != progress.done) return;
+              *last = now;
+              json data{{"job", id},
+                        {"phase", progress.phase},
+                        {"step", progress.step},
+                        {"done", progress.done},
+                        {"total", progress.total}};
+              if (progress.sheets > 0) data["layout_sheets"] = progress.sheets;
+              onStrand([this, id, data] {
+                if (auto p = planning.find(id); p != planning.end()) p->second.progress = data;
+                publish("progress", data);
+              });
+            },
+            log);
+        jobs::PlannedJob planned = jobs::makeJob(request, folder / "planned", context);
+        syncFolder(folder / "planned");
+        syncFolder(folder);
+        sheets = static_cast<int>(planned.files.size());
+        summary = jobs::summaryJson(planned);
+        summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
+        summary["cost"] = jobs::costJson(planned.cost);
+      }
+    } catch (const core::Cancelled&) {
+      cancelled = true;
+    } catch (const std::exception& error) {
+      failure = inSubmittersWords(error.what(), folder);
+    }
+    onStrand([this, id = job.id, sheets, summary, failure, cancelled] {
+      const std::string by = planning.count(id) ? planning[id].cancelledBy : "";
+      planning.erase(id);
+      try {
+        if (cancelled && by.empty()) {
+          store->transition(id, JobState::Queued, "the daemon stopped while it planned; it is planned again");
+        } else if (cancelled) {
+          jobChanged(store->transition(id, JobState::Cancelled, fmt::format("cancelled while planning by {}", by)));
+        } else if (failure) {
+          log->warn("job {}: {}", id, *failure);
+          jobChanged(store->transition(id, JobState::Failed, *failure));
+        } else {
+          JobChange change;
+          change.sheets = sheets;
+          change.summary = summary.dump();
+          const JobRecord ready = store->transition(
+              id, JobState::Ready,
+              fmt::format("planned: {} sheet{}; start it with `rotafab start {}`", sheets, sheets == 1 ? "" : "s", id),
+              change);
+          log->info("job {}: planned, {} sheets", id, sheets);
+          jobChanged(ready);
+        }
+      } catch (const std::exception& error) {
+        log->error("job {}: {}", id, error.what());
+      }
+      finishIfStopping();
+      pump();
+    });
+  }
+
+  void startCut(const JobRecord& job, int fromSheet, const std::string& reason) {
+    Device* device = deviceNamed(job.device);
+    if (!device) throw ApiError(409, fmt::format("job {}: there is no device {} now", job.id, job.device));
+    if (device->job) {
+      throw ApiError(409, fmt::format("{} is busy with job {}; job {} can start once it is done", device->config.name,
+                                      *device->job, job.id));
+    }
+    if (device->state == "offline" || device->state == "checking") {
+      throw ApiError(409, fmt::format("{} is {}{}", device->config.name, device->state,
+                                      device->message.empty() ? "" : ": " + device->message));
+    }
+    if (fromSheet < 1 || fromSheet > job.sheets) {
+      throw ApiError(400, fmt::format("job {} has sheets 1 to {}, not {}", job.id, job.sheets, fromSheet));
+    }
+    JobChange change;
+    change.sheet = fromSheet;
+    change.stroke = 0;
+    change.strokes = 0;
+    const JobRecord running = store->transition(job.id, JobState::Running, reason, change);
+    const size_t index = static_cast<size_t>(device - devices.data());
+    auto cut = std::make_unique<Cut>();
+    cut->control = std::make_shared<RunControl>();
+    cut->device = index;
+    cut->firstSheet = fromSheet;
+    device->job = job.id;
+    device->state = "running";
+    device->message.clear();
+    const fs::path folder = plannedFolder(job);
+    Cut& started = *cut;
+    cuts[job.id] = std::move(cut);
+    started.thread =
+        std::thread([this, id = job.id, control = started.control, uri = device->config.uri, machine = device->machine,
+                     material = device->material, folder, fromSheet,
+                     sheets = job.sheets] { runCut(id, control, uri, machine, material, folder, fromSheet, sheets); });
+    log->info("job {}: cutting on {} from sheet {}", job.id, device->config.name, fromSheet);
+    jobChanged(running);
+    deviceChanged(*device);
+  }
+
+  // On the job's own thread: the driver's loop, its events posted to the strand.
+  void runCut(JobId id, const std::shared_ptr<RunControl>& control, const std::string& uri,
+              const profiles::MachineProfile& machine, const profiles::MaterialProfile& material,
+              const fs::path& folder, int fromSheet, int sheets) {
+    std::optional<devices::DeviceFault> fault;
+    std::optional<std::string> failure;
+    devices::RunSummary summary;
+    // Destroyed on the strand, once the strand can no longer reach it through control->run.
+    std::shared_ptr<devices::JobRun> owned;
+    try {
+      devices::JobRunSetup setup;
+      setup.device = devices::parseDeviceUri(uri);
+      setup.machine = machine;
+      setup.material = material;
+      for (const jobs::JobSheet& sheet : jobs::readJobSheets(folder, std::nullopt)) {
+        if (sheet.index >= fromSheet) setup.sheets.push_back(sheet.drawing);
+      }
+      setup.cancellation = &control->cancel;
+      owned = std::make_shared<devices::JobRun>(std::move(setup));
+      devices::JobRun& run = *owned;
+      control->run = &run;
+      devices::RunEvents events;
+      events.beforeSheet = [this, id, control](const jobs::Toolpath&) {
+        std::promise<bool> loaded;
+        std::future<bool> answer = loaded.get_future();
+        onStrand([this, id, control, loaded = std::make_shared<std::promise<bool>>(std::move(loaded))]() mutable {
+          auto c = cuts.find(id);
+          if (c == cuts.end() || control->cancel.cancelled()) {
+            loaded->set_value(false);
+            return;
+          }
+          c->second->waiting.emplace(std::move(*loaded));
+          try {
+            const JobRecord job = store->job(id).value();
+            store->addEvent(id, "waiting",
+                            fmt::format("sheet {} cut; waiting for sheet {} to be loaded", job.sheet, job.sheet + 1));
+            jobChanged(job);
+          } catch (const std::exception& error) {
+            log->error("job {}: {}", id, error.what());
+          }
+        });
+        return answer.get();
+      };
+      events.sheetStarted = [this, id, fromSheet, sheets](size_t index, const jobs::Toolpath& toolpath,
+                                                          double seconds) {
+        const int sheet = fromSheet + static_cast<int>(index);
+        const auto strokes = static_cast<int64_t>(toolpath.strokes.size());
+        onStrand([this, id, sheet, sheets, strokes, seconds] {
+          auto c = cuts.find(id);
+          if (c == cuts.end()) return;
+          c->second->progress = {{"job", id},   {"phase", "cutting"}, {"sheet", sheet},         {"sheets", sheets},
+                                 {"stroke", 0}, {"strokes", strokes}, {"seconds_left", seconds}};
+          JobChange change;
+          change.sheet = sheet;
+          change.stroke = 0;
+          change.strokes = strokes;
+          try {
+            store->update(id, change);
+            store->addEvent(id, "sheet", fmt::format("sheet {} of {} started", sheet, sheets));
+            jobChanged(store->job(id).value());
+          } catch (const std::exception& error) {
+            log->error("job {}: {}", id, error.what());
+          }
+        });
+      };
+      events.progress = [this, id, fromSheet, sheets](const devices::Progress& progress) {
+        onStrand([this, id, progress, fromSheet, sheets] { cutProgress(id, progress, fromSheet, sheets); });
+      };
+      summary = run.run(false, events, control->cancel);
+      control->run = nullptr;
+    } catch (const devices::DeviceFault& caught) {
+      control->run = nullptr;
+      fault = caught;
+      if (fault->sheet > 0) fault->sheet += fromSheet - 1, fault->sheets = sheets;
+    } catch (const std::exception& error) {
+      control->run = nullptr;
+      failure = inSubmittersWords(error.what(), folder);
+    }
+    onStrand([this, id, fault, failure, summary, owned = std::move(owned)]() mutable {
+      cutEnded(id, fault, failure, summary);
+      owned.reset();  // disconnects the device
+    });
+  }
+
+  void cutProgress(JobId id, const devices::Progress& progress, int fromSheet, int sheets) {
+    auto c = cuts.find(id);
+    if (c == cuts.end()) return;
+    Cut& cut = *c->second;
+    const int sheet = fromSheet + progress.sheet - 1;
+    cut.progress = {{"job", id},
+                    {"phase", "cutting"},
+                    {"sheet", sheet},
+                    {"sheets", sheets},
+                    {"stroke", progress.stroke},
+                    {"strokes", progress.strokes},
+                    {"seconds_left", progress.secondsLeft}};
+    const auto now = Clock::now();
+    // The store is told at most once a second: enough to say after a kill
+    // where the cut had got to, without a synced write per stroke.
+    if (now - cut.lastStored >= std::chrono::seconds(1)) {
+      cut.lastStored = now;
+      JobChange change;
+      change.sheet = sheet;
+      change.stroke = static_cast<int64_t>(progress.stroke);
+      change.strokes = static_cast<int64_t>(progress.strokes);
+      try {
+        store->update(id, change);
+      } catch (const std::exception& error) {
+        log->error("job {}: {}", id, error.what());
+      }
+    }
+    if (now - cut.lastSent >= std::chrono::milliseconds(200) || progress.stroke == progress.strokes) {
+      cut.lastSent = now;
+      publish("progress", cut.progress);
+    }
+  }
+
+  void cutEnded(JobId id, const std::optional<devices::DeviceFault>& fault, const std::optional<std::string>& failure,
+                const devices::RunSummary& summary) {
+    auto c = cuts.find(id);
+    if (c == cuts.end()) return;
+    std::unique_ptr<Cut> cut = std::move(c->second);
+    cuts.erase(c);
+    if (cut->thread.joinable()) cut->thread.join();
+    Device& device = devices[cut->device];
+    device.job.reset();
+    device.state = "idle";
+    try {
+      const JobRecord job = store->job(id).value();
+      JobRecord ended;
+      if (!fault && !failure) {
+        JobChange change;
+        change.sheet = job.sheets;
+        change.stroke = job.strokes;
+        ended = store->transition(id, JobState::Done,
+                                  fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {:.1f} in burnt",
+                                              device.config.name, summary.sheets, summary.sheets == 1 ? "" : "s",
+                                              cut->firstSheet, summary.strokes, summary.burnt),
+                                  change);
+      } else if (failure) {
+        device.state = "fault";
+        device.message = *failure;
+        ended = store->transition(id, JobState::Failed, *failure);
+      } else {
+        JobChange change;
+        if (fault->sheet > 0) {
+          change.sheet = fault->sheet;
+          change.stroke = static_cast<int64_t>(fault->strokesDone);
+          change.strokes = static_cast<int64_t>(fault->strokes);
+        }
+        const std::string where =
+            fault->sheet == 0    ? std::string("before the first sheet")
+            : fault->nothingSent ? fmt::format("at sheet {} of {}, before any of it was sent", fault->sheet, job.sheets)
+                                 : sheetWhere(fault->sheet, job.sheets, static_cast<int64_t>(fault->strokesDone),
+                                              static_cast<int64_t>(fault->strokes));
+        const std::string laser = devices::laserStateAfter(*fault);
+        const int goOn = std::max(1, fault->sheet);
+        if (fault->kind == devices::FaultKind::Cancelled && cut->control->shutdown) {
+          ended =
+              store->transition(id, JobState::Interrupted,
+                                fmt::format("the daemon stopped {}; {}; go on with `rotafab resume {} --from-sheet {}`",
+                                            where, laser, id, goOn),
+                                change);
+        } else if (fault->kind == devices::FaultKind::Cancelled) {
+          ended =
+              store->transition(id, JobState::Cancelled,
+                                fmt::format("cancelled{} {}; {}",
+                                            cut->cancelledBy.empty() ? "" : " by " + cut->cancelledBy, where, laser),
+                                change);
+        } else {
+          device.state = "fault";
+          device.message = fault->what();
+          ended = store->transition(
+              id, JobState::Failed,
+              fmt::format("{} ({}; stopped {}; {}); to go on once it is fixed: `rotafab resume {} --from-sheet {}`",
+                          fault->what(), devices::faultName(fault->kind), where, laser, id, goOn),
+              change);
+        }
+      }
+      log->info("job {}: {}: {}", id, stateName(ended.state), ended.message);
+      jobChanged(ended);
+    } catch (const std::exception& error) {
+      log->error("job {}: {}", id, error.what());
+    }
+    deviceChanged(device);
+    finishIfStopping();
+    pump();
+  }
+
+  void finishIfStopping() {
+    if (!stopping || !cuts.empty() || !planning.empty() || !stopped) return;
+    auto done = std::move(stopped);
+    stopped = nullptr;
+    done();
+  }
+
+  // ---- actions ----
+
+  Reply act(JobId id, const std::string& action, const json& arguments, const std::string& who) {
+    if (stopping) throw ApiError(503, "the daemon is stopping");
+    const JobRecord job = jobOrThrow(id);
+    const auto refuse = [&](const std::string& why) -> Reply {
+      throw ApiError(409, fmt::format("job {} is {}{}", id, stateName(job.state), why));
+    };
+    if (action == "cancel") {
+      if (job.state == JobState::Planning) {
+        planning[id].cancelledBy = who;
+        planning[id].cancel->cancel();
+        return {202, jobJson(job)};
+      }
+      if (holdsDevice(job.state)) {
+        Cut& cut = *cuts.at(id);
+        cut.cancelledBy = who;
+        // (A paused job stays held: the driver sees the cancel in its hold
+        // and stops from there, without moving again.)
+        cut.control->cancel.cancel();
+        if (cut.waiting) {
+          cut.waiting->set_value(false);
+          cut.waiting.reset();
+        }
+        return {202, jobJson(job)};
+      }
+      if (job.state == JobState::Done || job.state == JobState::Cancelled) refuse("; there is nothing to cancel");
+      const JobRecord cancelled = store->transition(id, JobState::Cancelled, fmt::format("cancelled by {}", who));
+      jobChanged(cancelled);
+      pump();
+      return {200, jobJson(cancelled)};
+    }
+    if (action == "pause") {
+      if (job.state != JobState::Running) refuse("; only a running job can be paused");
+      Cut& cut = *cuts.at(id);
+      if (cut.waiting) refuse(", waiting for the next sheet: nothing moves, so there is nothing to pause");
+      if (auto* run = cut.control->run.load()) run->pause();
+      const JobRecord paused = store->transition(id, JobState::Paused, fmt::format("paused by {}", who));
+      devices[cut.device].state = "paused";
+      deviceChanged(devices[cut.device]);
+      jobChanged(paused);
+      return {200, jobJson(paused)};
+    }
+    if (action == "resume") {
+      if (job.state == JobState::Paused) {
+        Cut& cut = *cuts.at(id);
+        if (auto* run = cut.control->run.load()) run->resume();
+        const JobRecord running = store->transition(id, JobState::Running, fmt::format("resumed by {}", who));
+        devices[cut.device].state = "running";
+        deviceChanged(devices[cut.device]);
+        jobChanged(running);
+        return {200, jobJson(running)};
+      }
+      if (job.state == JobState::Interrupted || job.state == JobState::Failed) {
+        if (job.sheets == 0) refuse("; it was never planned: submit it again");
+        if (!arguments.contains("from_sheet") || !arguments["from_sheet"].is_number_integer()) {
+          throw ApiError(400, fmt::format("job {} stopped {}: say which sheet to go on from, with --from-sheet N "
+                                          "(from_sheet), once that sheet is loaded",
+                                          id, sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes)));
+        }
+        const int from = arguments["from_sheet"].get<int>();
+        startCut(job, from, fmt::format("resumed by {} from sheet {}", who, from));
+        return {200, jobJson(store->job(id).value())};
+      }
+      refuse("; only a paused, interrupted or failed job can be resumed");
+    }
+    if (action == "start") {
+      if (job.state != JobState::Ready) {
+        refuse(job.state == JobState::Queued || job.state == JobState::Planning ? "; it can start once it is planned"
+                                                                                : "; only a ready job can be started");
+      }
+      startCut(job, 1, fmt::format("started by {}", who));
+      return {200, jobJson(store->job(id).value())};
+    }
+    if (action == "next") {
+      auto c = cuts.find(id);
+      if (c == cuts.end() || !c->second->waiting) {
+        refuse(
+            job.state == JobState::Running
+                ? fmt::format(", cutting sheet {} of {}: it is not waiting for the next sheet", job.sheet, job.sheets)
+                : std::string("; only a job waiting between sheets takes `next`"));
+      }
+      c->second->waiting->set_value(true);
+      c->second->waiting.reset();
+      store->addEvent(id, "next", fmt::format("{} loaded sheet {}", who, job.sheet + 1));
+      return {200, jobJson(job)};
+    }
+    if (action == "move") {
+      if (isFinal(job.state) && job.state != JobState::Interrupted && job.state != JobState::Failed) {
+        refuse("; only a job still to cut has a place in the queue");
+      }
+      int priority = job.priority;
+      if (arguments.contains("priority")) {
+        if (!arguments["priority"].is_number_integer()) throw ApiError(400, "priority: expected a whole number");
+        priority = arguments["priority"].get<int>();
+      }
+      double position = job.position;
+      if (arguments.contains("before")) {
+        if (!arguments["before"].is_number_integer()) throw ApiError(400, "before: expected a job number");
+        const JobRecord other = jobOrThrow(arguments["before"].get<JobId>());
+        if (other.id == id) throw ApiError(400, "a job cannot move before itself");
+        priority = other.priority;
+        // Halfway between the other job and the one before it in the queue.
+        double previous = other.position - 1;
+        for (const JobRecord& candidate : store->jobs()) {
+          if (candidate.priority == priority && candidate.position < other.position && candidate.id != id) {
+            previous = std::max(previous, candidate.position);
+          }
+        }
+        position = (previous + other.position) / 2;
+      } else if (!arguments.contains("priority")) {
+        throw ApiError(400, "move needs before (a job number) or priority (a whole number)");
+      }
+      store->reorder(id, priority, position);
+      store->addEvent(id, "move", fmt::format("moved by {}", who));
+      const JobRecord moved = store->job(id).value();
+      jobChanged(moved);
+      return {200, jobJson(moved)};
+    }
+    throw ApiError(404, fmt::format("no action {} (cancel, pause, resume, start, next, move)", action));
+  }
+};
+
+Service::Service(asio::io_context& io, DaemonConfig config, std::shared_ptr<spdlog::logger> log)
+    : config_(std::move(config)) {
+  impl_ = std::make_unique<Impl>(io, config_, std::move(log));
+}
+
+Service::~Service() {
+  // Whatever is still posted finishes; the planners see their cancel.
+  for (auto& [id, planning] : impl_->planning) planning.cancel->cancel();
+  for (auto& [id, cut] : impl_->cuts) cut->control->cancel.cancel();
+  impl_->planners.join();
+  for (std::thread& check : impl_->checks) {
+    if (check.joinable()) check.join();
+  }
+  impl_->workers.join();
+  impl_->state.join();
+  for (auto& [id, cut] : impl_->cuts) {
+    if (cut->thread.joinable()) cut->thread.join();
+  }
+}
+
+void Service::start() {
+  impl_->open();
+  std::promise<void> recovered;
+  auto done = recovered.get_future();
+  impl_->onStrand([this, &recovered] {
+    try {
+      impl_->recover();
+      recovered.set_value();
+    } catch (...) {
+      recovered.set_exception(std::current_exception());
+    }
+  });
+  done.get();
+  impl_->onStrand([this] {
+    impl_->checkDevices();
+    impl_->pump();
+  });
+}
+
+void Service::submit(Submission submission, ReplyHandler done) {
+  Impl& impl = *impl_;
+  // The bytes go to the spool off the strand; the row once they are durable.
+  asio::post(impl.workers, [&impl, submission = std::move(submission), done = std::move(done)]() mutable {
+    NewJob job;
+    job.owner = submission.owner;
+    job.device = submission.device;
+    job.priority = submission.priority;
+    job.options = json(submission.options).dump();
+    std::optional<Spool::Entry> entry;
+    Reply refused;
+    refused.status = 0;
+    try {
+      if (impl.stopping) throw ApiError(503, "the daemon is stopping");
+      if (!submission.device.empty()) {
+        bool known = false;
+        for (const DeviceConfig& device : impl.config.devices) known = known || device.name == submission.device;
+        if (!known) {
+          std::string names;
+          for (const DeviceConfig& device : impl.config.devices) names += (names.empty() ? "" : ", ") + device.name;
+          throw ApiError(400, fmt::format("there is no device {} (the devices: {})", submission.device, names));
+        }
+      }
+      entry.emplace(impl.spool->begin());
+      if (!submission.fileName.empty()) {
+        const std::string name = fs::path(submission.fileName).filename().string();
+        if (name.empty() || name == "." || name == ".." || name == "planned") {
+          throw ApiError(400, fmt::format("\"{}\" is not a mesh file's name", submission.fileName));
+        }
+        job.kind = JobKind::Mesh;
+        job.source = name;
+        bool machine = false, material = false;
+        parseMakeOptions(name, submission.options, machine, material);
+        entry->addFile(name, submission.bytes);
+      } else {
+        const fs::path path = submission.path;
+        std::error_code error;
+        if (path.empty() || !path.is_absolute()) {
+          throw ApiError(400,
+                         fmt::format("path \"{}\": expected an absolute path on the daemon's machine", path.string()));
+        }
+        if (fs::is_directory(path, error)) {
+          if (!submission.options.empty()) {
+            throw ApiError(400, fmt::format("{}: a planned folder is cut as it was made; make options are for a mesh",
+                                            path.string()));
+          }
+          if (!fs::is_regular_file(path / "manifest.json", error)) {
+            throw ApiError(400, fmt::format("{}: not an output folder of `rotafab make`: it holds no manifest.json",
+                                            path.string()));
+          }
+          job.kind = JobKind::Planned;
+          job.source = path.string();
+          // Read and checked before it is queued: a folder that cannot be cut is refused now.
+          const auto sheets = jobs::readJobSheets(path, std::nullopt);
+          entry->copyFolder(path);
+        } else if (fs::is_regular_file(path, error)) {
+          job.kind = JobKind::Mesh;
+          job.source = path.filename().string();
+          bool machine = false, material = false;
+          parseMakeOptions(job.source, submission.options, machine, material);
+          std::ifstream in(path, std::ios::binary);
+          const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+          if (!in && !in.eof()) throw ApiError(400, fmt::format("{}: cannot read the file", path.string()));
+          entry->addFile(job.source, bytes);
+        } else {
+          throw ApiError(400, fmt::format("{}: no such file or folder on the daemon's machine", path.string()));
+        }
+      }
+      job.spool = entry->commit();
+    } catch (const ApiError& error) {
+      refused = {error.status, {{"error", error.what()}}};
+    } catch (const core::UserError& error) {
+      refused = {400, {{"error", error.what()}}};
+    } catch (const std::exception& error) {
+      const std::string what = error.what();
+      const bool full = what.find("No space left") != std::string::npos || what.find("full") != std::string::npos;
+      refused = {full ? 507 : 500,
+                 {{"error", full ? fmt::format("the spool's disk is full; the job was not accepted ({})", what)
+                                 : fmt::format("the job was not accepted: {}", what)}}};
+      impl.log->error("submission refused: {}", what);
+    }
+    if (refused.status != 0) {
+      entry.reset();  // the half-written entry goes
+      done(refused);
+      return;
+    }
+    impl.answer(std::move(done), [&impl, job, entry = std::make_shared<std::optional<Spool::Entry>>(std::move(entry))] {
+      if (impl.stopping) throw ApiError(503, "the daemon is stopping");
+      JobRecord added;
+      try {
+        added = impl.store->addJob(job, fmt::format("submitted by {}", job.owner));
+      } catch (...) {
+        std::error_code ignored;
+        fs::remove_all(impl.spool->pathOf(job.spool), ignored);
+        throw;
+      }
+      impl.log->info("job {}: {} submitted by {}", added.id, added.source, added.owner);
+      impl.jobChanged(added);
+      impl.pump();
+      return Reply{201, impl.jobJson(impl.store->job(added.id).value())};
+    });
+  });
+}
+
+void Service::list(ReplyHandler done) {
+  impl_->answer(std::move(done), [this] {
+    json jobs = json::array();
+    for (const JobRecord& job : impl_->store->jobs()) jobs.push_back(impl_->jobJson(job));
+    return Reply{200, {{"jobs", jobs}}};
+  });
+}
+
+void Service::status(JobId id, ReplyHandler done) {
+  impl_->answer(std::move(done), [this, id] {
+    const JobRecord job = impl_->jobOrThrow(id);
+    json out = impl_->jobJson(job);
+    json transitions = json::array();
+    for (const Transition& t : impl_->store->transitions(id)) {
+      transitions.push_back({{"from", t.from ? json(stateName(*t.from)) : json(nullptr)},
+                             {"to", stateName(t.to)},
+                             {"at", isoTime(t.at)},
+                             {"reason", t.reason}});
+    }
+    out["transitions"] = transitions;
+    return Reply{200, out};
+  });
+}
+
+void Service::manifest(JobId id, ReplyHandler done) {
+  impl_->answer(std::move(done), [this, id] {
+    const JobRecord job = impl_->jobOrThrow(id);
+    if (job.sheets == 0) {
+      throw ApiError(409,
+                     fmt::format("job {} is {}: it has no manifest until it is planned", id, stateName(job.state)));
+    }
+    std::ifstream in(impl_->plannedFolder(job) / "manifest.json");
+    json manifest = json::parse(in, nullptr, false);
+    if (manifest.is_discarded()) throw ApiError(500, fmt::format("job {}: its manifest.json cannot be read", id));
+    return Reply{200, manifest};
+  });
+}
+
+void Service::devices(ReplyHandler done) {
+  impl_->answer(std::move(done), [this] {
+    json all = json::array();
+    for (const auto& device : impl_->devices) all.push_back(impl_->deviceJson(device));
+    return Reply{200, {{"devices", all}}};
+  });
+}
+
+void Service::act(JobId id, const std::string& action, const json& arguments, const std::string& who,
+                  ReplyHandler done) {
+  impl_->answer(std::move(done), [this, id, action, arguments, who] { return impl_->act(id, action, arguments, who); });
+}
+
+size_t Service::subscribe(std::function<void(const ServiceEvent&)> sink) {
+  std::promise<size_t> id;
+  auto result = id.get_future();
+  impl_->onStrand([this, &id, sink = std::move(sink)]() mutable {
+    const size_t next = impl_->nextSubscriber++;
+    impl_->subscribers[next] = std::move(sink);
+    id.set_value(next);
+  });
+  return result.get();
+}
+
+void Service::unsubscribe(size_t id) {
+  impl_->onStrand([this, id] { impl_->subscribers.erase(id); });
+}
+
+void Service::shutdown(const std::string& why, std::function<void()> done) {
+  impl_->onStrand([this, why, done = std::move(done)]() mutable {
+    Impl& impl = *impl_;
+    impl.stopping = true;
+    impl.stopped = std::move(done);
+    impl.log->info("stopping ({}): {} cut{} and {} plan{} to stop", why, impl.cuts.size(),
+                   impl.cuts.size() == 1 ? "" : "s", impl.planning.size(), impl.planning.size() == 1 ? "" : "s");
+    for (auto& [id, planning] : impl.planning) planning.cancel->cancel();
+    for (auto& [id, cut] : impl.cuts) {
+      cut->control->shutdown = true;
+      cut->control->cancel.cancel();
+      if (cut->waiting) {
+        cut->waiting->set_value(false);
+        cut->waiting.reset();
+      }
+    }
+    impl.finishIfStopping();
+  });
+}
+
+}  // namespace rotafab::service

@@ -1,0 +1,111 @@
+#pragma once
+// The fabrication queue (SPEC, "Daemon"): jobs submitted, planned once
+// against their device's machine profile, cut one per device with a stop
+// between sheets, and every change of state kept in the store before
+// anyone is told of it.
+//
+// Threads: the daemon's one io_context runs the network; every piece of the
+// queue's state (the store included) is touched only on one strand, so no
+// lock guards it. Work that would hold that strand goes elsewhere: spool
+// files are written on the worker pool, plans are made on the planners'
+// pool (each plan on every core through the Executor), and each running job
+// has a thread of its own for the driver, whose calls block on the device.
+// Those post what they learn back to the strand.
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/thread_pool.hpp>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "daemon/service/DaemonConfig.h"
+#include "daemon/service/JobStore.h"
+#include "daemon/service/Spool.h"
+
+namespace spdlog {
+class logger;
+}
+
+namespace rotafab::service {
+
+// A refusal for the API's client: an HTTP status (4xx: the request; 5xx: the daemon) and one line.
+class ApiError : public std::runtime_error {
+ public:
+  ApiError(int status, const std::string& message) : std::runtime_error(message), status(status) {}
+  int status;
+};
+
+// What the API hands over for a submission.
+struct Submission {
+  std::string owner;
+  std::string device;  // empty: any device whose machine profile fits
+  int priority = 0;
+  std::vector<std::string> options;  // `make` options, as command-line words
+  // Either an upload (the mesh's file name and bytes) or a path on the
+  // daemon's machine: a mesh file or a `make` output folder.
+  std::string fileName, bytes;
+  std::filesystem::path path;
+};
+
+// A reply: the JSON body, or the ApiError it became.
+struct Reply {
+  int status = 200;
+  nlohmann::json body;
+};
+using ReplyHandler = std::function<void(Reply)>;
+
+// What a subscriber to the event stream is told: "job" (a transition: the
+// job as status shows it), "progress" (of a plan or a cut), "device".
+struct ServiceEvent {
+  std::string type;
+  nlohmann::json data;
+};
+
+class Service {
+ public:
+  Service(boost::asio::io_context& io, DaemonConfig config, std::shared_ptr<spdlog::logger> log);
+  ~Service();
+  Service(const Service&) = delete;
+  Service& operator=(const Service&) = delete;
+
+  // Opens the store and the spool, brings back what a stop left (running
+  // jobs become interrupted, plans are made again), checks every device
+  // (stopped safely, laser off confirmed; offline if it does not answer)
+  // and starts the queue. Throws StoreError, ConfigError.
+  void start();
+
+  // The API. Each may be called from any thread; `done` is called once, on
+  // the service's strand or pool (the caller posts it where it needs it).
+  void submit(Submission submission, ReplyHandler done);
+  void list(ReplyHandler done);
+  void status(JobId id, ReplyHandler done);
+  void manifest(JobId id, ReplyHandler done);
+  void devices(ReplyHandler done);
+  // cancel, pause, resume, start, next, move; `arguments`: resume's
+  // from_sheet, move's before or priority; `who` for the record.
+  void act(JobId id, const std::string& action, const nlohmann::json& arguments, const std::string& who,
+           ReplyHandler done);
+
+  // The event stream: `sink` is called on the strand for each event until unsubscribed.
+  size_t subscribe(std::function<void(const ServiceEvent&)> sink);
+  void unsubscribe(size_t id);
+
+  // Stops every device safely, records each running job interrupted, and
+  // calls `done` once all have stopped (on the strand).
+  void shutdown(const std::string& why, std::function<void()> done);
+
+  [[nodiscard]] const DaemonConfig& config() const { return config_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  DaemonConfig config_;
+};
+
+}  // namespace rotafab::service

@@ -1,0 +1,396 @@
+// The job store on SQLite (JobStore.h). WAL mode, so that readers never
+// wait for a writer; synchronous=FULL, so that a transaction that returned
+// survives a power cut, not only a kill of the process (in WAL mode NORMAL
+// would only survive the kill). The schema is versioned in `user_version`
+// and migrated one step at a time, each step a transaction of its own.
+
+#include <fmt/format.h>
+#include <sqlite3.h>
+
+#include <chrono>
+#include <utility>
+
+#include "daemon/service/JobStore.h"
+
+namespace rotafab::service {
+namespace {
+
+// Each migration takes the schema from its index to the next version.
+constexpr const char* kMigrations[] = {
+    // 1: jobs and their transitions.
+    R"(CREATE TABLE jobs (
+         id INTEGER PRIMARY KEY AUTOINCREMENT,
+         state TEXT NOT NULL,
+         kind TEXT NOT NULL,
+         source TEXT NOT NULL,
+         owner TEXT NOT NULL,
+         device TEXT NOT NULL,
+         priority INTEGER NOT NULL,
+         position REAL NOT NULL,
+         options TEXT NOT NULL,
+         spool TEXT NOT NULL,
+         submitted REAL NOT NULL,
+         updated REAL NOT NULL,
+         sheets INTEGER NOT NULL DEFAULT 0,
+         summary TEXT NOT NULL DEFAULT '',
+         sheet INTEGER NOT NULL DEFAULT 0,
+         stroke INTEGER NOT NULL DEFAULT 0,
+         strokes INTEGER NOT NULL DEFAULT 0,
+         message TEXT NOT NULL DEFAULT '');
+       CREATE TABLE transitions (
+         id INTEGER PRIMARY KEY AUTOINCREMENT,
+         job INTEGER NOT NULL REFERENCES jobs(id),
+         from_state TEXT,
+         to_state TEXT NOT NULL,
+         at REAL NOT NULL,
+         reason TEXT NOT NULL);)",
+    // 2: events, and the indexes the queue and a job's history are read by.
+    R"(CREATE TABLE events (
+         id INTEGER PRIMARY KEY AUTOINCREMENT,
+         job INTEGER REFERENCES jobs(id),
+         at REAL NOT NULL,
+         kind TEXT NOT NULL,
+         text TEXT NOT NULL);
+       CREATE INDEX jobs_queue ON jobs(priority DESC, position);
+       CREATE INDEX transitions_job ON transitions(job, id);
+       CREATE INDEX events_job ON events(job, id);)",
+};
+constexpr int kNewest = static_cast<int>(std::size(kMigrations));
+
+double now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+
+class Statement {
+ public:
+  Statement(sqlite3* db, const char* sql) : db_(db) {
+    if (sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr) != SQLITE_OK) fail("prepare");
+  }
+  ~Statement() { sqlite3_finalize(statement_); }
+  Statement(const Statement&) = delete;
+  Statement& operator=(const Statement&) = delete;
+
+  Statement& bind(int index, int64_t value) {
+    check(sqlite3_bind_int64(statement_, index, value));
+    return *this;
+  }
+  Statement& bind(int index, double value) {
+    check(sqlite3_bind_double(statement_, index, value));
+    return *this;
+  }
+  Statement& bind(int index, std::string_view text) {
+    check(sqlite3_bind_text(statement_, index, text.data(), static_cast<int>(text.size()), SQLITE_TRANSIENT));
+    return *this;
+  }
+  Statement& bindNull(int index) {
+    check(sqlite3_bind_null(statement_, index));
+    return *this;
+  }
+  // True while there is a row.
+  bool step() {
+    const int result = sqlite3_step(statement_);
+    if (result == SQLITE_ROW) return true;
+    if (result == SQLITE_DONE) return false;
+    fail("step");
+  }
+  int64_t integer(int column) const { return sqlite3_column_int64(statement_, column); }
+  double real(int column) const { return sqlite3_column_double(statement_, column); }
+  bool isNull(int column) const { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
+  std::string text(int column) const {
+    const auto* bytes = reinterpret_cast<const char*>(sqlite3_column_text(statement_, column));
+    return bytes ? std::string(bytes, static_cast<size_t>(sqlite3_column_bytes(statement_, column))) : std::string();
+  }
+
+ private:
+  void check(int result) const {
+    if (result != SQLITE_OK) fail("bind");
+  }
+  [[noreturn]] void fail(const char* what) const;
+
+  sqlite3* db_;
+  sqlite3_stmt* statement_ = nullptr;
+};
+
+// One line for what SQLite said, in the words of what the daemon was doing.
+[[noreturn]] void storeFailure(sqlite3* db, std::string_view doing) {
+  const int code = sqlite3_extended_errcode(db) & 0xff;
+  if (code == SQLITE_FULL) throw StoreError(fmt::format("{}: the disk that holds the job store is full", doing));
+  if (code == SQLITE_NOTADB || code == SQLITE_CORRUPT)
+    throw StoreError(fmt::format("{}: the job store is not a sound SQLite database ({})", doing, sqlite3_errmsg(db)));
+  throw StoreError(fmt::format("{}: {}", doing, sqlite3_errmsg(db)));
+}
+
+void Statement::fail(const char* what) const { storeFailure(db_, fmt::format("the job store ({})", what)); }
+
+void execute(sqlite3* db, const char* sql, std::string_view doing) {
+  char* error = nullptr;
+  if (sqlite3_exec(db, sql, nullptr, nullptr, &error) != SQLITE_OK) {
+    sqlite3_free(error);
+    storeFailure(db, doing);
+  }
+}
+
+// BEGIN IMMEDIATE ... COMMIT, rolled back unless committed.
+class Transaction {
+ public:
+  explicit Transaction(sqlite3* db) : db_(db) { execute(db_, "BEGIN IMMEDIATE", "the job store (begin)"); }
+  ~Transaction() {
+    if (!committed_) sqlite3_exec(db_, "ROLLBACK", nullptr, nullptr, nullptr);
+  }
+  void commit() {
+    execute(db_, "COMMIT", "the job store (commit)");
+    committed_ = true;
+  }
+
+ private:
+  sqlite3* db_;
+  bool committed_ = false;
+};
+
+constexpr const char* kJobColumns =
+    "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
+    "summary, sheet, stroke, strokes, message";
+
+JobRecord jobOf(const Statement& row) {
+  JobRecord job;
+  job.id = row.integer(0);
+  job.state = stateNamed(row.text(1)).value_or(JobState::Failed);
+  job.kind = row.text(2) == "planned" ? JobKind::Planned : JobKind::Mesh;
+  job.source = row.text(3);
+  job.owner = row.text(4);
+  job.device = row.text(5);
+  job.priority = static_cast<int>(row.integer(6));
+  job.position = row.real(7);
+  job.options = row.text(8);
+  job.spool = row.text(9);
+  job.submitted = row.real(10);
+  job.updated = row.real(11);
+  job.sheets = static_cast<int>(row.integer(12));
+  job.summary = row.text(13);
+  job.sheet = static_cast<int>(row.integer(14));
+  job.stroke = row.integer(15);
+  job.strokes = row.integer(16);
+  job.message = row.text(17);
+  return job;
+}
+
+class SqliteStore final : public JobStore {
+ public:
+  SqliteStore(const std::filesystem::path& file, std::optional<int> upTo) : file_(file) {
+    const int opened = sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+    if (opened != SQLITE_OK) {
+      const std::string why = db_ ? sqlite3_errmsg(db_) : "out of memory";
+      sqlite3_close(db_);
+      throw StoreError(fmt::format("{}: cannot open the job store: {}", file.string(), why));
+    }
+    try {
+      sqlite3_busy_timeout(db_, 5000);
+      sqlite3_extended_result_codes(db_, 1);
+      execute(db_, "PRAGMA journal_mode=WAL", doing("set WAL mode").c_str());
+      execute(db_, "PRAGMA synchronous=FULL", doing("set synchronous=FULL").c_str());
+      execute(db_, "PRAGMA foreign_keys=ON", doing("turn on foreign keys").c_str());
+      migrate(upTo.value_or(kNewest));
+    } catch (...) {
+      sqlite3_close(db_);
+      throw;
+    }
+  }
+  ~SqliteStore() override { sqlite3_close(db_); }
+
+  JobRecord addJob(const NewJob& job, std::string_view reason) override {
+    Transaction transaction(db_);
+    Statement last(db_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
+    last.step();
+    const double position = last.real(0) + 1, at = now();
+    Statement insert(db_,
+                     "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                     "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    insert.bind(1, stateName(JobState::Queued))
+        .bind(2, kindName(job.kind))
+        .bind(3, job.source)
+        .bind(4, job.owner)
+        .bind(5, job.device)
+        .bind(6, static_cast<int64_t>(job.priority))
+        .bind(7, position)
+        .bind(8, job.options)
+        .bind(9, job.spool)
+        .bind(10, at)
+        .bind(11, at);
+    insert.step();
+    const JobId id = sqlite3_last_insert_rowid(db_);
+    record(id, std::nullopt, JobState::Queued, at, reason);
+    transaction.commit();
+    return *this->job(id);
+  }
+
+  std::optional<JobRecord> job(JobId id) override {
+    Statement select(db_, fmt::format("SELECT {} FROM jobs WHERE id = ?", kJobColumns).c_str());
+    select.bind(1, id);
+    if (!select.step()) return std::nullopt;
+    return jobOf(select);
+  }
+
+  std::vector<JobRecord> jobs() override {
+    Statement select(db_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns).c_str());
+    std::vector<JobRecord> all;
+    while (select.step()) all.push_back(jobOf(select));
+    return all;
+  }
+
+  JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change) override {
+    Transaction transaction(db_);
+    const auto current = job(id);
+    if (!current) throw TransitionRefused(fmt::format("there is no job {}", id));
+    if (!allowedTransition(current->state, to)) {
+      throw TransitionRefused(
+          fmt::format("job {} is {}; it cannot become {}", id, stateName(current->state), stateName(to)));
+    }
+    const double at = now();
+    Statement set(db_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
+    set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
+    set.step();
+    apply(id, change);
+    record(id, current->state, to, at, reason);
+    transaction.commit();
+    return *job(id);
+  }
+
+  void update(JobId id, const JobChange& change) override {
+    Transaction transaction(db_);
+    apply(id, change);
+    transaction.commit();
+  }
+
+  void reorder(JobId id, int priority, double position) override {
+    Transaction transaction(db_);
+    Statement set(db_, "UPDATE jobs SET priority = ?, position = ?, updated = ? WHERE id = ?");
+    set.bind(1, static_cast<int64_t>(priority)).bind(2, position).bind(3, now()).bind(4, id);
+    set.step();
+    transaction.commit();
+  }
+
+  std::vector<Transition> transitions(JobId id) override {
+    Statement select(db_, "SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = ? ORDER BY id");
+    select.bind(1, id);
+    std::vector<Transition> all;
+    while (select.step()) {
+      Transition t;
+      t.job = select.integer(0);
+      if (!select.isNull(1)) t.from = stateNamed(select.text(1));
+      t.to = stateNamed(select.text(2)).value_or(JobState::Failed);
+      t.at = select.real(3);
+      t.reason = select.text(4);
+      all.push_back(std::move(t));
+    }
+    return all;
+  }
+
+  void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) override {
+    Statement insert(db_, "INSERT INTO events (job, at, kind, text) VALUES (?, ?, ?, ?)");
+    if (job) {
+      insert.bind(1, *job);
+    } else {
+      insert.bindNull(1);
+    }
+    insert.bind(2, now()).bind(3, kind).bind(4, text);
+    insert.step();
+  }
+
+  std::vector<Event> events(std::optional<JobId> job, size_t newest) override {
+    Statement select(db_, job ? "SELECT id, job, at, kind, text FROM events WHERE job = ? ORDER BY id DESC LIMIT ?"
+                              : "SELECT id, job, at, kind, text FROM events ORDER BY id DESC LIMIT ?");
+    int index = 1;
+    if (job) select.bind(index++, *job);
+    select.bind(index, static_cast<int64_t>(newest));
+    std::vector<Event> all;
+    while (select.step()) {
+      Event e;
+      e.id = select.integer(0);
+      if (!select.isNull(1)) e.job = select.integer(1);
+      e.at = select.real(2);
+      e.kind = select.text(3);
+      e.text = select.text(4);
+      all.insert(all.begin(), std::move(e));
+    }
+    return all;
+  }
+
+  int schemaVersion() override {
+    Statement version(db_, "PRAGMA user_version");
+    version.step();
+    return static_cast<int>(version.integer(0));
+  }
+
+  std::string integrityCheck() override {
+    Statement check(db_, "PRAGMA integrity_check");
+    std::string result;
+    while (check.step()) result += (result.empty() ? "" : "; ") + check.text(0);
+    return result;
+  }
+
+ private:
+  std::string doing(std::string_view what) const { return fmt::format("{}: {}", file_.string(), what); }
+
+  void migrate(int upTo) {
+    const int found = schemaVersion();
+    if (found > kNewest) {
+      throw StoreError(
+          fmt::format("{}: the job store has schema version {}, made by a newer rotafabd (this one "
+                      "knows up to {}); run that version, or give this one another state directory",
+                      file_.string(), found, kNewest));
+    }
+    for (int version = found; version < upTo; ++version) {
+      Transaction transaction(db_);
+      execute(db_, kMigrations[version], doing(fmt::format("migrate the schema to version {}", version + 1)).c_str());
+      execute(db_, fmt::format("PRAGMA user_version = {}", version + 1).c_str(),
+              doing("record the schema version").c_str());
+      transaction.commit();
+    }
+  }
+
+  void apply(JobId id, const JobChange& change) {
+    const auto setText = [&](const char* column, const std::optional<std::string>& value) {
+      if (!value) return;
+      Statement set(db_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column).c_str());
+      set.bind(1, *value).bind(2, id);
+      set.step();
+    };
+    const auto setNumber = [&](const char* column, std::optional<int64_t> value) {
+      if (!value) return;
+      Statement set(db_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column).c_str());
+      set.bind(1, *value).bind(2, id);
+      set.step();
+    };
+    setText("device", change.device);
+    setText("summary", change.summary);
+    setNumber("sheets", change.sheets);
+    setNumber("sheet", change.sheet);
+    setNumber("stroke", change.stroke);
+    setNumber("strokes", change.strokes);
+  }
+
+  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+    Statement insert(db_, "INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES (?, ?, ?, ?, ?)");
+    insert.bind(1, id);
+    if (from) {
+      insert.bind(2, stateName(*from));
+    } else {
+      insert.bindNull(2);
+    }
+    insert.bind(3, stateName(to)).bind(4, at).bind(5, reason);
+    insert.step();
+  }
+
+  std::filesystem::path file_;
+  sqlite3* db_ = nullptr;
+};
+
+}  // namespace
+
+std::string_view kindName(JobKind kind) { return kind == JobKind::Planned ? "planned" : "mesh"; }
+
+std::unique_ptr<JobStore> openSqliteStore(const std::filesystem::path& file, std::optional<int> upToVersion) {
+  return std::make_unique<SqliteStore>(file, upToVersion);
+}
+
+int newestSchemaVersion() { return kNewest; }
+
+}  // namespace rotafab::service

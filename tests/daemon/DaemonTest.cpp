@@ -1,0 +1,440 @@
+// rotafabd as a process, through its socket: jobs submitted, planned,
+// started and cut to their end by the client; the stops between sheets;
+// kills at any instant; SIGTERM mid-cut; many clients at once; hostile
+// requests; a full disk; a device's fault.
+
+#include <gtest/gtest.h>
+#include <sys/mount.h>
+
+#include <fstream>
+#include <mutex>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "daemon/DaemonSupport.h"
+#include "daemon/service/DaemonConfig.h"
+#include "daemon/service/JobStore.h"
+
+namespace rotafab::test {
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+// A `make` output folder of three sheets for the default device's bed
+// (grbl-diode-400), made once for the whole program.
+const fs::path& threeSheets() {
+  static TempDir folder;
+  static const fs::path made = [] {
+    const fs::path out = folder.path() / "soccer";
+    const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
+                                " --structure band --machine grbl-diode-400 --time 0 --out " + quoted(out));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return out;
+  }();
+  return made;
+}
+
+std::string state(const json& job) { return job.is_object() ? job.value("state", "") : ""; }
+
+TEST(Daemon, AMeshIsSubmittedPlannedStartedAndCutToItsEndThroughTheClient) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  // Planned once, against the device's machine profile; nothing cuts before an operator starts it.
+  const CommandResult submitted =
+      daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --follow");
+  ASSERT_EQ(submitted.status, 0) << submitted.out << submitted.err;
+  EXPECT_NE(submitted.out.find("job 1: cube.obj queued for laser1"), std::string::npos) << submitted.out;
+  EXPECT_NE(submitted.err.find("job 1: ready: planned: 1 sheet; start it with `rotafab start 1`"), std::string::npos)
+      << submitted.err;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(state(daemon.job(1)), "ready");
+  const CommandResult started = daemon.client("start 1");
+  ASSERT_EQ(started.status, 0) << started.err;
+  const CommandResult followed = daemon.client("status 1 --follow");
+  EXPECT_EQ(followed.status, 0) << followed.err;
+  EXPECT_NE(followed.err.find("job 1: done: cut on laser1: 1 sheet"), std::string::npos) << followed.err;
+  const json job = daemon.clientJson("status 1");
+  EXPECT_EQ(job["state"], "done");
+  EXPECT_EQ(job["owner"], daemon.clientJson("jobs")["jobs"][0]["owner"]);
+  std::vector<std::string> states;
+  for (const json& t : job["transitions"]) states.push_back(t["to"]);
+  EXPECT_EQ(states, (std::vector<std::string>{"queued", "planning", "ready", "running", "done"}));
+  EXPECT_EQ(job["summary"]["panels"], 6);
+  // The manifest of the planned job, from the daemon.
+  const CommandResult manifest = daemon.client("manifest 1");
+  EXPECT_EQ(manifest.status, 0) << manifest.err;
+  EXPECT_NE(manifest.out.find("6 panels on 1 sheet"), std::string::npos) << manifest.out;
+  const json devices = daemon.clientJson("devices --daemon");
+  ASSERT_EQ(devices["devices"].size(), 1u);
+  EXPECT_EQ(devices["devices"][0]["state"], "idle");
+  // At its start the daemon stopped the device and the controller confirmed its laser off.
+  EXPECT_NE(devices["devices"][0].value("checked", "").find("laser off confirmed"), std::string::npos)
+      << devices.dump();
+  // Done is final.
+  const CommandResult again = daemon.client("start 1");
+  EXPECT_EQ(again.status, 1);
+  EXPECT_EQ(again.err, "error: job 1 is done; only a ready job can be started\n");
+}
+
+TEST(Daemon, EachSheetAfterTheFirstWaitsForNextAndACutCanBePausedAndResumed) {
+  TempDir root;
+  Daemon daemon(root.path(), "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=200\"}]\n");
+  daemon.start();
+  const json submitted = daemon.clientJson("submit " + quoted(threeSheets()));
+  const long long id = submitted["id"];
+  EXPECT_EQ(submitted["kind"], "planned");
+  ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+  EXPECT_EQ(daemon.job(id)["sheets"], 3);
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  // Paused mid-sheet: the device holds, and says so.
+  json job =
+      daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 2; });
+  ASSERT_EQ(daemon.client(fmt::format("pause {}", id)).status, 0);
+  EXPECT_EQ(state(daemon.job(id)), "paused");
+  EXPECT_EQ(daemon.clientJson("devices --daemon")["devices"][0]["state"], "paused");
+  const json held = daemon.job(id);
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));
+  // (A stroke the controller had buffered may still be acknowledged; no more.)
+  EXPECT_LE(daemon.job(id)["progress"]["stroke"].get<int>(), held["progress"]["stroke"].get<int>() + 2);
+  ASSERT_EQ(daemon.client(fmt::format("resume {}", id)).status, 0);
+  EXPECT_EQ(state(daemon.job(id)), "running");
+  for (int sheet = 2; sheet <= 3; ++sheet) {
+    job = daemon.waitForJob(
+        id, [](const json& j) { return j.value("waiting_for_next", false); }, 120);
+    ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
+    EXPECT_EQ(job["sheet"], sheet - 1);
+    EXPECT_EQ(state(job), "running");
+    // Nothing moves while it waits: a pause has nothing to hold.
+    EXPECT_EQ(daemon.client(fmt::format("pause {}", id)).status, 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_TRUE(daemon.job(id).value("waiting_for_next", false));
+    const CommandResult next = daemon.client(fmt::format("next {}", id));
+    ASSERT_EQ(next.status, 0) << next.err;
+  }
+  job = daemon.waitForJob(
+      id, [](const json& j) { return state(j) == "done"; }, 120);
+  ASSERT_EQ(state(job), "done") << job.dump();
+  EXPECT_EQ(job["sheet"], 3);
+  const CommandResult late = daemon.client(fmt::format("next {}", id));
+  EXPECT_EQ(late.status, 1);
+  EXPECT_NE(late.err.find("is done"), std::string::npos) << late.err;
+}
+
+TEST(Daemon, AKillAtAnyInstantLosesNoAcceptedJobAndRestartsNoCut) {
+  TempDir root;
+  Daemon daemon(root.path(), "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=50\"}]\n");
+  std::mt19937 random(20261202);
+  std::set<long long> accepted;
+  std::set<long long> everRunning;
+  const int iterations = 8;
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    daemon.start();
+    // Whatever is ready is started, so that some kills land mid-cut.
+    for (const json& job : daemon.clientJson("jobs")["jobs"]) {
+      if (state(job) == "ready") {
+        if (daemon.client(fmt::format("start {}", job["id"].get<long long>())).status == 0) {
+          everRunning.insert(job["id"].get<long long>());
+          break;
+        }
+      }
+    }
+    // Submissions go on while the kill comes: meshes (planned by the daemon) and planned folders.
+    std::mutex mutex;
+    std::atomic<bool> stop{false};
+    std::thread submitter([&] {
+      for (int i = 0; !stop; ++i) {
+        const std::string what = i % 2 == 0
+                                     ? quoted(threeSheets())
+                                     : quoted(kSource / "examples/soccer-ball.obj") + " --structure band --time 1";
+        const CommandResult r = daemon.client("submit " + what + " --json");
+        if (r.status != 0) break;  // the kill
+        const json job = json::parse(r.out, nullptr, false);
+        std::lock_guard lock(mutex);
+        if (job.is_object()) accepted.insert(job["id"].get<long long>());
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(std::uniform_int_distribution<int>(100, 1500)(random)));
+    daemon.kill9();
+    stop = true;
+    submitter.join();
+    {
+      auto store = service::openSqliteStore(daemon.stateDir() / "jobs.sqlite3");
+      EXPECT_EQ(store->integrityCheck(), "ok") << "iteration " << iteration;
+      for (long long id : accepted) EXPECT_TRUE(store->job(id)) << "job " << id << " was accepted and is lost";
+    }
+    daemon.start();
+    const json jobs = daemon.clientJson("jobs")["jobs"];
+    for (const json& job : jobs) {
+      EXPECT_NE(state(job), "running") << job.dump();
+      EXPECT_NE(state(job), "paused") << job.dump();
+      if (state(job) == "interrupted") {
+        EXPECT_NE(job.value("message", "").find("the daemon stopped while it cut"), std::string::npos) << job.dump();
+        EXPECT_TRUE(everRunning.contains(job["id"].get<long long>()));
+      }
+    }
+    // Nothing starts by itself.
+    std::this_thread::sleep_for(std::chrono::milliseconds(800));
+    for (const json& job : daemon.clientJson("jobs")["jobs"]) EXPECT_NE(state(job), "running") << job.dump();
+    daemon.kill9();
+  }
+  EXPECT_GT(accepted.size(), static_cast<size_t>(iterations));
+  // An interrupted job goes on only when an operator resumes it, from the sheet they say.
+  daemon.start();
+  std::optional<long long> interrupted;
+  for (const json& job : daemon.clientJson("jobs")["jobs"]) {
+    if (state(job) == "interrupted") interrupted = job["id"].get<long long>();
+  }
+  if (interrupted) {
+    const CommandResult bare = daemon.client(fmt::format("resume {}", *interrupted));
+    EXPECT_EQ(bare.status, 1);
+    EXPECT_NE(bare.err.find("--from-sheet N"), std::string::npos) << bare.err;
+    const int sheets = daemon.job(*interrupted)["sheets"];
+    ASSERT_EQ(daemon.client(fmt::format("resume {} --from-sheet {}", *interrupted, sheets)).status, 0);
+    const json done = daemon.waitForJob(
+        *interrupted, [](const json& j) { return state(j) == "done"; }, 120);
+    EXPECT_EQ(state(done), "done") << done.dump();
+  }
+}
+
+TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
+  TempDir root;
+  const fs::path witness = root.path() / "laser";
+  Daemon daemon(root.path(), fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: "
+                                         "\"sim:grbl?speed=5&witness={}\"}}]\n",
+                                         witness.string()));
+  daemon.start();
+  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
+  ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  const json cutting =
+      daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+  ASSERT_GE(cutting["progress"]["stroke"].get<int>(), 3) << cutting.dump();
+  daemon.signal(SIGTERM);
+  EXPECT_EQ(daemon.wait(30), 0) << readFile(daemon.log());
+  // The simulated controller saw its laser lit, then off, and nothing after.
+  const std::string changes = readFile(witness);
+  EXPECT_NE(changes.find("on\n"), std::string::npos) << changes;
+  EXPECT_TRUE(changes.ends_with("off\n")) << changes;
+  daemon.start();
+  const json job = daemon.job(id);
+  EXPECT_EQ(state(job), "interrupted") << job.dump();
+  EXPECT_NE(job.value("message", "").find("the daemon stopped at sheet 1 of 3"), std::string::npos) << job.dump();
+  EXPECT_NE(job.value("message", "").find("laser off"), std::string::npos) << job.dump();
+  EXPECT_NE(job.value("message", "").find(fmt::format("rotafab resume {} --from-sheet 1", id)), std::string::npos);
+  const json last = job["transitions"].back();
+  EXPECT_EQ(last["from"], "running");
+  EXPECT_EQ(last["to"], "interrupted");
+}
+
+TEST(Daemon, TwoHundredConcurrentSubmissionsEachLandExactlyOnce) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  constexpr int kClients = 8, kEach = 25;
+  std::vector<std::thread> clients;
+  std::mutex mutex;
+  std::vector<long long> ids;
+  std::vector<std::string> failures;
+  for (int c = 0; c < kClients; ++c) {
+    clients.emplace_back([&, c] {
+      for (int i = 0; i < kEach; ++i) {
+        const int tag = c * kEach + i;  // the priority tells each submission apart
+        const CommandResult r =
+            daemon.client(fmt::format("submit {} --priority {} --json", quoted(threeSheets()), tag));
+        std::lock_guard lock(mutex);
+        if (r.status != 0) {
+          failures.push_back(r.err);
+          continue;
+        }
+        ids.push_back(json::parse(r.out)["id"].get<long long>());
+      }
+    });
+  }
+  for (auto& client : clients) client.join();
+  EXPECT_TRUE(failures.empty()) << failures.front();
+  EXPECT_EQ(std::set<long long>(ids.begin(), ids.end()).size(), static_cast<size_t>(kClients * kEach));
+  const json jobs = daemon.clientJson("jobs")["jobs"];
+  ASSERT_EQ(jobs.size(), static_cast<size_t>(kClients * kEach));
+  std::multiset<int> priorities;
+  for (const json& job : jobs) priorities.insert(job["priority"].get<int>());
+  for (int tag = 0; tag < kClients * kEach; ++tag) EXPECT_EQ(priorities.count(tag), 1u) << tag;
+  // In queue order: the highest priority first.
+  EXPECT_EQ(jobs.front()["priority"], kClients * kEach - 1);
+}
+
+TEST(Daemon, HostileRequestsAreRefusedWhileOtherClientsAreServed) {
+  TempDir root;
+  const std::string token = "s3cret-token";
+  Daemon daemon(root.path(),
+                fmt::format("upload_limit: 100000\nheader_timeout: 1\n"
+                            "listen: [unix:{}, tcp://127.0.0.1:0]\n"
+                            "tokens: [{{name: alice, hash: \"{}\"}}]\n",
+                            (root.path() / "run/rotafab/rotafabd.sock").string(), service::hashToken(token, "5a17")));
+  daemon.start();
+  // A slow client holds a connection open with half a header...
+  const int slow = connectUnix(daemon.socket());
+  ASSERT_GE(slow, 0);
+  ::send(slow, "GET /api/jobs HTTP/1.1\r\nHost: x\r\n", 33, MSG_NOSIGNAL);
+  // ...while the others are refused, each in its own words, and the daemon goes on.
+  const auto refused = [&](const RawReply& reply, int status, const std::string& words) {
+    EXPECT_EQ(reply.status, status) << reply.text;
+    ASSERT_TRUE(reply.body.is_object()) << reply.text;
+    EXPECT_NE(reply.body.value("error", "").find(words), std::string::npos) << reply.text;
+  };
+  refused(daemon.post("/api/jobs", "{not json"), 400, "not valid JSON");
+  refused(daemon.raw("\x01\x02\x03 garbage \xff\r\n\r\n"), 400, "malformed request");
+  refused(daemon.raw("GET /api/jobs HTTP/1.1\r\nHost: x\r\nX-Flood: " + std::string(40000, 'a') + "\r\n\r\n"), 431,
+          "larger than 16384 bytes");
+  refused(daemon.raw("POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: "
+                     "5000000\r\n\r\n{}"),
+          413, "larger than the 100000 bytes the daemon takes");
+  refused(daemon.get("/api/nothing"), 404, "no such resource");
+  refused(daemon.raw("DELETE /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 405, "GET and POST");
+  refused(daemon.post("/api/jobs", R"({"path": "relative/cube.obj"})"), 400, "expected an absolute path");
+  refused(daemon.post("/api/jobs", R"({"path": "/nowhere/cube.obj"})"), 400, "no such file or folder");
+  refused(daemon.post("/api/jobs/1/start", "{}"), 404, "there is no job 1");
+  refused(daemon.post("/api/jobs/1/explode", "{}"), 404, "no action explode");
+  // The make options are read by `make`'s own table.
+  const std::string form =
+      "--b\r\nContent-Disposition: form-data; "
+      "name=\"options\"\r\n\r\n[\"--structure\",\"band\",\"--samples\",\"999\"]\r\n"
+      "--b\r\nContent-Disposition: form-data; name=\"file\"; filename=\"cube.obj\"\r\n\r\nv 0 0 0\r\n--b--\r\n";
+  refused(daemon.raw(fmt::format("POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: multipart/form-data; "
+                                 "boundary=b\r\nContent-Length: {}\r\n\r\n{}",
+                                 form.size(), form)),
+          400, "make options: --samples: Value 999 not in range 1 to 64");
+  // Served meanwhile.
+  EXPECT_EQ(daemon.get("/api/jobs").status, 200);
+  // The slow client's connection is closed once its header's time is up.
+  EXPECT_EQ(exchange(slow, "", 5), "");
+  ::close(slow);
+  // TCP: the token is asked for, and only the right one lets anyone in.
+  const json where = json::parse(readFile(daemon.stateDir() / "rotafabd.json"));
+  std::string tcp;
+  for (const json& address : where["listen"]) {
+    if (address.get<std::string>().starts_with("tcp://")) tcp = "http://" + address.get<std::string>().substr(6);
+  }
+  ASSERT_FALSE(tcp.empty()) << where.dump();
+  const CommandResult none = daemon.client("jobs --server " + tcp);
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.err.find("this listener needs a token"), std::string::npos) << none.err;
+  const CommandResult wrong = daemon.client("jobs --server " + tcp + " --token guess");
+  EXPECT_EQ(wrong.status, 1);
+  EXPECT_NE(wrong.err.find("not one this daemon knows"), std::string::npos) << wrong.err;
+  const CommandResult right =
+      daemon.client("submit " + quoted(threeSheets()) + " --server " + tcp + " --token " + token);
+  EXPECT_EQ(right.status, 0) << right.err;
+  // A job submitted with a token belongs to the token's holder.
+  EXPECT_EQ(daemon.job(1)["owner"], "alice");
+}
+
+TEST(Daemon, AFullSpoolDiskRefusesTheSubmissionAndLosesNoEarlierJob) {
+  TempDir root;
+  Daemon daemon(root.path());
+  const fs::path spool = daemon.stateDir() / "spool";
+  fs::create_directories(spool);
+  if (::mount("tmpfs", spool.c_str(), "tmpfs", 0, "size=6m") != 0) {
+    GTEST_SKIP() << "mounting a small tmpfs needs root (CI runs as root)";
+  }
+  struct Unmount {
+    fs::path at;
+    ~Unmount() { ::umount2(at.c_str(), MNT_DETACH); }
+  } unmount{spool};
+  daemon.start();
+  ASSERT_EQ(daemon.client("submit " + quoted(threeSheets())).status, 0);
+  // A mesh of 8 MB: a cube and a long comment.
+  const fs::path big =
+      root.write("big.obj", readFile(kSource / "examples/cube.obj") + "# " + std::string(8 << 20, 'x') + "\n");
+  const CommandResult full = daemon.client("submit " + quoted(big) + " --structure band");
+  EXPECT_EQ(full.status, 1);
+  EXPECT_NE(full.err.find("the spool's disk is full; the job was not accepted"), std::string::npos) << full.err;
+  const json jobs = daemon.clientJson("jobs")["jobs"];
+  ASSERT_EQ(jobs.size(), 1u);
+  EXPECT_EQ(jobs[0]["kind"], "planned");
+  // Nothing half-written stays in the spool.
+  size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(spool))
+    entries += entry.path().filename().string().starts_with(".incoming") ? 1 : 0;
+  EXPECT_EQ(entries, 0u);
+  daemon.kill9();
+}
+
+TEST(Daemon, ADeviceFaultFailsOnlyItsJobWithTheDevicesOwnMessage) {
+  TempDir root;
+  Daemon daemon(root.path(),
+                "devices:\n"
+                "  - {name: faulty, machine: grbl-diode-400, uri: \"sim:grbl?speed=50&fault=alarm&after=30\"}\n"
+                "  - {name: good, machine: grbl-diode-400, uri: \"sim:grbl?speed=200\"}\n");
+  daemon.start();
+  const long long bad = daemon.clientJson("submit " + quoted(threeSheets()) + " --device faulty")["id"];
+  const long long good = daemon.clientJson("submit " + quoted(threeSheets()) + " --device good")["id"];
+  for (long long id : {bad, good}) {
+    ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+    ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  }
+  const json failed = daemon.waitForJob(bad, [](const json& j) { return state(j) == "failed"; });
+  EXPECT_EQ(state(failed), "failed") << failed.dump();
+  EXPECT_NE(failed.value("message", "").find("ALARM:1"), std::string::npos) << failed.dump();
+  EXPECT_NE(failed.value("message", "").find("--from-sheet 1"), std::string::npos) << failed.dump();
+  for (int sheet = 2; sheet <= 3; ++sheet) {
+    const json waiting = daemon.waitForJob(
+        good, [](const json& j) { return j.value("waiting_for_next", false); }, 120);
+    ASSERT_TRUE(waiting.value("waiting_for_next", false)) << waiting.dump();
+    ASSERT_EQ(daemon.client(fmt::format("next {}", good)).status, 0);
+  }
+  EXPECT_EQ(state(daemon.waitForJob(
+                good, [](const json& j) { return state(j) == "done"; }, 120)),
+            "done");
+  const json devices = daemon.clientJson("devices --daemon")["devices"];
+  EXPECT_EQ(devices[0]["state"], "fault");
+  EXPECT_NE(devices[0].value("message", "").find("ALARM:1"), std::string::npos) << devices.dump();
+  EXPECT_EQ(devices[1]["state"], "idle");
+}
+
+TEST(Daemon, AJobIsPlannedForAndCutOnASimulatedM2Nano) {
+  TempDir root;
+  Daemon daemon(root.path(), "devices: [{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=50\"}]\n");
+  daemon.start();
+  const json devices = daemon.clientJson("devices --daemon")["devices"];
+  const long long id =
+      daemon.clientJson("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --time 0")["id"];
+  const json ready = daemon.waitForJob(id, [](const json& j) { return state(j) == "ready" || state(j) == "failed"; });
+  ASSERT_EQ(state(ready), "ready") << ready.dump();
+  EXPECT_NE(ready["transitions"][1]["reason"].get<std::string>().find("k40-m2nano"), std::string::npos);
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  const json done = daemon.waitForJob(
+      id, [](const json& j) { return state(j) == "done" || state(j) == "failed"; }, 120);
+  EXPECT_EQ(state(done), "done") << done.dump();
+}
+
+TEST(Daemon, OneDaemonPerStateDirectoryAndAConfigMistakeIsOneLine) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  const int second = daemon.runToEnd({});
+  EXPECT_EQ(second, 1);
+  EXPECT_NE(readFile(daemon.log()).find("another rotafabd (pid "), std::string::npos) << readFile(daemon.log());
+  const fs::path bad = root.write("bad.yaml", "state_dir: " + (root.path() / "other").string() +
+                                                  "\ndevices:\n  - {name: laser1, uri: \"sim:grbl\", machine: nope}\n");
+  EXPECT_EQ(daemon.runToEnd({"--config", bad.string()}), 1);
+  EXPECT_NE(readFile(daemon.log()).find("device laser1: no machine profile named 'nope'"), std::string::npos)
+      << readFile(daemon.log());
+  // Still serving.
+  EXPECT_EQ(daemon.get("/api").status, 200);
+}
+
+TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {
+  TempDir root;
+  Daemon daemon(root.path());  // not started
+  const CommandResult r = daemon.client("jobs");
+  EXPECT_EQ(r.status, 1);
+  EXPECT_EQ(r.err, fmt::format("error: no rotafabd answers on {}: start it with `rotafabd` (in another terminal, or as "
+                               "a service), or give --server URL\n",
+                               daemon.socket().string()));
+}
+
+}  // namespace
+}  // namespace rotafab::test
