@@ -225,6 +225,12 @@ void DaemonClient::events(const std::string& target,
       }
     }
   } catch (const boost::system::system_error& error) {
+    if (error.code() == asio::error::eof || error.code() == asio::error::connection_reset) {
+      throw DaemonUnreachable(
+          fmt::format("rotafabd at {} closed the event stream: it has stopped (its jobs say where "
+                      "they were once it runs again)",
+                      address_.describe()));
+    }
     throw DaemonUnreachable(
         fmt::format("the event stream of rotafabd at {} ended: {}", address_.describe(), error.code().message()));
   }

@@ -8,11 +8,13 @@
 #include <iostream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "core/Duration.h"
 #include "daemon/CommandSupport.h"
 #include "daemon/DaemonClient.h"
 #include "daemon/MakeOptions.h"
+#include "daemon/RunProgress.h"
 #include "jobs/Manifest.h"
 
 namespace rotafab::cli {
@@ -144,48 +146,86 @@ bool settled(const json& job) {
 // interrupted, or ready (planned: an operator starts it).
 int follow(const DaemonClient& client, long long id) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  // At a terminal, Enter says the next sheet is loaded, as `rotafab run` asks.
+  const bool askHere = terminal && ::isatty(STDIN_FILENO) != 0;
   json job = client.get(fmt::format("/api/jobs/{}", id));
   printStatus(job);
   if (settled(job)) return job.value("state", "") == "failed" ? kDeviceFault : kSuccess;
-  std::string lastState = job.value("state", "");
+  std::string lastState = job.value("state", ""), lastLine;
   bool barShown = false;
-  int lastSheet = 0;
+  int lastSheet = 0, askedFor = 0;
   const auto endBar = [&] {
     if (barShown && terminal) fmt::print(stderr, "\n");
     barShown = false;
   };
+  core::Cancellation stopAsking;
+  std::thread asking;
+  const auto stopAsker = [&] {
+    stopAsking.cancel();
+    if (asking.joinable()) asking.join();
+  };
   int status = kSuccess;
-  client.events(fmt::format("/api/events?job={}", id), [&](const std::string& type, const json& data) {
-    if (type == "progress") {
-      if (data.value("phase", "") == "cutting" && data.value("sheet", 0) != lastSheet) {
-        endBar();
-        lastSheet = data.value("sheet", 0);
+  try {
+    client.events(fmt::format("/api/events?job={}", id), [&](const std::string& type, const json& data) {
+      if (type == "progress") {
+        if (data.value("phase", "") == "cutting" && data.value("sheet", 0) != lastSheet) {
+          endBar();
+          lastSheet = data.value("sheet", 0);
+        }
+        const std::string line = progressLine(data);
+        if (terminal) {
+          fmt::print(stderr, "\r{:<90}", line);
+          barShown = true;
+        } else {
+          // Without a terminal, a line at each tenth of a sheet (and each step of a plan).
+          const std::string decile =
+              data.value("phase", "") == "cutting"
+                  ? fmt::format("{}/{}", data.value("sheet", 0),
+                                10 * data.value("stroke", 0) / std::max(1, data.value("strokes", 0)))
+                  : line;
+          if (decile != lastLine) fmt::print(stderr, "{}\n", line);
+          lastLine = decile;
+        }
+        return true;
       }
-      const std::string line = progressLine(data);
-      if (terminal) {
-        fmt::print(stderr, "\r{:<90}", line);
-        barShown = true;
-      } else if (data.value("stroke", 1) == data.value("strokes", 0) || data.value("phase", "") != "cutting") {
-        fmt::print(stderr, "{}\n", line);
+      if (type != "job") return true;
+      const std::string state = data.value("state", "");
+      const bool waiting = data.value("waiting_for_next", false);
+      const int next = data.value("sheet", 0) + 1;
+      if (state != lastState) {
+        endBar();
+        fmt::print(stderr, "job {}: {}: {}\n", id, state, data.value("message", ""));
+        lastState = state;
+      }
+      if (waiting && askedFor != next) {
+        endBar();
+        askedFor = next;
+        if (askHere) {
+          fmt::print(stderr, "job {}: load sheet {} and press Enter (or run `rotafab next {}`)\n", id, next, id);
+          if (asking.joinable()) asking.join();
+          asking = std::thread([&client, id, &stopAsking] {
+            if (!waitForEnter(stopAsking)) return;
+            try {
+              client.post(fmt::format("/api/jobs/{}/next", id), json::object());
+            } catch (const std::exception& error) {
+              fmt::print(stderr, "error: {}\n", error.what());
+            }
+          });
+        } else {
+          fmt::print(stderr, "job {}: load sheet {} and run `rotafab next {}`\n", id, next, id);
+        }
+      }
+      if (settled(data)) {
+        status = state == "failed" ? kDeviceFault : kSuccess;
+        return false;
       }
       return true;
-    }
-    if (type != "job") return true;
-    const std::string state = data.value("state", "");
-    if (state != lastState || data.value("waiting_for_next", false)) {
-      endBar();
-      fmt::print(stderr, "job {}: {}: {}\n", id, state, data.value("message", ""));
-      if (data.value("waiting_for_next", false)) {
-        fmt::print(stderr, "job {}: load sheet {} and run `rotafab next {}`\n", id, data.value("sheet", 0) + 1, id);
-      }
-      lastState = state;
-    }
-    if (settled(data)) {
-      status = state == "failed" ? kDeviceFault : kSuccess;
-      return false;
-    }
-    return true;
-  });
+    });
+  } catch (...) {
+    stopAsker();
+    throw;
+  }
+  stopAsker();
   return status;
 }
 

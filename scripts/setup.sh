@@ -14,7 +14,7 @@ packages=(
   # libraries (see README "Dependencies" for what each is for)
   libassimp-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
   libspdlog-dev libfmt-dev libyaml-cpp-dev libboost-dev libboost-system-dev
-  libsqlite3-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
+  libsqlite3-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
   libopenmesh-dev
   hershey-fonts-data libumockdev-dev umockdev
   # tests and benchmarks

@@ -381,6 +381,11 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
         throw ApiError(400, fmt::format("unknown field \"{}\" (path, options, device, priority)", key));
       }
     }
+    if (std::is_same_v<Protocol, asio::ip::tcp> && body.contains("path")) {
+      throw ApiError(403,
+                     "a path on the daemon's machine can be submitted over its Unix socket only; over TCP, upload "
+                     "the mesh (a multipart form with file=@MESH)");
+    }
     if (!body.contains("path") || !body["path"].is_string()) {
       throw ApiError(400,
                      "a submission is a multipart upload of the mesh (file=@MESH), or {\"path\": \"/abs/path\"} of a "

@@ -87,9 +87,15 @@ class JobStore {
   virtual ~JobStore() = default;
   // Adds a queued job (last in its priority) and its submission as its first transition.
   virtual JobRecord addJob(const NewJob& job, std::string_view reason) = 0;
+  // Several at once, in one transaction (what came in while the last one committed), in order.
+  virtual std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) = 0;
   [[nodiscard]] virtual std::optional<JobRecord> job(JobId id) = 0;
   // Every job in queue order: priority (higher first), then position.
   [[nodiscard]] virtual std::vector<JobRecord> jobs() = 0;
+  // The jobs in these states, in queue order; the first `limit` of them, and
+  // only those for `device` when one is named.
+  [[nodiscard]] virtual std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit = SIZE_MAX,
+                                                      const std::string& device = "") = 0;
   // Moves a job to `to` if the table allows it from the state it is in
   // (JobState.h; TransitionRefused otherwise, naming both), with `change`,
   // and records the transition, all in one transaction.

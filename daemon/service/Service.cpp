@@ -142,6 +142,16 @@ struct Service::Impl {
   std::map<JobId, std::unique_ptr<Cut>> cuts;
   std::vector<std::thread> checks;
   std::map<size_t, std::function<void(const ServiceEvent&)>> subscribers;
+  // Submissions whose files are written: synced together (on syncStrand),
+  // then added together (on the strand), so that the clients who submit at
+  // once share one syncfs and one transaction.
+  struct Pending {
+    Spool::Entry entry;
+    NewJob job;
+    ReplyHandler done;
+  };
+  asio::strand<asio::thread_pool::executor_type> syncStrand{workers.get_executor()};
+  std::vector<std::shared_ptr<Pending>> toSync, toAdd;
   size_t nextSubscriber = 1;
   bool stopping = false;
   std::function<void()> stopped;
@@ -295,8 +305,8 @@ struct Service::Impl {
   // (never restarted), plans it was making are made again.
   void recover() {
     std::set<std::string> named;
-    for (const JobRecord& job : store->jobs()) {
-      named.insert(job.spool);
+    for (const JobRecord& job : store->jobs()) named.insert(job.spool);
+    for (const JobRecord& job : store->jobsIn({JobState::Running, JobState::Paused, JobState::Planning})) {
       if (holdsDevice(job.state)) {
         const std::string where = sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes);
         const std::string reason = fmt::format(
@@ -367,31 +377,24 @@ struct Service::Impl {
   // and cuts of ready jobs on idle devices configured to start by themselves.
   void pump() {
     if (stopping) return;
-    std::vector<JobRecord> all;
     try {
-      all = store->jobs();
-    } catch (const StoreError& error) {
-      log->error("{}", error.what());
-      return;
-    }
-    for (const JobRecord& job : all) {
-      if (planning.size() >= config.planners) break;
-      if (job.state == JobState::Queued) startPlanning(job);
-    }
-    for (size_t index = 0; index < devices.size(); ++index) {
-      Device& device = devices[index];
-      if (!device.config.autoStart || device.state != "idle" || device.job) continue;
-      for (const JobRecord& job : all) {
-        if (job.state == JobState::Ready && job.device == device.config.name) {
+      if (planning.size() < config.planners) {
+        for (const JobRecord& job : store->jobsIn({JobState::Queued}, config.planners - planning.size())) {
+          startPlanning(job);
+        }
+      }
+      for (Device& device : devices) {
+        if (!device.config.autoStart || device.state != "idle" || device.job) continue;
+        for (const JobRecord& job : store->jobsIn({JobState::Ready}, 1, device.config.name)) {
           try {
-            startCut(store->job(job.id).value(), 1,
-                     fmt::format("started by itself: {} has auto_start", device.config.name));
+            startCut(job, 1, fmt::format("started by itself: {} has auto_start", device.config.name));
           } catch (const std::exception& error) {
             log->error("job {}: {}", job.id, error.what());
           }
-          break;
         }
       }
+    } catch (const std::exception& error) {
+      log->error("{}", error.what());
     }
   }
 
@@ -621,9 +624,12 @@ struct Service::Impl {
         });
         return answer.get();
       };
-      events.sheetStarted = [this, id, fromSheet, sheets](size_t index, const jobs::Toolpath& toolpath,
-                                                          double seconds) {
+      // The sheet being cut, in the job's numbering (the run's own counts from fromSheet).
+      auto current = std::make_shared<std::atomic<int>>(fromSheet);
+      events.sheetStarted = [this, id, fromSheet, sheets, current](size_t index, const jobs::Toolpath& toolpath,
+                                                                   double seconds) {
         const int sheet = fromSheet + static_cast<int>(index);
+        *current = sheet;
         const auto strokes = static_cast<int64_t>(toolpath.strokes.size());
         onStrand([this, id, sheet, sheets, strokes, seconds] {
           auto c = cuts.find(id);
@@ -643,8 +649,8 @@ struct Service::Impl {
           }
         });
       };
-      events.progress = [this, id, fromSheet, sheets](const devices::Progress& progress) {
-        onStrand([this, id, progress, fromSheet, sheets] { cutProgress(id, progress, fromSheet, sheets); });
+      events.progress = [this, id, sheets, current](const devices::Progress& progress) {
+        onStrand([this, id, progress, sheet = current->load(), sheets] { cutProgress(id, progress, sheet, sheets); });
       };
       summary = run.run(false, events, control->cancel);
       control->run = nullptr;
@@ -662,11 +668,10 @@ struct Service::Impl {
     });
   }
 
-  void cutProgress(JobId id, const devices::Progress& progress, int fromSheet, int sheets) {
+  void cutProgress(JobId id, const devices::Progress& progress, int sheet, int sheets) {
     auto c = cuts.find(id);
     if (c == cuts.end()) return;
     Cut& cut = *c->second;
-    const int sheet = fromSheet + progress.sheet - 1;
     cut.progress = {{"job", id},
                     {"phase", "cutting"},
                     {"sheet", sheet},
@@ -764,6 +769,63 @@ struct Service::Impl {
     }
     deviceChanged(device);
     finishIfStopping();
+    pump();
+  }
+
+  // On syncStrand: one syncfs for every entry written so far.
+  void syncSubmissions() {
+    auto batch = std::move(toSync);
+    toSync.clear();
+    std::vector<Spool::Entry*> entries;
+    for (const auto& pending : batch) entries.push_back(&pending->entry);
+    try {
+      Spool::Entry::commitAll(entries);
+    } catch (const std::exception& error) {
+      log->error("submissions refused: {}", error.what());
+      for (const auto& pending : batch) {
+        pending->done({507, {{"error", fmt::format("the job was not accepted: {}", error.what())}}});
+      }
+      return;  // the entries go with the batch
+    }
+    onStrand([this, batch = std::move(batch)] {
+      toAdd.insert(toAdd.end(), batch.begin(), batch.end());
+      if (toAdd.size() == batch.size()) onStrand([this] { addSubmissions(); });
+    });
+  }
+
+  // On the strand: the rows of every submission synced so far, in one transaction.
+  void addSubmissions() {
+    auto batch = std::move(toAdd);
+    toAdd.clear();
+    const auto refuseAll = [&](int status, const std::string& why) {
+      for (const auto& pending : batch) {
+        std::error_code ignored;
+        fs::remove_all(pending->entry.folder(), ignored);
+        pending->done({status, {{"error", why}}});
+      }
+    };
+    if (stopping) return refuseAll(503, "the daemon is stopping");
+    std::vector<NewJob> jobs;
+    std::vector<std::string> reasons;
+    for (const auto& pending : batch) {
+      jobs.push_back(pending->job);
+      reasons.push_back(fmt::format("submitted by {}", pending->job.owner));
+    }
+    std::vector<JobRecord> added;
+    try {
+      added = store->addJobs(jobs, reasons);
+    } catch (const StoreError& error) {
+      log->error("{}", error.what());
+      return refuseAll(507, error.what());
+    } catch (const std::exception& error) {
+      log->error("{}", error.what());
+      return refuseAll(500, error.what());
+    }
+    for (size_t i = 0; i < added.size(); ++i) {
+      log->info("job {}: {} submitted by {}", added[i].id, added[i].source, added[i].owner);
+      jobChanged(added[i]);
+      batch[i]->done({201, jobJson(added[i])});
+    }
     pump();
   }
 
@@ -988,9 +1050,15 @@ void Service::submit(Submission submission, ReplyHandler done) {
           }
           job.kind = JobKind::Planned;
           job.source = path.string();
-          // Read and checked before it is queued: a folder that cannot be cut is refused now.
-          const auto sheets = jobs::readJobSheets(path, std::nullopt);
-          entry->copyFolder(path);
+          // Its manifest is looked at now (a folder that is not a make output is refused at once), and
+          // read with its sheets when the job is planned, against its device's bed, off the submission's path.
+          std::ifstream manifestFile(path / "manifest.json");
+          char first = 0;
+          manifestFile >> first;
+          if (first != '{') {
+            throw ApiError(400, fmt::format("{}: manifest.json is not a manifest (not a JSON object)", path.string()));
+          }
+          entry->addFolder(path);
         } else if (fs::is_regular_file(path, error)) {
           job.kind = JobKind::Mesh;
           job.source = path.filename().string();
@@ -1004,7 +1072,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
           throw ApiError(400, fmt::format("{}: no such file or folder on the daemon's machine", path.string()));
         }
       }
-      job.spool = entry->commit();
+      job.spool = entry->name();
     } catch (const ApiError& error) {
       refused = {error.status, {{"error", error.what()}}};
     } catch (const core::UserError& error) {
@@ -1022,20 +1090,11 @@ void Service::submit(Submission submission, ReplyHandler done) {
       done(refused);
       return;
     }
-    impl.answer(std::move(done), [&impl, job, entry = std::make_shared<std::optional<Spool::Entry>>(std::move(entry))] {
-      if (impl.stopping) throw ApiError(503, "the daemon is stopping");
-      JobRecord added;
-      try {
-        added = impl.store->addJob(job, fmt::format("submitted by {}", job.owner));
-      } catch (...) {
-        std::error_code ignored;
-        fs::remove_all(impl.spool->pathOf(job.spool), ignored);
-        throw;
-      }
-      impl.log->info("job {}: {} submitted by {}", added.id, added.source, added.owner);
-      impl.jobChanged(added);
-      impl.pump();
-      return Reply{201, impl.jobJson(impl.store->job(added.id).value())};
+    // Synced to disk with whatever else came in meanwhile, then added with it.
+    auto pending = std::make_shared<Impl::Pending>(Impl::Pending{std::move(*entry), job, std::move(done)});
+    asio::post(impl.syncStrand, [&impl, pending] {
+      impl.toSync.push_back(pending);
+      if (impl.toSync.size() == 1) asio::post(impl.syncStrand, [&impl] { impl.syncSubmissions(); });
     });
   });
 }

@@ -12,13 +12,9 @@
 #include <stdexcept>
 #include <system_error>
 
-#include "jobs/AtomicFile.h"
-
 namespace rotafab::service {
 namespace fs = std::filesystem;
 namespace {
-
-constexpr std::string_view kIncoming = ".incoming-";
 
 std::string randomName() {
   static thread_local std::mt19937_64 generator{std::random_device{}()};
@@ -48,21 +44,21 @@ Spool::Spool(fs::path folder) : folder_(std::move(folder)) {
 
 Spool::Entry Spool::begin() const {
   const std::string name = "job-" + randomName();
-  fs::path temporary = folder_ / (std::string(kIncoming) + name);
+  fs::path folder = folder_ / name;
   std::error_code error;
-  fs::create_directory(temporary, error);
+  fs::create_directory(folder, error);
   if (error) {
-    throw std::runtime_error(fmt::format("{}: cannot create a spool entry: {}", temporary.string(), error.message()));
+    throw std::runtime_error(fmt::format("{}: cannot create a spool entry: {}", folder.string(), error.message()));
   }
-  return Entry(*this, std::move(temporary), name);
+  return Entry(*this, std::move(folder), name);
 }
 
-Spool::Entry::Entry(const Spool& spool, fs::path temporary, std::string name)
-    : spool_(&spool), temporary_(std::move(temporary)), name_(std::move(name)) {}
+Spool::Entry::Entry(const Spool& spool, fs::path folder, std::string name)
+    : spool_(&spool), folder_(std::move(folder)), name_(std::move(name)) {}
 
 Spool::Entry::Entry(Entry&& other) noexcept
     : spool_(other.spool_),
-      temporary_(std::move(other.temporary_)),
+      folder_(std::move(other.folder_)),
       name_(std::move(other.name_)),
       committed_(other.committed_) {
   other.committed_ = true;  // the moved-from entry removes nothing
@@ -71,17 +67,37 @@ Spool::Entry::Entry(Entry&& other) noexcept
 Spool::Entry::~Entry() {
   if (committed_) return;
   std::error_code ignored;
-  fs::remove_all(temporary_, ignored);
+  fs::remove_all(folder_, ignored);
 }
 
 void Spool::Entry::addFile(std::string_view name, std::string_view bytes) {
-  jobs::writeFileAtomically(temporary_ / std::string(name), bytes);
+  const fs::path file = folder_ / std::string(name);
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0)
+    throw std::runtime_error(fmt::format("{}: cannot create the file: {}", file.string(), std::strerror(errno)));
+  size_t written = 0;
+  while (written < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = errno;
+      ::close(fd);
+      throw std::runtime_error(fmt::format("{}: cannot write the file: {}", file.string(), std::strerror(error)));
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::close(fd) != 0) {
+    throw std::runtime_error(fmt::format("{}: cannot write the file: {}", file.string(), std::strerror(errno)));
+  }
 }
 
-void Spool::Entry::copyFolder(const fs::path& from) {
+void Spool::Entry::addFolder(const fs::path& from) {
   std::error_code error;
   for (const fs::directory_entry& file : fs::directory_iterator(from, error)) {
     if (!file.is_regular_file()) continue;
+    const fs::path target = folder_ / file.path().filename();
+    if (::link(file.path().c_str(), target.c_str()) == 0) continue;
+    // Another file system, or a file the daemon may not link: a copy.
     std::ifstream in(file.path(), std::ios::binary);
     std::ostringstream bytes;
     bytes << in.rdbuf();
@@ -91,15 +107,26 @@ void Spool::Entry::copyFolder(const fs::path& from) {
   if (error) throw std::runtime_error(fmt::format("{}: cannot read the folder: {}", from.string(), error.message()));
 }
 
+void Spool::Entry::commitAll(const std::vector<Entry*>& entries) {
+  if (entries.empty()) return;
+  entries.front()->commit();
+  for (Entry* entry : entries) entry->committed_ = true;
+}
+
 std::string Spool::Entry::commit() {
-  syncFolder(temporary_);
-  const fs::path final = spool_->folder_ / name_;
-  if (::rename(temporary_.c_str(), final.c_str()) != 0) {
+  const int fd = ::open(folder_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) {
     throw std::runtime_error(
-        fmt::format("{}: cannot rename the spool entry: {}", final.string(), std::strerror(errno)));
+        fmt::format("{}: cannot open the spool entry: {}", folder_.string(), std::strerror(errno)));
+  }
+  const int synced = ::syncfs(fd);
+  const int error = errno;
+  ::close(fd);
+  if (synced != 0) {
+    throw std::runtime_error(
+        fmt::format("{}: cannot sync the spool entry: {}", folder_.string(), std::strerror(error)));
   }
   committed_ = true;
-  syncFolder(spool_->folder_);
   return name_;
 }
 
@@ -109,7 +136,7 @@ size_t Spool::removeOrphans(const std::set<std::string>& named) const {
   for (const fs::directory_entry& entry : fs::directory_iterator(folder_, error)) {
     const std::string name = entry.path().filename().string();
     if (named.contains(name)) continue;
-    if (!name.starts_with(kIncoming) && !name.starts_with("job-")) continue;
+    if (!name.starts_with("job-")) continue;
     std::error_code ignored;
     fs::remove_all(entry.path(), ignored);
     ++removed;

@@ -2,16 +2,20 @@
 // The daemon's spool: one folder per job under the state directory, for the
 // mesh that was uploaded and the sheets planned from it. A job's row may
 // point at its folder only once every byte in it is on disk: an entry is
-// filled under a temporary name, each file written and fsynced
-// (jobs/AtomicFile.h), then renamed to its final name and the spool's own
-// folder fsynced, so that after a kill or a power cut a folder with a final
-// name is whole. What a kill leaves between the rename and the row (a
-// folder no job names) is removed at the next start.
+// filled, then the file system is synced (syncfs: one journal commit for
+// every file and name in the entry, where an fsync of each would cost one
+// each), and only then does the store get the row. A folder no row names is
+// one a kill or a failure left before its row: it is removed when the entry
+// fails, and at the next start. A planned folder's files are hard-linked
+// into the entry where the file system allows it (a `make` output is
+// replaced file by file, by rename, never written in place, so a link keeps
+// the sheets as submitted), and copied otherwise.
 
 #include <filesystem>
 #include <set>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rotafab::service {
 
@@ -27,19 +31,22 @@ class Spool {
     Entry& operator=(const Entry&) = delete;
     Entry(Entry&& other) noexcept;
     ~Entry();
-    // Writes one file into the entry, durably. Throws std::runtime_error ("... the disk is full").
+    // Writes one file into the entry. Throws std::runtime_error naming it ("No space left on device").
     void addFile(std::string_view name, std::string_view bytes);
-    // Copies the files of a folder (not its subfolders) into the entry, durably.
-    void copyFolder(const std::filesystem::path& from);
-    [[nodiscard]] const std::filesystem::path& folder() const { return temporary_; }
-    // Gives the entry its final name, durably; returns that name (relative to the spool).
+    // The files of a folder (not its subfolders), linked or copied into the entry.
+    void addFolder(const std::filesystem::path& from);
+    [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }
+    // Syncs the entry to disk; returns its name (relative to the spool), for the job's row.
     std::string commit();
+    // Syncs all of them with one syncfs (they are on one file system); throws as commit().
+    static void commitAll(const std::vector<Entry*>& entries);
+    [[nodiscard]] const std::string& name() const { return name_; }
 
    private:
     friend class Spool;
-    Entry(const Spool& spool, std::filesystem::path temporary, std::string name);
+    Entry(const Spool& spool, std::filesystem::path folder, std::string name);
     const Spool* spool_;
-    std::filesystem::path temporary_;
+    std::filesystem::path folder_;
     std::string name_;
     bool committed_ = false;
   };
@@ -48,7 +55,7 @@ class Spool {
   Entry begin() const;
   [[nodiscard]] std::filesystem::path pathOf(const std::string& name) const { return folder_ / name; }
   [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }
-  // Removes half-filled entries and folders no job names; returns how many.
+  // Removes the folders no job names; returns how many.
   size_t removeOrphans(const std::set<std::string>& named) const;
 
  private:

@@ -54,6 +54,8 @@ constexpr const char* kMigrations[] = {
        CREATE INDEX jobs_queue ON jobs(priority DESC, position);
        CREATE INDEX transitions_job ON transitions(job, id);
        CREATE INDEX events_job ON events(job, id);)",
+    // 3: the jobs the scheduler looks for (queued, ready) found without reading every job.
+    R"(CREATE INDEX jobs_state ON jobs(state, priority DESC, position);)",
 };
 constexpr int kNewest = static_cast<int>(std::size(kMigrations));
 
@@ -93,6 +95,7 @@ class Statement {
   }
   int64_t integer(int column) const { return sqlite3_column_int64(statement_, column); }
   double real(int column) const { return sqlite3_column_double(statement_, column); }
+  void reset() { sqlite3_reset(statement_); }
   bool isNull(int column) const { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
   std::string text(int column) const {
     const auto* bytes = reinterpret_cast<const char*>(sqlite3_column_text(statement_, column));
@@ -196,29 +199,41 @@ class SqliteStore final : public JobStore {
   ~SqliteStore() override { sqlite3_close(db_); }
 
   JobRecord addJob(const NewJob& job, std::string_view reason) override {
+    return addJobs({job}, {std::string(reason)}).front();
+  }
+
+  std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) override {
     Transaction transaction(db_);
     Statement last(db_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
     last.step();
-    const double position = last.real(0) + 1, at = now();
+    double position = last.real(0);
+    const double at = now();
     Statement insert(db_,
                      "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
                      "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    insert.bind(1, stateName(JobState::Queued))
-        .bind(2, kindName(job.kind))
-        .bind(3, job.source)
-        .bind(4, job.owner)
-        .bind(5, job.device)
-        .bind(6, static_cast<int64_t>(job.priority))
-        .bind(7, position)
-        .bind(8, job.options)
-        .bind(9, job.spool)
-        .bind(10, at)
-        .bind(11, at);
-    insert.step();
-    const JobId id = sqlite3_last_insert_rowid(db_);
-    record(id, std::nullopt, JobState::Queued, at, reason);
+    std::vector<JobId> ids;
+    for (size_t i = 0; i < jobs.size(); ++i) {
+      const NewJob& job = jobs[i];
+      insert.bind(1, stateName(JobState::Queued))
+          .bind(2, kindName(job.kind))
+          .bind(3, job.source)
+          .bind(4, job.owner)
+          .bind(5, job.device)
+          .bind(6, static_cast<int64_t>(job.priority))
+          .bind(7, ++position)
+          .bind(8, job.options)
+          .bind(9, job.spool)
+          .bind(10, at)
+          .bind(11, at);
+      insert.step();
+      insert.reset();
+      ids.push_back(sqlite3_last_insert_rowid(db_));
+      record(ids.back(), std::nullopt, JobState::Queued, at, reasons.at(i));
+    }
     transaction.commit();
-    return *this->job(id);
+    std::vector<JobRecord> added;
+    for (JobId id : ids) added.push_back(*this->job(id));
+    return added;
   }
 
   std::optional<JobRecord> job(JobId id) override {
@@ -233,6 +248,22 @@ class SqliteStore final : public JobStore {
     std::vector<JobRecord> all;
     while (select.step()) all.push_back(jobOf(select));
     return all;
+  }
+
+  std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit, const std::string& device) override {
+    std::string marks;
+    for (size_t i = 0; i < states.size(); ++i) marks += i == 0 ? "?" : ", ?";
+    Statement select(db_, fmt::format("SELECT {} FROM jobs WHERE state IN ({}){} ORDER BY priority DESC, position "
+                                      "LIMIT ?",
+                                      kJobColumns, marks, device.empty() ? "" : " AND device = ?")
+                              .c_str());
+    int index = 1;
+    for (JobState state : states) select.bind(index++, stateName(state));
+    if (!device.empty()) select.bind(index++, device);
+    select.bind(index, static_cast<int64_t>(std::min<size_t>(limit, INT64_MAX)));
+    std::vector<JobRecord> found;
+    while (select.step()) found.push_back(jobOf(select));
+    return found;
   }
 
   JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change) override {

@@ -110,6 +110,13 @@ TEST(JobStore, TheQueueIsInPriorityThenSubmissionOrderAndCanBeReordered) {
   EXPECT_EQ(order(), (std::vector<JobId>{c, b, a}));
   store->reorder(a, 9, first.position);
   EXPECT_EQ(order(), (std::vector<JobId>{a, c, b}));
+  // The scheduler's question: which jobs are queued (or ready), in queue order.
+  store->transition(c, JobState::Planning, "planning");
+  const auto queued = store->jobsIn({JobState::Queued});
+  ASSERT_EQ(queued.size(), 2u);
+  EXPECT_EQ(queued[0].id, a);
+  EXPECT_EQ(queued[1].id, b);
+  EXPECT_EQ(store->jobsIn({JobState::Planning, JobState::Ready}).size(), 1u);
 }
 
 TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {

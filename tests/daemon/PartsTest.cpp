@@ -98,7 +98,7 @@ TEST(DaemonConfig, ATokenMatchesOnlyTheHashMadeFromIt) {
   EXPECT_NE(hashToken("s3cret", "ffff"), hash);
 }
 
-TEST(Spool, AnEntryIsThereOnlyOnceCommittedAndWhole) {
+TEST(Spool, AnEntryIsRemovedUnlessCommittedAndAFolderIsLinkedNotCopied) {
   TempDir dir;
   const Spool spool(dir.path() / "spool");
   std::string name;
@@ -116,11 +116,24 @@ TEST(Spool, AnEntryIsThereOnlyOnceCommittedAndWhole) {
   size_t entries = 0;
   for (const auto& entry : std::filesystem::directory_iterator(spool.folder())) entries += entry.exists();
   EXPECT_EQ(entries, 1u);
-  // What a kill leaves (a half-filled entry, a folder no job names) goes at the next start.
-  std::filesystem::create_directories(spool.folder() / ".incoming-job-dead");
+  // What a kill leaves (a half-filled entry, a whole one no job names yet) goes at the next start.
+  std::filesystem::create_directories(spool.folder() / "job-half");
   std::filesystem::create_directories(spool.folder() / "job-orphan");
   EXPECT_EQ(spool.removeOrphans({name}), 2u);
   EXPECT_TRUE(std::filesystem::exists(spool.pathOf(name) / "cube.obj"));
+  // A planned folder's files are linked: the same bytes, none copied, and
+  // they stay when the folder submitted is made again or removed.
+  const auto planned = dir.path() / "planned";
+  std::filesystem::create_directories(planned / "sub");
+  test::TempDir scratch;
+  std::ofstream(planned / "sheet-001.svg") << "<svg/>";
+  auto entry = spool.begin();
+  entry.addFolder(planned);
+  const std::string linked = entry.commit();
+  EXPECT_EQ(std::filesystem::hard_link_count(spool.pathOf(linked) / "sheet-001.svg"), 2u);
+  EXPECT_FALSE(std::filesystem::exists(spool.pathOf(linked) / "sub"));
+  std::filesystem::remove_all(planned);
+  EXPECT_EQ(test::readFile(spool.pathOf(linked) / "sheet-001.svg"), "<svg/>");
 }
 
 TEST(Spool, AFullDiskRefusesTheEntryAndLeavesNothingHalfWritten) {

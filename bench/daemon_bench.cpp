@@ -1,0 +1,237 @@
+// The daemon's benchmark (docs/PERFORMANCE.md, "The daemon"): a real
+// rotafabd on its Unix socket, against the disk it keeps its state on.
+//
+//   1. the rate of bare SQLite transactions (WAL, synchronous=FULL) on that
+//      disk: the limit a durable submission cannot beat;
+//   2. submissions of a planned `make` folder per second, from 1 and from 8
+//      clients at once, each a new connection;
+//   3. status queries per second (GET /api/jobs/ID), 4 clients;
+//   4. with 10,000 jobs in the store: the time from the daemon's start to its
+//      first answer, and its memory (VmRSS) then and after a list of all.
+//
+//   build/rotafab_daemon_bench [--dir DIR] [--jobs 10000]
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sqlite3.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/service/JobStore.h"
+
+extern char** environ;
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double bareSqliteRate(const fs::path& dir, int transactions) {
+  const fs::path file = dir / "bare.sqlite3";
+  sqlite3* db = nullptr;
+  sqlite3_open(file.c_str(), &db);
+  sqlite3_exec(db, "PRAGMA journal_mode=WAL; PRAGMA synchronous=FULL; CREATE TABLE t (a INTEGER, b TEXT)", nullptr,
+               nullptr, nullptr);
+  sqlite3_stmt* insert = nullptr;
+  sqlite3_prepare_v2(db, "INSERT INTO t VALUES (?, ?)", -1, &insert, nullptr);
+  const auto start = Clock::now();
+  for (int i = 0; i < transactions; ++i) {
+    sqlite3_exec(db, "BEGIN IMMEDIATE", nullptr, nullptr, nullptr);
+    sqlite3_bind_int(insert, 1, i);
+    sqlite3_bind_text(insert, 2, "a job row of about this many bytes: owner, source, options", -1, SQLITE_STATIC);
+    sqlite3_step(insert);
+    sqlite3_reset(insert);
+    sqlite3_exec(db, "COMMIT", nullptr, nullptr, nullptr);
+  }
+  const double rate = transactions / since(start);
+  sqlite3_finalize(insert);
+  sqlite3_close(db);
+  return rate;
+}
+
+int connectTo(const fs::path& socket) {
+  const int fd = ::socket(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  std::snprintf(address.sun_path, sizeof address.sun_path, "%s", socket.c_str());
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// One request on a new connection; the status code of the reply.
+int request(const fs::path& socket, const std::string& bytes) {
+  const int fd = connectTo(socket);
+  if (fd < 0) return 0;
+  ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  std::string reply;
+  char chunk[8192];
+  for (ssize_t n; (n = ::recv(fd, chunk, sizeof chunk, 0)) > 0;) reply.append(chunk, static_cast<size_t>(n));
+  ::close(fd);
+  return reply.size() > 12 ? std::stoi(reply.substr(9, 3)) : 0;
+}
+
+struct Daemon {
+  pid_t pid = 0;
+  fs::path root;
+  fs::path socket() const { return root / "run/rotafab/rotafabd.sock"; }
+  void start() {
+    const std::string state = "XDG_STATE_HOME=" + (root / "state").string(),
+                      run = "XDG_RUNTIME_DIR=" + (root / "run").string(), config = (root / "rotafabd.yaml").string();
+    std::vector<char*> env;
+    for (char** e = environ; *e; ++e) env.push_back(*e);
+    env.push_back(const_cast<char*>(state.c_str()));
+    env.push_back(const_cast<char*>(run.c_str()));
+    env.push_back(nullptr);
+    std::string program = ROTAFAB_DAEMON, flag = "--config";
+    char* argv[] = {program.data(), flag.data(), const_cast<char*>(config.c_str()), nullptr};
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    const std::string log = (root / "daemon.log").string();
+    posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+    posix_spawn(&pid, program.c_str(), &actions, nullptr, argv, env.data());
+    posix_spawn_file_actions_destroy(&actions);
+  }
+  // Seconds until it answers GET /api.
+  double waitServing() const {
+    const auto start = Clock::now();
+    while (request(socket(), "GET /api HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n") != 200) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      if (since(start) > 60) return -1;
+    }
+    return since(start);
+  }
+  long rssKiB() const {
+    std::ifstream status(fmt::format("/proc/{}/status", pid));
+    for (std::string line; std::getline(status, line);) {
+      if (line.starts_with("VmRSS:")) return std::stol(line.substr(6));
+    }
+    return -1;
+  }
+  void stop() {
+    ::kill(pid, SIGTERM);
+    ::waitpid(pid, nullptr, 0);
+  }
+};
+
+// Submissions of `folder` by path from `clients` threads for about `seconds`; per second.
+double submissionRate(const fs::path& socket, const fs::path& folder, int clients, double seconds) {
+  const std::string body = fmt::format(R"({{"path": "{}"}})", folder.string());
+  const std::string bytes = fmt::format(
+      "POST /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: "
+      "{}\r\n\r\n{}",
+      body.size(), body);
+  std::atomic<int> done{0}, failed{0};
+  const auto start = Clock::now();
+  std::vector<std::thread> threads;
+  for (int c = 0; c < clients; ++c) {
+    threads.emplace_back([&] {
+      while (since(start) < seconds) (request(socket, bytes) == 201 ? done : failed)++;
+    });
+  }
+  for (auto& thread : threads) thread.join();
+  if (failed > 0) fmt::print(stderr, "  ({} submissions refused)\n", failed.load());
+  return done / since(start);
+}
+
+double statusRate(const fs::path& socket, int clients, double seconds) {
+  const std::string bytes = "GET /api/jobs/1 HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n";
+  std::atomic<int> done{0};
+  const auto start = Clock::now();
+  std::vector<std::thread> threads;
+  for (int c = 0; c < clients; ++c) {
+    threads.emplace_back([&] {
+      while (since(start) < seconds) done += request(socket, bytes) == 200 ? 1 : 0;
+    });
+  }
+  for (auto& thread : threads) thread.join();
+  return done / since(start);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  fs::path dir = fs::temp_directory_path() / fmt::format("rotafab-daemon-bench-{}", ::getpid());
+  int manyJobs = 10000;
+  for (int i = 1; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    if (flag == "--dir") dir = fs::path(argv[i + 1]) / fmt::format("rotafab-daemon-bench-{}", ::getpid());
+    if (flag == "--jobs") manyJobs = std::stoi(argv[i + 1]);
+  }
+  fs::create_directories(dir);
+  // A planned folder: the cube on the default device's bed.
+  const fs::path planned = dir / "cube";
+  const std::string make = fmt::format(
+      "{} make {}/examples/cube.obj --structure band --machine grbl-diode-400 --out {} "
+      ">/dev/null 2>&1",
+      ROTAFAB_CLI, ROTAFAB_SOURCE_DIR, planned.string());
+  if (std::system(make.c_str()) != 0) {
+    fmt::print(stderr, "cannot make the cube's folder\n");
+    return 1;
+  }
+  fmt::print("state on {} (the disk of {})\n", dir.string(), fs::temp_directory_path().string());
+  const double bare = bareSqliteRate(dir, 3000);
+  fmt::print("bare SQLite transactions (WAL, synchronous=FULL): {:.0f}/s\n", bare);
+
+  Daemon daemon{0, dir / "queue"};
+  fs::create_directories(daemon.root);
+  std::ofstream(daemon.root / "rotafabd.yaml")
+      << "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=100\"}]\n";
+  daemon.start();
+  daemon.waitServing();
+  for (int clients : {1, 8}) {
+    const double rate = submissionRate(daemon.socket(), planned, clients, 5);
+    fmt::print("submissions of a planned folder, {} client{}: {:.0f}/s ({:.0f}% of bare SQLite)\n", clients,
+               clients == 1 ? "" : "s", rate, 100 * rate / bare);
+  }
+  fmt::print("status queries (GET /api/jobs/1), 4 clients: {:.0f}/s\n", statusRate(daemon.socket(), 4, 3));
+  daemon.stop();
+
+  // 10,000 jobs, most of them done, as a year of a busy workshop leaves them.
+  Daemon full{0, dir / "full"};
+  fs::create_directories(full.root / "state/rotafab");
+  std::ofstream(full.root / "rotafabd.yaml")
+      << "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=100\"}]\n";
+  {
+    auto store = rotafab::service::openSqliteStore(full.root / "state/rotafab/jobs.sqlite3");
+    for (int i = 0; i < manyJobs; ++i) {
+      rotafab::service::NewJob job;
+      job.kind = rotafab::service::JobKind::Planned;
+      job.source = fmt::format("/home/workshop/job-{}", i);
+      job.owner = "alice";
+      job.device = "laser1";
+      job.options = "[]";
+      job.spool = fmt::format("job-{:016x}", i);
+      const auto id = store->addJob(job, "submitted by alice").id;
+      if (i + 20 < manyJobs) {
+        store->transition(id, rotafab::service::JobState::Cancelled, "cancelled by alice");
+      }
+    }
+  }
+  const auto started = Clock::now();
+  full.start();
+  const double serving = full.waitServing();
+  fmt::print("with {} jobs in the store: serving {:.3f} s after the start (first answer {:.3f} s), VmRSS {:.1f} MiB\n",
+             manyJobs, since(started), serving, full.rssKiB() / 1024.0);
+  request(full.socket(), "GET /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
+  fmt::print("  after listing all {} jobs: VmRSS {:.1f} MiB\n", manyJobs, full.rssKiB() / 1024.0);
+  full.stop();
+  fs::remove_all(dir);
+  return 0;
+}
