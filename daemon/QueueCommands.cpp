@@ -177,12 +177,14 @@ int follow(const DaemonClient& client, long long id) {
           fmt::print(stderr, "\r{:<90}", line);
           barShown = true;
         } else {
-          // Without a terminal, a line at each tenth of a sheet (and each step of a plan).
+          // Without a terminal, a line at each tenth of a sheet, and at each step of a plan (its
+          // counts every tenth).
           const std::string decile =
               data.value("phase", "") == "cutting"
                   ? fmt::format("{}/{}", data.value("sheet", 0),
                                 10 * data.value("stroke", 0) / std::max(1, data.value("strokes", 0)))
-                  : line;
+                  : fmt::format("{}/{}/{}", data.value("phase", ""), data.value("step", ""),
+                                10 * data.value("done", 0) / std::max(1, data.value("total", 0)));
           if (decile != lastLine) fmt::print(stderr, "{}\n", line);
           lastLine = decile;
         }

@@ -133,7 +133,7 @@ TEST(Daemon, AKillAtAnyInstantLosesNoAcceptedJobAndRestartsNoCut) {
   for (int iteration = 0; iteration < iterations; ++iteration) {
     daemon.start();
     // Whatever is ready is started, so that some kills land mid-cut.
-    for (const json& job : daemon.clientJson("jobs")["jobs"]) {
+    for (const json& job : json(daemon.clientJson("jobs")["jobs"])) {
       if (state(job) == "ready") {
         if (daemon.client(fmt::format("start {}", job["id"].get<long long>())).status == 0) {
           everRunning.insert(job["id"].get<long long>());
@@ -177,14 +177,14 @@ TEST(Daemon, AKillAtAnyInstantLosesNoAcceptedJobAndRestartsNoCut) {
     }
     // Nothing starts by itself.
     std::this_thread::sleep_for(std::chrono::milliseconds(800));
-    for (const json& job : daemon.clientJson("jobs")["jobs"]) EXPECT_NE(state(job), "running") << job.dump();
+    for (const json& job : json(daemon.clientJson("jobs")["jobs"])) EXPECT_NE(state(job), "running") << job.dump();
     daemon.kill9();
   }
   EXPECT_GT(accepted.size(), static_cast<size_t>(iterations));
   // An interrupted job goes on only when an operator resumes it, from the sheet they say.
   daemon.start();
   std::optional<long long> interrupted;
-  for (const json& job : daemon.clientJson("jobs")["jobs"]) {
+  for (const json& job : json(daemon.clientJson("jobs")["jobs"])) {
     if (state(job) == "interrupted") interrupted = job["id"].get<long long>();
   }
   if (interrupted) {

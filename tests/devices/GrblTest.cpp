@@ -110,6 +110,29 @@ TEST(Grbl, RefusesToCutWithLaserModeOff) {
   }
 }
 
+// A connect that fails keeps no link: the next call opens the port again and
+// asks the controller again, instead of sending to one it never accepted.
+TEST(Grbl, AConnectThatFailsLeavesNoHalfSetLink) {
+  sim::GrblSimulatorOptions options;
+  options.laserMode = false;
+  sim::GrblSimulator simulator(options);
+  int opened = 0;
+  const std::string path = simulator.path();
+  grbl::GrblDriver driver(
+      [&opened, path] {
+        ++opened;
+        return openSerialLink(path, 115200);
+      },
+      quick());
+  EXPECT_THROW(driver.connect(), DeviceFault);
+  EXPECT_EQ(opened, 1);
+  // status() connects first when there is no link: the refusal again, from a fresh connect.
+  EXPECT_THROW(driver.status(), DeviceFault);
+  EXPECT_EQ(opened, 2);
+  // With no link, a safe stop cannot hear the controller confirm anything, and says so.
+  EXPECT_FALSE(driver.stopSafely());
+}
+
 // The whole job: every line taken in order, the buffer kept full and never
 // overflowed, the laser lit only while cutting and off at the end.
 TEST(Grbl, StreamsAJobToTheEndWithTheBufferFullAndNeverOverflowed) {
