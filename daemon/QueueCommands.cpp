@@ -368,8 +368,15 @@ void addQueueCommands(CLI::App& app, int& status) {
         if (make->json) {
           std::cout << job.dump() << '\n';
         } else {
-          fmt::print("job {}: {} queued{}\n", job.value("id", 0), job.value("source", ""),
+          fmt::print("job {}: {} {}{}\n", job.value("id", 0), job.value("source", ""),
+                     job.value("state", "") == "queued" ? "queued" : "submitted",
                      job["device"].is_string() ? " for " + job["device"].get<std::string>() : "");
+        }
+        // A planned folder is checked as it is submitted: its job is ready at once.
+        if (settled(job)) {
+          if (!make->json)
+            fmt::print("job {}: {}: {}\n", job.value("id", 0), job.value("state", ""), job.value("message", ""));
+          return kSuccess;
         }
         if (*follows) return follow(daemon, job.value("id", 0LL));
         if (!make->json) fmt::print("follow it with `rotafab status {} --follow`\n", job.value("id", 0));

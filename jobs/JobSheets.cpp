@@ -16,13 +16,15 @@ namespace {
 
 // The sheets to read: (number, SVG file).
 std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesystem::path& target,
-                                                              std::optional<int> only) {
+                                                              std::optional<int> only,
+                                                              const nlohmann::json* manifestRead) {
   std::vector<std::pair<int, std::filesystem::path>> sheets;
   if (std::filesystem::is_directory(target)) {
     const auto manifestFile = target / "manifest.json";
-    const nlohmann::json manifest = readManifest(target);
+    const nlohmann::json manifest = manifestRead ? nlohmann::json() : readManifest(target);
+    const nlohmann::json& listed = manifestRead ? *manifestRead : manifest;
     try {
-      for (const auto& sheet : manifest.at("sheets")) {
+      for (const auto& sheet : listed.at("sheets")) {
         const int index = sheet.at("index");
         for (const auto& file : sheet.at("files")) {
           const std::string name = file;
@@ -50,11 +52,10 @@ std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesys
   return sheets;
 }
 
-}  // namespace
-
-std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only) {
+std::vector<JobSheet> readSheets(const std::filesystem::path& target, std::optional<int> only,
+                                 const nlohmann::json* manifest) {
   std::vector<JobSheet> sheets;
-  for (const auto& [index, file] : sheetFiles(target, only)) {
+  for (const auto& [index, file] : sheetFiles(target, only, manifest)) {
     try {
       sheets.push_back({index, file, readSheetSvg(file)});
     } catch (const std::invalid_argument& error) {
@@ -62,6 +63,16 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::op
     }
   }
   return sheets;
+}
+
+}  // namespace
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only) {
+  return readSheets(target, only, nullptr);
+}
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::json& manifest) {
+  return readSheets(folder, std::nullopt, &manifest);
 }
 
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {

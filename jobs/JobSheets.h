@@ -4,6 +4,7 @@
 // (SheetReader.h), and checked against the bed they are to be cut on.
 
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct JobSheet {
 // All the sheets, or only sheet `only`. Throws core::UserError naming the
 // folder, the manifest or the sheet file and what is wrong.
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only);
+// All the sheets of an output folder whose manifest (readManifest) the caller has read already.
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::json& manifest);
 
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -25,10 +26,17 @@ nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
           fmt::format("{}: not an output folder of `rotafab make`: it holds no manifest.json", folderOrFile.string()));
     }
   }
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw core::UserError(fmt::format("{}: cannot read it: {}", file.string(), std::strerror(errno)));
+  // Read whole, then parsed: nlohmann's parser reads a string several times faster than a stream.
+  std::string text;
+  in.seekg(0, std::ios::end);
+  text.resize(static_cast<size_t>(std::max<std::streamoff>(0, in.tellg())));
+  in.seekg(0);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (!in) throw core::UserError(fmt::format("{}: cannot read it: {}", file.string(), std::strerror(errno)));
   try {
-    return nlohmann::json::parse(in);
+    return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& error) {
     throw core::UserError(fmt::format("{}: not JSON: {}", file.string(), jsonErrorText(error)));
   }

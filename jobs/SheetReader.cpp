@@ -20,6 +20,8 @@ bool number(std::string_view text, size_t& at, double& value) {
   return true;
 }
 
+bool contains(const std::string& line, std::string_view tag) { return line.find(tag) != std::string::npos; }
+
 }  // namespace
 
 SheetDrawing readSheetSvg(const std::filesystem::path& file) {
@@ -76,15 +78,16 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
       }
       if (path.points.size() < 2) throw fail(lineNumber, "a path of fewer than 2 points");
       sheet.paths.push_back(std::move(path));
-    } else if (!sized && std::regex_search(line, m, svgTag)) {
+      // (Each regular expression only where its tag is: most lines are none of these.)
+    } else if (!sized && contains(line, "<svg ") && std::regex_search(line, m, svgTag)) {
       sheet.width = std::stod(m[1]), sheet.height = std::stod(m[2]);
       sized = true;
-    } else if (std::regex_search(line, m, descTag)) {
+    } else if (contains(line, "<desc>") && std::regex_search(line, m, descTag)) {
       sheet.index = std::stoi(m[1]), sheet.sheetCount = std::stoi(m[2]), sheet.margin = std::stod(m[3]);
       described = true;
-    } else if (std::regex_search(line, m, titleTag)) {
+    } else if (contains(line, "<title>") && std::regex_search(line, m, titleTag)) {
       sheet.title = m[1];
-    } else if (std::regex_search(line, m, groupTag)) {
+    } else if (contains(line, "<g id=\"") && std::regex_search(line, m, groupTag)) {
       const auto named = profiles::operationNamed(m[1].str());
       if (!named) {
         throw fail(lineNumber, fmt::format("group \"{}\" is not an operation (cut, score, etch, outline)", m[1].str()));

@@ -95,7 +95,7 @@ DaemonConfig loadConfig(const fs::path& file) {
   try {
     const auto keys = reader.keys(root, "",
                                   {"state_dir", "store", "host", "listen", "tokens", "devices", "upload_limit",
-                                   "connection_limit", "planners", "header_timeout", "body_timeout"},
+                                   "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
                                   {});
     bool listenGiven = false;
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
@@ -168,6 +168,7 @@ DaemonConfig loadConfig(const fs::path& file) {
     if (root["header_timeout"])
       config.headerTimeout = reader.number(root["header_timeout"], "header_timeout", 0.1, 3600);
     if (root["body_timeout"]) config.bodyTimeout = reader.number(root["body_timeout"], "body_timeout", 0.1, 86400);
+    if (root["plan_timeout"]) config.planTimeout = reader.number(root["plan_timeout"], "plan_timeout", 1, 7 * 86400);
     if (root["planners"]) config.planners = static_cast<unsigned>(reader.integer(root["planners"], "planners", 1, 64));
     if (!listenGiven && root["state_dir"]) config.listen = {"unix:" + defaultSocket(config.stateDir).string()};
     // A listener beyond this machine needs a token to let anyone in.

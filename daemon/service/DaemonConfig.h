@@ -38,6 +38,7 @@ struct DaemonConfig {
   double headerTimeout = 10;  // seconds for a request's header to arrive
   double bodyTimeout = 120;   // seconds for its body
   unsigned planners = 1;      // jobs planned at once (each on every core)
+  double planTimeout = 3600;  // seconds a plan may take before its job fails
 };
 
 // $XDG_STATE_HOME/rotafab, else ~/.local/state/rotafab.

@@ -9,6 +9,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -26,6 +27,21 @@ using JobId = int64_t;
 enum class JobKind { Mesh, Planned };
 std::string_view kindName(JobKind kind);
 
+// Fields a transition or a progress report changes with it (unset: unchanged).
+struct JobChange {
+  std::optional<std::string> device, summary;
+  std::optional<int> sheets, sheet;
+  std::optional<int64_t> stroke, strokes;
+};
+
+// A step a job takes in the very transaction that adds it (a planned folder
+// checked while it was submitted is queued, planning and ready in one commit
+// rather than three); each allowed by JobState.h from the one before.
+struct FirstStep {
+  JobState to = JobState::Queued;
+  std::function<std::string(JobId)> reason;  // given the job's number, which the store assigns
+};
+
 struct NewJob {
   JobKind kind = JobKind::Mesh;
   std::string source;   // the mesh file or folder as the submitter named it (for people)
@@ -34,6 +50,8 @@ struct NewJob {
   int priority = 0;     // higher first
   std::string options;  // the `make` options, as JSON (an array of command-line words)
   std::string spool;    // its folder in the spool, relative to the spool directory; durable before the job is added
+  std::vector<FirstStep> then;  // after its submission, in the same transaction
+  JobChange change;             // with the last of `then`
 };
 
 struct JobRecord {
@@ -51,13 +69,6 @@ struct JobRecord {
   int sheet = 0;
   int64_t stroke = 0, strokes = 0;
   std::string message;  // the reason of the last transition
-};
-
-// Fields a transition or a progress report changes with it (unset: unchanged).
-struct JobChange {
-  std::optional<std::string> device, summary;
-  std::optional<int> sheets, sheet;
-  std::optional<int64_t> stroke, strokes;
 };
 
 struct Transition {
@@ -85,7 +96,8 @@ class StoreError : public std::runtime_error {
 class JobStore {
  public:
   virtual ~JobStore() = default;
-  // Adds a queued job (last in its priority) and its submission as its first transition.
+  // Adds a queued job (last in its priority) and its submission as its first
+  // transition, then its `then` steps (TransitionRefused if one is not allowed).
   virtual JobRecord addJob(const NewJob& job, std::string_view reason) = 0;
   // Several at once, in one transaction (what came in while the last one committed), in order.
   virtual std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) = 0;

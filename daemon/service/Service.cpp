@@ -1,10 +1,12 @@
 #include "daemon/service/Service.h"
 
 #include <fmt/format.h>
+#include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
 #include <boost/asio/post.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <chrono>
 #include <fstream>
 #include <future>
@@ -20,6 +22,7 @@
 #include "devices/JobRun.h"
 #include "geometry/PolygonMesh.h"
 #include "jobs/JobSheets.h"
+#include "jobs/ManifestFile.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::service {
@@ -70,14 +73,36 @@ cli::MakeOptions parseMakeOptions(const std::string& mesh, const std::vector<std
   return options;
 }
 
-// A message about a file in the spool, in the words of the file the submitter named.
-std::string inSubmittersWords(std::string message, const fs::path& folder) {
+// A message about a file in the spool, in the words of the file the
+// submitter named: the spool's folder dropped, or said as `submitted`.
+std::string inSubmittersWords(std::string message, const fs::path& folder, const fs::path& submitted = {}) {
   const std::string prefix = folder.string() + "/";
-  for (size_t at = message.find(prefix); at != std::string::npos; at = message.find(prefix)) {
-    message.erase(at, prefix.size());
+  const std::string as = submitted.empty() ? "" : submitted.string() + "/";
+  for (size_t at = message.find(prefix); at != std::string::npos; at = message.find(prefix, at + as.size())) {
+    message.replace(at, prefix.size(), as);
   }
   return message;
 }
+
+// The notes a plan makes (make's own, naming the mesh by its path in the
+// spool), in the daemon's log as "job N: bunny.obj: ...".
+class JobNotesSink : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  JobNotesSink(std::shared_ptr<spdlog::logger> log, const fs::path& folder, std::string job)
+      : log_(std::move(log)), folder_(folder), job_(std::move(job)) {}
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& message) override {
+    const std::string text(message.payload.data(), message.payload.size());
+    log_->log(message.level, "{}: {}", job_, inSubmittersWords(text, folder_));
+  }
+  void flush_() override { log_->flush(); }
+
+ private:
+  std::shared_ptr<spdlog::logger> log_;
+  fs::path folder_;
+  std::string job_;
+};
 
 std::string sheetWhere(int sheet, int sheets, int64_t stroke, int64_t strokes) {
   if (sheet <= 0) return "before the first sheet";
@@ -107,6 +132,8 @@ struct Service::Impl {
     std::shared_ptr<core::Cancellation> cancel;
     json progress;
     std::string cancelledBy;  // who asked; empty: the daemon stopping
+    std::shared_ptr<asio::steady_timer> timeout;
+    bool timedOut = false;
   };
   struct Cut {
     std::shared_ptr<RunControl> control;
@@ -142,6 +169,9 @@ struct Service::Impl {
   std::map<JobId, std::unique_ptr<Cut>> cuts;
   std::vector<std::thread> checks;
   std::map<size_t, std::function<void(const ServiceEvent&)>> subscribers;
+  // Starts and resumes asked for while their device's check (at the daemon's
+  // start) is still running: answered once it ends, rather than refused.
+  std::vector<std::function<void()>> afterChecks;
   // Submissions whose files are written: synced together (on syncStrand),
   // then added together (on the strand), so that the clients who submit at
   // once share one syncfs and one transaction.
@@ -366,6 +396,9 @@ struct Service::Impl {
           store->addEvent(std::nullopt, "device", fmt::format("{}: {}: {}", device.config.name, state, message));
           deviceChanged(device);
           pump();
+          auto waiting = std::move(afterChecks);
+          afterChecks.clear();
+          for (auto& action : waiting) action();
         });
       });
     }
@@ -399,18 +432,19 @@ struct Service::Impl {
   }
 
   // The device a job is planned against: the one it names, or the first
-  // whose machine profile the job's options do not rule out.
-  Device* deviceFor(const JobRecord& job, std::string& why) {
-    if (!job.device.empty()) {
-      Device* device = deviceNamed(job.device);
-      if (!device) why = fmt::format("there is no device {} now (the devices: {})", job.device, deviceNames());
+  // whose machine profile the job's options do not rule out. It reads only
+  // what open() set (names and profiles), so a submission may ask it off the strand.
+  Device* deviceFor(const std::string& named, const std::string& options, std::string& why) {
+    if (!named.empty()) {
+      Device* device = deviceNamed(named);
+      if (!device) why = fmt::format("there is no device {} now (the devices: {})", named, deviceNames());
       return device;
     }
     if (devices.empty()) {
       why = "the daemon has no devices";
       return nullptr;
     }
-    const json words = json::parse(job.options.empty() ? "[]" : job.options, nullptr, false);
+    const json words = json::parse(options.empty() ? "[]" : options, nullptr, false);
     std::string machine;
     if (words.is_array()) {
       for (size_t i = 0; i + 1 < words.size(); ++i) {
@@ -424,9 +458,55 @@ struct Service::Impl {
     return nullptr;
   }
 
+  static std::string planningReason(const Device& device) {
+    return fmt::format("planning against {} ({})", device.config.name, device.machine.name);
+  }
+
+  static std::string plannedReason(int sheets, JobId id) {
+    return fmt::format("planned: {} sheet{}; start it with `rotafab start {}`", sheets, sheets == 1 ? "" : "s", id);
+  }
+
+  // A planned folder's plan: its sheets read and checked against the bed
+  // they are to be cut on; the summary the queue shows, from its manifest.
+  static json planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine) {
+    const json manifest = jobs::readManifest(folder);
+    const auto planned = jobs::readJobSheets(folder, manifest);
+    jobs::checkSheetsFitBed(planned, machine);
+    json summary{{"sheets", static_cast<int>(planned.size())}};
+    if (manifest.is_object()) {
+      if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
+      if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
+    }
+    return summary;
+  }
+
+  // A planned folder is planned while it is submitted (off the strand, in
+  // the submission's worker): its job is added ready, its queued, planning
+  // and ready recorded in the one transaction that adds it, where planning
+  // it from the queue would cost two more synced commits. A folder whose
+  // sheets are unreadable, or too large for the device's bed, is refused
+  // then and there, in the words of the folder the submitter named.
+  void planOnSubmission(NewJob& job, const fs::path& folder, const fs::path& submitted) {
+    std::string why;
+    const Device* device = deviceFor(job.device, job.options, why);
+    if (!device) throw ApiError(409, why);
+    json summary;
+    try {
+      summary = planOfFolder(folder, device->machine);
+    } catch (const core::UserError& error) {
+      throw ApiError(400, inSubmittersWords(error.what(), folder, submitted));
+    }
+    const int sheets = summary["sheets"].get<int>();
+    job.change.device = device->config.name;
+    job.change.sheets = sheets;
+    job.change.summary = summary.dump();
+    job.then = {{JobState::Planning, [reason = planningReason(*device)](JobId) { return reason; }},
+                {JobState::Ready, [sheets](JobId id) { return plannedReason(sheets, id); }}};
+  }
+
   void startPlanning(const JobRecord& queued) {
     std::string why;
-    Device* device = deviceFor(queued, why);
+    Device* device = deviceFor(queued.device, queued.options, why);
     if (!device) {
       jobChanged(store->transition(queued.id, JobState::Planning, "planning"));
       jobChanged(store->transition(queued.id, JobState::Failed, why));
@@ -434,12 +514,21 @@ struct Service::Impl {
     }
     JobChange change;
     change.device = device->config.name;
-    const JobRecord job =
-        store->transition(queued.id, JobState::Planning,
-                          fmt::format("planning against {} ({})", device->config.name, device->machine.name), change);
+    const JobRecord job = store->transition(queued.id, JobState::Planning, planningReason(*device), change);
     jobChanged(job);
     auto cancel = std::make_shared<core::Cancellation>();
-    planning[job.id] = Planning{cancel, json(), ""};
+    // A plan that takes longer than plan_timeout is stopped, and its job fails saying so.
+    auto timeout = std::make_shared<asio::steady_timer>(
+        strand,
+        std::chrono::duration_cast<asio::steady_timer::duration>(std::chrono::duration<double>(config.planTimeout)));
+    timeout->async_wait([this, id = job.id](const boost::system::error_code& error) {
+      if (error) return;  // the plan ended first
+      if (auto p = planning.find(id); p != planning.end()) {
+        p->second.timedOut = true;
+        p->second.cancel->cancel();
+      }
+    });
+    planning[job.id] = Planning{cancel, json(), "", timeout};
     asio::post(planners, [this, job, machine = device->machine, material = device->material, cancel] {
       plan(job, machine, material, cancel);
     });
@@ -455,18 +544,8 @@ struct Service::Impl {
     bool cancelled = false;
     try {
       if (job.kind == JobKind::Planned) {
-        const auto planned = jobs::readJobSheets(folder, std::nullopt);
-        jobs::checkSheetsFitBed(planned, machine);
-        sheets = static_cast<int>(planned.size());
-        summary = {{"sheets", sheets}};
-        std::ifstream manifestFile(folder / "manifest.json");
-        const json manifest = json::parse(manifestFile, nullptr, false);
-        if (manifest.is_object()) {
-          if (manifest.contains("panels") && manifest["panels"].is_array()) {
-            summary["panels"] = manifest["panels"].size();
-          }
-          if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
-        }
+        summary = planOfFolder(folder, machine);
+        sheets = summary["sheets"].get<int>();
       } else {
         const json words = json::parse(job.options.empty() ? "[]" : job.options);
         bool machineGiven = false, materialGiven = false;
@@ -498,7 +577,8 @@ struct Service::Impl {
                 publish("progress", data);
               });
             },
-            log);
+            std::make_shared<spdlog::logger>(
+                "plan", std::make_shared<JobNotesSink>(log, folder, fmt::format("job {}", job.id))));
         jobs::PlannedJob planned = jobs::makeJob(request, folder / "planned", context);
         syncFolder(folder / "planned");
         syncFolder(folder);
@@ -513,10 +593,23 @@ struct Service::Impl {
       failure = inSubmittersWords(error.what(), folder);
     }
     onStrand([this, id = job.id, sheets, summary, failure, cancelled] {
-      const std::string by = planning.count(id) ? planning[id].cancelledBy : "";
-      planning.erase(id);
+      std::string by;
+      bool timedOut = false;
+      if (auto p = planning.find(id); p != planning.end()) {
+        by = p->second.cancelledBy;
+        timedOut = p->second.timedOut;
+        p->second.timeout->cancel();
+        planning.erase(p);
+      }
       try {
-        if (cancelled && by.empty()) {
+        if (cancelled && timedOut) {
+          const std::string why = fmt::format(
+              "planning took longer than plan_timeout ({:g} s) and was stopped: give `make` a shorter --time, "
+              "or raise plan_timeout in the daemon's configuration",
+              config.planTimeout);
+          log->warn("job {}: {}", id, why);
+          jobChanged(store->transition(id, JobState::Failed, why));
+        } else if (cancelled && by.empty()) {
           store->transition(id, JobState::Queued, "the daemon stopped while it planned; it is planned again");
         } else if (cancelled) {
           jobChanged(store->transition(id, JobState::Cancelled, fmt::format("cancelled while planning by {}", by)));
@@ -527,10 +620,7 @@ struct Service::Impl {
           JobChange change;
           change.sheets = sheets;
           change.summary = summary.dump();
-          const JobRecord ready = store->transition(
-              id, JobState::Ready,
-              fmt::format("planned: {} sheet{}; start it with `rotafab start {}`", sheets, sheets == 1 ? "" : "s", id),
-              change);
+          const JobRecord ready = store->transition(id, JobState::Ready, plannedReason(sheets, id), change);
           log->info("job {}: planned, {} sheets", id, sheets);
           jobChanged(ready);
         }
@@ -822,7 +912,10 @@ struct Service::Impl {
       return refuseAll(500, error.what());
     }
     for (size_t i = 0; i < added.size(); ++i) {
-      log->info("job {}: {} submitted by {}", added[i].id, added[i].source, added[i].owner);
+      log->info("job {}: {} submitted by {}{}", added[i].id, added[i].source, added[i].owner,
+                added[i].state == JobState::Queued
+                    ? ""
+                    : fmt::format("; {}: {}", stateName(added[i].state), added[i].message));
       jobChanged(added[i]);
       batch[i]->done({201, jobJson(added[i])});
     }
@@ -837,6 +930,30 @@ struct Service::Impl {
   }
 
   // ---- actions ----
+
+  // Whether a start or resume of job `id` must wait for its device's check to end.
+  bool waitsForCheck(JobId id, const std::string& action) {
+    if (action != "start" && action != "resume") return false;
+    const auto job = store->job(id);
+    const Device* device = job ? deviceNamed(job->device) : nullptr;
+    return device && device->state == "checking";
+  }
+
+  // On the strand: the action, answered now or once its device is checked.
+  void actOrWait(JobId id, const std::string& action, const json& arguments, const std::string& who,
+                 ReplyHandler done) {
+    try {
+      if (!stopping && waitsForCheck(id, action)) {
+        afterChecks.push_back([this, id, action, arguments, who, done = std::move(done)]() mutable {
+          actOrWait(id, action, arguments, who, std::move(done));
+        });
+        return;
+      }
+    } catch (const std::exception&) {
+      // (the store's error is answered by act's own guard below)
+    }
+    done(guarded([&] { return act(id, action, arguments, who); }));
+  }
 
   Reply act(JobId id, const std::string& action, const json& arguments, const std::string& who) {
     if (stopping) throw ApiError(503, "the daemon is stopping");
@@ -1050,8 +1167,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
           }
           job.kind = JobKind::Planned;
           job.source = path.string();
-          // Its manifest is looked at now (a folder that is not a make output is refused at once), and
-          // read with its sheets when the job is planned, against its device's bed, off the submission's path.
+          // A folder that is not a make output, or whose sheets are wrong, is refused at once.
           std::ifstream manifestFile(path / "manifest.json");
           char first = 0;
           manifestFile >> first;
@@ -1059,6 +1175,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
             throw ApiError(400, fmt::format("{}: manifest.json is not a manifest (not a JSON object)", path.string()));
           }
           entry->addFolder(path);
+          impl.planOnSubmission(job, entry->folder(), path);
         } else if (fs::is_regular_file(path, error)) {
           job.kind = JobKind::Mesh;
           job.source = path.filename().string();
@@ -1147,7 +1264,9 @@ void Service::devices(ReplyHandler done) {
 
 void Service::act(JobId id, const std::string& action, const json& arguments, const std::string& who,
                   ReplyHandler done) {
-  impl_->answer(std::move(done), [this, id, action, arguments, who] { return impl_->act(id, action, arguments, who); });
+  impl_->onStrand([this, id, action, arguments, who, done = std::move(done)]() mutable {
+    impl_->actOrWait(id, action, arguments, who, std::move(done));
+  });
 }
 
 size_t Service::subscribe(std::function<void(const ServiceEvent&)> sink) {
@@ -1173,6 +1292,9 @@ void Service::shutdown(const std::string& why, std::function<void()> done) {
     impl.log->info("stopping ({}): {} cut{} and {} plan{} to stop", why, impl.cuts.size(),
                    impl.cuts.size() == 1 ? "" : "s", impl.planning.size(), impl.planning.size() == 1 ? "" : "s");
     for (auto& [id, planning] : impl.planning) planning.cancel->cancel();
+    auto waiting = std::move(impl.afterChecks);  // each answered: the daemon is stopping
+    impl.afterChecks.clear();
+    for (auto& action : waiting) action();
     for (auto& [id, cut] : impl.cuts) {
       cut->control->shutdown = true;
       cut->control->cancel.cancel();

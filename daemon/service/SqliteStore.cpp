@@ -229,6 +229,12 @@ class SqliteStore final : public JobStore {
       insert.reset();
       ids.push_back(sqlite3_last_insert_rowid(db_));
       record(ids.back(), std::nullopt, JobState::Queued, at, reasons.at(i));
+      JobState state = JobState::Queued;
+      for (size_t step = 0; step < job.then.size(); ++step) {
+        move(ids.back(), state, job.then[step].to, at, job.then[step].reason(ids.back()));
+        state = job.then[step].to;
+      }
+      if (!job.then.empty()) apply(ids.back(), job.change);
     }
     transaction.commit();
     std::vector<JobRecord> added;
@@ -270,16 +276,8 @@ class SqliteStore final : public JobStore {
     Transaction transaction(db_);
     const auto current = job(id);
     if (!current) throw TransitionRefused(fmt::format("there is no job {}", id));
-    if (!allowedTransition(current->state, to)) {
-      throw TransitionRefused(
-          fmt::format("job {} is {}; it cannot become {}", id, stateName(current->state), stateName(to)));
-    }
-    const double at = now();
-    Statement set(db_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
-    set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
-    set.step();
+    move(id, current->state, to, now(), reason);
     apply(id, change);
-    record(id, current->state, to, at, reason);
     transaction.commit();
     return *job(id);
   }
@@ -396,6 +394,17 @@ class SqliteStore final : public JobStore {
     setNumber("sheet", change.sheet);
     setNumber("stroke", change.stroke);
     setNumber("strokes", change.strokes);
+  }
+
+  // The job's state and message, and the transition's record; in the caller's transaction.
+  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) {
+    if (!allowedTransition(from, to)) {
+      throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
+    }
+    Statement set(db_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
+    set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
+    set.step();
+    record(id, from, to, at, reason);
   }
 
   void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {

@@ -23,18 +23,21 @@ struct SimAddress : DeviceAddress {
   // A file the simulated laser's every change is appended to ("on", "off"),
   // for a test that watches the laser from outside the process.
   std::string witness;
+  // Each reply this much later (a slow USB adapter's; a check that takes its time).
+  int latencyMs = 0;
 };
 
 // The faults a simulated GRBL can be told to have, for a drill of what the
 // operator sees (and for the command line's tests).
 constexpr const char* kGrblFaults = "stall, noise, garbage, alarm, silence or unplug";
 
-// sim:NAME[?speed=N][&fault=KIND[&after=LINES]]
+// sim:NAME[?speed=N][&fault=KIND[&after=LINES]][&witness=FILE][&latency=MS]
 std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
   auto parsed = std::make_unique<SimAddress>(uri);
   std::string query = splitQuery(uri).second;
-  const std::string takes = faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES and witness=FILE", kGrblFaults)
-                                   : "speed=N, a positive number";
+  const std::string takes =
+      faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES, witness=FILE and latency=MS", kGrblFaults)
+             : "speed=N, a positive number";
   while (!query.empty()) {
     const size_t end = query.find('&');
     const std::string option = query.substr(0, end);
@@ -54,6 +57,8 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
       parsed->after = *wholeNumber<size_t>(value);
     } else if (faults && key == "witness" && !value.empty()) {
       parsed->witness = value;
+    } else if (faults && key == "latency" && wholeNumber<unsigned>(value) && *wholeNumber<unsigned>(value) <= 10000) {
+      parsed->latencyMs = static_cast<int>(*wholeNumber<unsigned>(value));
     } else {
       throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
     }
@@ -104,6 +109,7 @@ class SimGrblEntry : public DriverEntry {
     const auto& sim = dynamic_cast<const SimAddress&>(address);
     GrblSimulatorOptions options;
     options.timeScale = sim.speed;
+    options.replyLatency = std::chrono::milliseconds(sim.latencyMs);
     if (!sim.witness.empty()) {
       options.laserChanged = [file = sim.witness](bool lit) {
         // Appended and closed at once: what is written survives a kill of the process.

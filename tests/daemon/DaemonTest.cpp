@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <sys/mount.h>
 
+#include <algorithm>
 #include <fstream>
 #include <mutex>
 #include <random>
@@ -274,6 +275,44 @@ TEST(Daemon, TwoHundredConcurrentSubmissionsEachLandExactlyOnce) {
   for (int tag = 0; tag < kClients * kEach; ++tag) EXPECT_EQ(priorities.count(tag), 1u) << tag;
   // In queue order: the highest priority first.
   EXPECT_EQ(jobs.front()["priority"], kClients * kEach - 1);
+  for (const json& job : jobs) EXPECT_EQ(job["state"], "ready") << job.dump();
+}
+
+TEST(Daemon, APlannedFolderIsReadyWhenSubmittedAndOneWithABrokenSheetIsRefusedNamingIt) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  // Its sheets are read and checked against the device's bed as it is submitted: ready at once,
+  // its queued, planning and ready recorded together.
+  const CommandResult submitted = daemon.client("submit " + quoted(threeSheets()));
+  ASSERT_EQ(submitted.status, 0) << submitted.err;
+  EXPECT_NE(submitted.out.find("job 1: ready: planned: 3 sheets; start it with `rotafab start 1`"), std::string::npos)
+      << submitted.out;
+  const json job = daemon.clientJson("status 1");
+  EXPECT_EQ(job["state"], "ready");
+  EXPECT_EQ(job["device"], "laser1");
+  EXPECT_EQ(job["sheets"], 3);
+  std::vector<std::string> states;
+  for (const json& t : job["transitions"]) states.push_back(t["to"]);
+  EXPECT_EQ(states, (std::vector<std::string>{"queued", "planning", "ready"}));
+  // A sheet that is not an SVG: one line naming it as the submitter knows it, and no job.
+  const fs::path broken = root.path() / "broken";
+  fs::copy(threeSheets(), broken);
+  std::string sheet;
+  for (const auto& entry : fs::directory_iterator(broken)) {
+    const std::string name = entry.path().filename().string();
+    if (name.ends_with(".svg") && !name.ends_with(".preview.svg")) sheet = entry.path().string();
+  }
+  ASSERT_FALSE(sheet.empty());
+  { std::ofstream(sheet, std::ios::trunc) << "<svg"; }
+  const CommandResult refused = daemon.client("submit " + quoted(broken));
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+  EXPECT_NE(refused.err.find(sheet), std::string::npos) << refused.err;
+  EXPECT_EQ(daemon.clientJson("jobs")["jobs"].size(), 1u);
+  size_t entries = 0;
+  for (const auto& entry : fs::directory_iterator(daemon.stateDir() / "spool")) entries += entry.is_directory() ? 1 : 0;
+  EXPECT_EQ(entries, 1u);
 }
 
 TEST(Daemon, HostileRequestsAreRefusedWhileOtherClientsAreServed) {
@@ -423,6 +462,43 @@ TEST(Daemon, AJobIsPlannedForAndCutOnASimulatedM2Nano) {
   const json done = daemon.waitForJob(
       id, [](const json& j) { return state(j) == "done" || state(j) == "failed"; }, 120);
   EXPECT_EQ(state(done), "done") << done.dump();
+}
+
+TEST(Daemon, APlanLongerThanPlanTimeoutIsStoppedAndItsJobFailsSayingSo) {
+  TempDir root;
+  Daemon daemon(root.path(), "plan_timeout: 1\n");
+  daemon.start();
+  // The bunny's default plan takes minutes on these machines.
+  const long long id =
+      daemon.clientJson("submit " + quoted(kSource / "examples/bunny.obj") + " --structure band")["id"];
+  const auto started = std::chrono::steady_clock::now();
+  const json failed = daemon.waitForJob(
+      id, [](const json& j) { return state(j) == "failed" || state(j) == "ready"; }, 60);
+  EXPECT_EQ(state(failed), "failed") << failed.dump();
+  EXPECT_NE(failed.value("message", "").find("longer than plan_timeout (1 s)"), std::string::npos) << failed.dump();
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(30));
+  // The planner is free again: the next job is planned.
+  const long long next =
+      daemon.clientJson("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --time 0")["id"];
+  EXPECT_EQ(state(daemon.waitForJob(next, [](const json& j) { return state(j) == "ready" || state(j) == "failed"; })),
+            "ready");
+}
+
+TEST(Daemon, AStartWhileItsDeviceIsStillCheckedWaitsForTheCheck) {
+  TempDir root;
+  // Each reply 400 ms late: the check at the daemon's start (connect, stop, laser off) takes seconds.
+  Daemon daemon(root.path(), "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?latency=400\"}]\n");
+  const fs::path folder = threeSheets();  // (made before the daemon starts its check)
+  daemon.start();
+  ASSERT_EQ(daemon.client("submit " + quoted(folder)).status, 0);
+  ASSERT_EQ(daemon.clientJson("devices --daemon")["devices"][0]["state"], "checking");
+  // Answered once the check ends, not refused because it had not.
+  const CommandResult started = daemon.client("start 1");
+  EXPECT_EQ(started.status, 0) << started.err;
+  const json devices = daemon.clientJson("devices --daemon")["devices"];
+  EXPECT_NE(devices[0].value("checked", "").find("stopped"), std::string::npos) << devices.dump();
+  EXPECT_EQ(state(daemon.job(1)), "running");
+  EXPECT_EQ(daemon.client("cancel 1").status, 0);
 }
 
 TEST(Daemon, OneDaemonPerStateDirectoryAndAConfigMistakeIsOneLine) {

@@ -71,6 +71,40 @@ TEST(JobStore, TheTableOfTransitionsIsEnforcedAndEveryMoveRecorded) {
   EXPECT_THROW(store->transition(99, JobState::Planning, "x"), TransitionRefused);
 }
 
+TEST(JobStore, AJobsFirstStepsAreRecordedWithItsSubmissionOrNotAtAll) {
+  TempDir dir;
+  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+  store->addJob(meshJob("first"), "submitted by alice");
+  // A planned folder checked while it was submitted: queued, planning and ready in one commit.
+  NewJob planned = meshJob("soccer");
+  planned.kind = JobKind::Planned;
+  planned.then = {
+      {JobState::Planning, [](JobId) { return std::string("planning against laser1"); }},
+      {JobState::Ready, [](JobId id) { return "planned; start it with `rotafab start " + std::to_string(id) + "`"; }}};
+  planned.change.sheets = 3;
+  const auto added = store->addJobs({planned, meshJob("third")}, {"submitted by bob", "submitted by carol"});
+  ASSERT_EQ(added.size(), 2u);
+  EXPECT_EQ(added[0].state, JobState::Ready);
+  EXPECT_EQ(added[0].sheets, 3);
+  EXPECT_EQ(added[0].message, "planned; start it with `rotafab start 2`");
+  EXPECT_EQ(added[1].state, JobState::Queued);
+  EXPECT_EQ(added[1].sheets, 0);
+  const auto history = store->transitions(added[0].id);
+  ASSERT_EQ(history.size(), 3u);
+  EXPECT_FALSE(history[0].from.has_value());
+  EXPECT_EQ(history[0].reason, "submitted by bob");
+  EXPECT_EQ(*history[1].from, JobState::Queued);
+  EXPECT_EQ(history[1].to, JobState::Planning);
+  EXPECT_EQ(*history[2].from, JobState::Planning);
+  EXPECT_EQ(history[2].to, JobState::Ready);
+  // A step the table refuses (a queued job cannot be cut) refuses the whole group: no job of it is added.
+  NewJob cut = meshJob("cut");
+  cut.then = {{JobState::Running, [](JobId) { return std::string("cut at once"); }}};
+  EXPECT_THROW(store->addJobs({meshJob("fourth"), cut}, {"s", "s"}), TransitionRefused);
+  EXPECT_EQ(store->jobs().size(), 3u);
+  EXPECT_EQ(store->addJob(meshJob("fifth"), "s").id, 4);
+}
+
 TEST(JobStore, FinalStatesAreFinalAndOnlyRunningOrPausedJobsHoldADevice) {
   for (JobState from : allStates()) {
     for (JobState to : allStates()) {

@@ -76,13 +76,15 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
       "1:10: listen[0]: tcp://0.0.0.0:8730 is reachable from other machines: give tokens (rotafabd --hash-token)");
   expectRefused("statedir: /tmp\n",
                 "1:1: statedir: unknown key (expected one of: state_dir, store, host, listen, tokens, devices, "
-                "upload_limit, connection_limit, planners, header_timeout, body_timeout)");
+                "upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
   expectRefused("devices: [{name: a, uri: x}, {name: a, uri: y}]\n",
                 "1:37: devices[1].name: another device has this name");
   expectRefused(
       "tokens: [{name: alice, hash: plain}]\n",
       "1:30: tokens[0].hash: expected \"sha256$SALT$HEX\" (64 hex digits), as `rotafabd --hash-token` prints it");
   expectRefused("devices: [a\n", "2:1: syntax: end of sequence flow not found");
+  EXPECT_EQ(loadConfig(dir.write("plan.yaml", "plan_timeout: 90\n")).planTimeout, 90);
+  EXPECT_EQ(defaults.planTimeout, 3600);
 }
 
 TEST(DaemonConfig, ATokenMatchesOnlyTheHashMadeFromIt) {
