@@ -4,12 +4,15 @@
 #include <sys/socket.h>
 #include <sys/time.h>
 
+#include <algorithm>
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
+#include <chrono>
 #include <random>
+#include <thread>
 
 #include "daemon/service/DaemonConfig.h"
 
@@ -160,9 +163,10 @@ HttpReply DaemonClient::request(const std::string& method, const std::string& ta
                                       address_.describe(), reply.status));
   }
   if (reply.status >= 400) {
-    throw core::UserError(reply.body.is_object() && reply.body.contains("error")
-                              ? reply.body["error"].get<std::string>()
-                              : fmt::format("rotafabd answered {}", reply.status));
+    throw DaemonRefused(reply.body.is_object() && reply.body.contains("error") && reply.body["error"].is_string()
+                            ? reply.body["error"].get<std::string>()
+                            : fmt::format("rotafabd answered {}", reply.status),
+                        reply.status, reply.body);
   }
   return reply;
 }
@@ -171,6 +175,23 @@ json DaemonClient::get(const std::string& target) const { return request("GET", 
 
 json DaemonClient::post(const std::string& target, const json& body) const {
   return request("POST", target, "application/json", body.dump()).body;
+}
+
+json DaemonClient::postPatiently(const std::string& target, const json& body, double patience,
+                                 const std::function<void(const DaemonRefused&)>& waiting) const {
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(patience);
+  bool told = false;
+  for (;;) {
+    try {
+      return post(target, body);
+    } catch (const DaemonRefused& refused) {
+      const json& after = refused.body.is_object() ? refused.body.value("retry_after", json()) : json();
+      if (!after.is_number() || std::chrono::steady_clock::now() >= until) throw;
+      if (!told) waiting(refused);
+      told = true;
+      std::this_thread::sleep_for(std::chrono::duration<double>(std::clamp(after.get<double>(), 0.05, 5.0)));
+    }
+  }
 }
 
 json DaemonClient::upload(const std::string& target, const std::string& fileName, const std::string& bytes,

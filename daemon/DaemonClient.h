@@ -34,14 +34,27 @@ class DaemonUnreachable : public core::UserError {
   using core::UserError::UserError;
 };
 
+// The daemon refused the request (4xx, 5xx): its own error text, and the reply's other fields.
+class DaemonRefused : public core::UserError {
+ public:
+  DaemonRefused(const std::string& message, int status, nlohmann::json body)
+      : core::UserError(message), status(status), body(std::move(body)) {}
+  int status;
+  nlohmann::json body;
+};
+
 class DaemonClient {
  public:
   explicit DaemonClient(ServerAddress address) : address_(std::move(address)) {}
 
-  // Throws DaemonUnreachable, and core::UserError with the daemon's own
+  // Throws DaemonUnreachable, and DaemonRefused with the daemon's own
   // error text for a refusal (4xx, 5xx).
   nlohmann::json get(const std::string& target) const;
   nlohmann::json post(const std::string& target, const nlohmann::json& body) const;
+  // As post(), asked again while the daemon's refusal says when to (`retry_after`: its device is
+  // being checked), for at most `patience` seconds; `waiting` is told the first time.
+  nlohmann::json postPatiently(const std::string& target, const nlohmann::json& body, double patience,
+                               const std::function<void(const DaemonRefused&)>& waiting) const;
   // A mesh as a multipart upload with the form's other fields.
   nlohmann::json upload(const std::string& target, const std::string& fileName, const std::string& bytes,
                         const std::vector<std::pair<std::string, std::string>>& fields) const;

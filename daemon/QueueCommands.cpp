@@ -231,6 +231,17 @@ int follow(const DaemonClient& client, long long id) {
   return status;
 }
 
+// How long `start` and `resume` wait for a device the daemon is still
+// checking (its start: connected, stopped, laser off confirmed). The wait is
+// here, in the command, so that Ctrl-C ends it and nothing starts after.
+constexpr double kDeviceCheckPatience = 120;
+
+void saysWaiting(const DaemonRefused& refused) {
+  fmt::print(stderr,
+             "waiting for the daemon's check of {} (connected, stopped, laser off confirmed); Ctrl-C gives up\n",
+             refused.body.value("device", std::string("the device")));
+}
+
 long long jobNumber(const std::string& text) {
   try {
     size_t used = 0;
@@ -436,8 +447,8 @@ void addQueueCommands(CLI::App& app, int& status) {
     const std::string name = verb;
     command->callback([client, job, name, &status] {
       status = talking([&]() -> int {
-        const json answer =
-            clientOf(*client).post(fmt::format("/api/jobs/{}/{}", jobNumber(*job), name), json::object());
+        const json answer = clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/{}", jobNumber(*job), name),
+                                                            json::object(), kDeviceCheckPatience, saysWaiting);
         printAnswer(answer, name, client->json);
         return kSuccess;
       });
@@ -468,8 +479,9 @@ void addQueueCommands(CLI::App& app, int& status) {
       status = talking([&]() -> int {
         json body = json::object();
         if (*fromSheet) body["from_sheet"] = **fromSheet;
-        printAnswer(clientOf(*client).post(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body), "resume",
-                    client->json);
+        printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
+                                                    kDeviceCheckPatience, saysWaiting),
+                    "resume", client->json);
         return kSuccess;
       });
     });

@@ -77,7 +77,7 @@ cli::MakeOptions parseMakeOptions(const std::string& mesh, const std::vector<std
 // submitter named: the spool's folder dropped, or said as `submitted`.
 std::string inSubmittersWords(std::string message, const fs::path& folder, const fs::path& submitted = {}) {
   const std::string prefix = folder.string() + "/";
-  const std::string as = submitted.empty() ? "" : submitted.string() + "/";
+  const std::string as = submitted.empty() ? "" : (submitted / "").string();
   for (size_t at = message.find(prefix); at != std::string::npos; at = message.find(prefix, at + as.size())) {
     message.replace(at, prefix.size(), as);
   }
@@ -169,9 +169,6 @@ struct Service::Impl {
   std::map<JobId, std::unique_ptr<Cut>> cuts;
   std::vector<std::thread> checks;
   std::map<size_t, std::function<void(const ServiceEvent&)>> subscribers;
-  // Starts and resumes asked for while their device's check (at the daemon's
-  // start) is still running: answered once it ends, rather than refused.
-  std::vector<std::function<void()>> afterChecks;
   // Submissions whose files are written: synced together (on syncStrand),
   // then added together (on the strand), so that the clients who submit at
   // once share one syncfs and one transaction.
@@ -180,7 +177,9 @@ struct Service::Impl {
     NewJob job;
     ReplyHandler done;
   };
-  asio::strand<asio::thread_pool::executor_type> syncStrand{workers.get_executor()};
+  // Its own thread: a sync never waits behind a submission's work (a large folder's sheets read).
+  asio::thread_pool syncer{1};
+  asio::strand<asio::thread_pool::executor_type> syncStrand{syncer.get_executor()};
   std::vector<std::shared_ptr<Pending>> toSync, toAdd;
   size_t nextSubscriber = 1;
   bool stopping = false;
@@ -200,7 +199,9 @@ struct Service::Impl {
     try {
       return work();
     } catch (const ApiError& error) {
-      return {error.status, {{"error", error.what()}}};
+      json body = error.details.is_object() ? error.details : json::object();
+      body["error"] = error.what();
+      return {error.status, body};
     } catch (const TransitionRefused& error) {
       return {409, {{"error", error.what()}}};
     } catch (const StoreError& error) {
@@ -396,9 +397,6 @@ struct Service::Impl {
           store->addEvent(std::nullopt, "device", fmt::format("{}: {}: {}", device.config.name, state, message));
           deviceChanged(device);
           pump();
-          auto waiting = std::move(afterChecks);
-          afterChecks.clear();
-          for (auto& action : waiting) action();
         });
       });
     }
@@ -522,8 +520,8 @@ struct Service::Impl {
         strand,
         std::chrono::duration_cast<asio::steady_timer::duration>(std::chrono::duration<double>(config.planTimeout)));
     timeout->async_wait([this, id = job.id](const boost::system::error_code& error) {
-      if (error) return;  // the plan ended first
-      if (auto p = planning.find(id); p != planning.end()) {
+      if (error || stopping) return;  // the plan ended first, or the daemon's stop stops it
+      if (auto p = planning.find(id); p != planning.end() && p->second.cancelledBy.empty()) {
         p->second.timedOut = true;
         p->second.cancel->cancel();
       }
@@ -602,7 +600,8 @@ struct Service::Impl {
         planning.erase(p);
       }
       try {
-        if (cancelled && timedOut) {
+        // (Whoever cancelled first says why: a person, the daemon's stop, or the timeout.)
+        if (cancelled && timedOut && by.empty()) {
           const std::string why = fmt::format(
               "planning took longer than plan_timeout ({:g} s) and was stopped: give `make` a shorter --time, "
               "or raise plan_timeout in the daemon's configuration",
@@ -639,7 +638,16 @@ struct Service::Impl {
       throw ApiError(409, fmt::format("{} is busy with job {}; job {} can start once it is done", device->config.name,
                                       *device->job, job.id));
     }
-    if (device->state == "offline" || device->state == "checking") {
+    if (device->state == "checking") {
+      // The client waits and asks again (`retry_after`): a start that waited here would begin
+      // a cut after its operator had perhaps given up on it.
+      throw ApiError(409,
+                     fmt::format("{} is still being checked (connected, stopped, its laser off confirmed); "
+                                 "start job {} again in a moment",
+                                 device->config.name, job.id),
+                     {{"retry_after", 0.25}, {"device", device->config.name}});
+    }
+    if (device->state == "offline") {
       throw ApiError(409, fmt::format("{} is {}{}", device->config.name, device->state,
                                       device->message.empty() ? "" : ": " + device->message));
     }
@@ -931,30 +939,6 @@ struct Service::Impl {
 
   // ---- actions ----
 
-  // Whether a start or resume of job `id` must wait for its device's check to end.
-  bool waitsForCheck(JobId id, const std::string& action) {
-    if (action != "start" && action != "resume") return false;
-    const auto job = store->job(id);
-    const Device* device = job ? deviceNamed(job->device) : nullptr;
-    return device && device->state == "checking";
-  }
-
-  // On the strand: the action, answered now or once its device is checked.
-  void actOrWait(JobId id, const std::string& action, const json& arguments, const std::string& who,
-                 ReplyHandler done) {
-    try {
-      if (!stopping && waitsForCheck(id, action)) {
-        afterChecks.push_back([this, id, action, arguments, who, done = std::move(done)]() mutable {
-          actOrWait(id, action, arguments, who, std::move(done));
-        });
-        return;
-      }
-    } catch (const std::exception&) {
-      // (the store's error is answered by act's own guard below)
-    }
-    done(guarded([&] { return act(id, action, arguments, who); }));
-  }
-
   Reply act(JobId id, const std::string& action, const json& arguments, const std::string& who) {
     if (stopping) throw ApiError(503, "the daemon is stopping");
     const JobRecord job = jobOrThrow(id);
@@ -1090,6 +1074,7 @@ Service::~Service() {
     if (check.joinable()) check.join();
   }
   impl_->workers.join();
+  impl_->syncer.join();  // (after the workers, who hand it entries; before the strand it hands rows)
   impl_->state.join();
   for (auto& [id, cut] : impl_->cuts) {
     if (cut->thread.joinable()) cut->thread.join();
@@ -1264,9 +1249,7 @@ void Service::devices(ReplyHandler done) {
 
 void Service::act(JobId id, const std::string& action, const json& arguments, const std::string& who,
                   ReplyHandler done) {
-  impl_->onStrand([this, id, action, arguments, who, done = std::move(done)]() mutable {
-    impl_->actOrWait(id, action, arguments, who, std::move(done));
-  });
+  impl_->answer(std::move(done), [this, id, action, arguments, who] { return impl_->act(id, action, arguments, who); });
 }
 
 size_t Service::subscribe(std::function<void(const ServiceEvent&)> sink) {
@@ -1292,9 +1275,6 @@ void Service::shutdown(const std::string& why, std::function<void()> done) {
     impl.log->info("stopping ({}): {} cut{} and {} plan{} to stop", why, impl.cuts.size(),
                    impl.cuts.size() == 1 ? "" : "s", impl.planning.size(), impl.planning.size() == 1 ? "" : "s");
     for (auto& [id, planning] : impl.planning) planning.cancel->cancel();
-    auto waiting = std::move(impl.afterChecks);  // each answered: the daemon is stopping
-    impl.afterChecks.clear();
-    for (auto& action : waiting) action();
     for (auto& [id, cut] : impl.cuts) {
       cut->control->shutdown = true;
       cut->control->cancel.cancel();

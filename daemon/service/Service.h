@@ -37,8 +37,10 @@ namespace rotafab::service {
 // A refusal for the API's client: an HTTP status (4xx: the request; 5xx: the daemon) and one line.
 class ApiError : public std::runtime_error {
  public:
-  ApiError(int status, const std::string& message) : std::runtime_error(message), status(status) {}
+  ApiError(int status, const std::string& message, nlohmann::json details = nullptr)
+      : std::runtime_error(message), status(status), details(std::move(details)) {}
   int status;
+  nlohmann::json details;  // fields the error's body has beside "error" (an object, or null)
 };
 
 // What the API hands over for a submission.

@@ -203,6 +203,17 @@ class SqliteStore final : public JobStore {
   }
 
   std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) override {
+    // Each job's first steps checked before anything is written.
+    for (const NewJob& job : jobs) {
+      JobState state = JobState::Queued;
+      for (const FirstStep& step : job.then) {
+        if (!allowedTransition(state, step.to)) {
+          throw TransitionRefused(
+              fmt::format("a new job of {} cannot go from {} to {}", job.source, stateName(state), stateName(step.to)));
+        }
+        state = step.to;
+      }
+    }
     Transaction transaction(db_);
     Statement last(db_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
     last.step();
@@ -231,7 +242,8 @@ class SqliteStore final : public JobStore {
       record(ids.back(), std::nullopt, JobState::Queued, at, reasons.at(i));
       JobState state = JobState::Queued;
       for (size_t step = 0; step < job.then.size(); ++step) {
-        move(ids.back(), state, job.then[step].to, at, job.then[step].reason(ids.back()));
+        const auto& reason = job.then[step].reason;
+        move(ids.back(), state, job.then[step].to, at, reason ? reason(ids.back()) : std::string());
         state = job.then[step].to;
       }
       if (!job.then.empty()) apply(ids.back(), job.change);
