@@ -410,7 +410,8 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     auto response = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(reply.status), 11);
     response->set(http::field::server, "rotafabd");
     response->set(http::field::content_type, "application/json");
-    response->body() = reply.body.dump(-1, ' ', false, json::error_handler_t::replace) + "\n";
+    response->body() = reply.text.empty() ? reply.body.dump(-1, ' ', false, json::error_handler_t::replace) + "\n"
+                                          : std::move(reply.text);
     const bool keep = keepAlive_ && request_.keep_alive() && reply.status < 400;
     response->keep_alive(keep);
     response->prepare_payload();

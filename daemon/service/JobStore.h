@@ -104,6 +104,8 @@ class JobStore {
   [[nodiscard]] virtual std::optional<JobRecord> job(JobId id) = 0;
   // Every job in queue order: priority (higher first), then position.
   [[nodiscard]] virtual std::vector<JobRecord> jobs() = 0;
+  // The same, one at a time (a long queue is never all in memory at once).
+  virtual void eachJob(const std::function<void(const JobRecord&)>& visit) = 0;
   // The jobs in these states, in queue order; the first `limit` of them, and
   // only those for `device` when one is named.
   [[nodiscard]] virtual std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit = SIZE_MAX,

@@ -57,8 +57,11 @@ struct Submission {
 
 // A reply: the JSON body, or the ApiError it became.
 struct Reply {
+  Reply() = default;
+  Reply(int status, nlohmann::json body) : status(status), body(std::move(body)) {}
   int status = 200;
   nlohmann::json body;
+  std::string text;  // the body already written as JSON (a long list, built a row at a time); else `body`
 };
 using ReplyHandler = std::function<void(Reply)>;
 

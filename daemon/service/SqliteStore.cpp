@@ -262,10 +262,14 @@ class SqliteStore final : public JobStore {
   }
 
   std::vector<JobRecord> jobs() override {
-    Statement select(db_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns).c_str());
     std::vector<JobRecord> all;
-    while (select.step()) all.push_back(jobOf(select));
+    eachJob([&](const JobRecord& job) { all.push_back(job); });
     return all;
+  }
+
+  void eachJob(const std::function<void(const JobRecord&)>& visit) override {
+    Statement select(db_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns).c_str());
+    while (select.step()) visit(jobOf(select));
   }
 
   std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit, const std::string& device) override {
