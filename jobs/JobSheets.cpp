@@ -14,27 +14,32 @@
 namespace rotafab::jobs {
 namespace {
 
-// The sheets to read: (number, SVG file).
-std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesystem::path& target,
-                                                              std::optional<int> only,
-                                                              const nlohmann::json* manifestRead) {
-  std::vector<std::pair<int, std::filesystem::path>> sheets;
-  if (std::filesystem::is_directory(target)) {
-    const auto manifestFile = target / "manifest.json";
-    const nlohmann::json manifest = manifestRead ? nlohmann::json() : readManifest(target);
-    const nlohmann::json& listed = manifestRead ? *manifestRead : manifest;
-    try {
-      for (const auto& sheet : listed.at("sheets")) {
-        const int index = sheet.at("index");
-        for (const auto& file : sheet.at("files")) {
-          const std::string name = file;
-          if (name.ends_with(".svg")) sheets.emplace_back(index, target / name);
-        }
+using SheetFiles = std::vector<std::pair<int, std::filesystem::path>>;  // (number, SVG file)
+
+// The SVG sheets an output folder's manifest lists.
+SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::json& manifest) {
+  const auto manifestFile = folder / "manifest.json";
+  SheetFiles sheets;
+  try {
+    for (const auto& sheet : manifest.at("sheets")) {
+      const int index = sheet.at("index");
+      for (const auto& file : sheet.at("files")) {
+        const std::string name = file;
+        if (name.ends_with(".svg")) sheets.emplace_back(index, folder / name);
       }
-    } catch (const nlohmann::json::exception& error) {
-      throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
     }
-    if (sheets.empty()) throw core::UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
+  } catch (const nlohmann::json::exception& error) {
+    throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
+  }
+  if (sheets.empty()) throw core::UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
+  return sheets;
+}
+
+// The sheets to read: an output folder's, or one sheet's SVG.
+SheetFiles sheetFiles(const std::filesystem::path& target, std::optional<int> only) {
+  SheetFiles sheets;
+  if (std::filesystem::is_directory(target)) {
+    sheets = listedSheets(target, readManifest(target));
   } else {
     if (target.extension() != ".svg") {
       throw core::UserError(
@@ -52,10 +57,9 @@ std::vector<std::pair<int, std::filesystem::path>> sheetFiles(const std::filesys
   return sheets;
 }
 
-std::vector<JobSheet> readSheets(const std::filesystem::path& target, std::optional<int> only,
-                                 const nlohmann::json* manifest) {
+std::vector<JobSheet> readSheets(const SheetFiles& files) {
   std::vector<JobSheet> sheets;
-  for (const auto& [index, file] : sheetFiles(target, only, manifest)) {
+  for (const auto& [index, file] : files) {
     try {
       sheets.push_back({index, file, readSheetSvg(file)});
     } catch (const std::invalid_argument& error) {
@@ -68,11 +72,11 @@ std::vector<JobSheet> readSheets(const std::filesystem::path& target, std::optio
 }  // namespace
 
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only) {
-  return readSheets(target, only, nullptr);
+  return readSheets(sheetFiles(target, only));
 }
 
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::json& manifest) {
-  return readSheets(folder, std::nullopt, &manifest);
+  return readSheets(listedSheets(folder, manifest));
 }
 
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {

@@ -471,10 +471,9 @@ struct Service::Impl {
     const auto planned = jobs::readJobSheets(folder, manifest);
     jobs::checkSheetsFitBed(planned, machine);
     json summary{{"sheets", static_cast<int>(planned.size())}};
-    if (manifest.is_object()) {
-      if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
-      if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
-    }
+    // (An object: its sheets were listed from it.)
+    if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
+    if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
     return summary;
   }
 
