@@ -15,7 +15,8 @@ struct Progress {
   std::string phase;
   // What within the phase, for example "band decomposition", "fastener
   // holes", "labels" (geometry); "first layout", "improving", "compacting"
-  // (nesting); empty for the start of the phase.
+  // (nesting), and "searching" (nesting: still at it, with nothing better
+  // yet); empty for the start of the phase.
   std::string step;
   size_t done = 0;   // units of the step done (faces, bands, panels, parts, sheets)
   size_t total = 0;  // of how many; 0 when the step is not counted
@@ -23,6 +24,8 @@ struct Progress {
   // one (in a strip: the strip's length), inches.
   int sheets = 0;
   double length = 0;
+  // Nesting: seconds since it began, of its budget (0: none given).
+  double elapsed = 0, budget = 0;
 };
 
 using ProgressSink = std::function<void(const Progress&)>;

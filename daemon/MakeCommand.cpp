@@ -71,7 +71,6 @@ int runMake(const MakeOptions& options) {
     ProgressLineOptions lines;
     lines.prefix = "make: ";
     lines.nestingPrefix = "nesting: ";
-    lines.seconds = options.seconds;
     const auto& bed = request.machine.bed;
     const double k = profiles::unitsPerInch(bed.unit);
     lines.bed = fmt::format("{:.4g} x {:.4g} {}", bed.width * k, bed.height * k, bed.unit);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "jobs/MakeJob.h"
+#include "jobs/Nesting.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::cli {
@@ -18,7 +19,7 @@ struct MakeOptions {
   std::optional<double> scale, tension, mergeCoplanar;
   std::optional<int> start, panels;
   int samples = 8, window = 8;
-  double seconds = 5.0;
+  double seconds = jobs::kDefaultNestingSeconds;
   bool json = false, scoreFolds = false;
 };
 

@@ -23,7 +23,7 @@ struct NestOptions {
   std::string spacing;
   std::string machine = "workshop-32x18";
   bool strip = false;
-  double seconds = 5.0;
+  double seconds = jobs::kDefaultNestingSeconds;
   std::string out;
   bool json = false;
   std::string order = "free";
@@ -75,7 +75,6 @@ int runNest(const NestOptions& options) {
     request.search.window = options.window;
     ProgressLineOptions lines;
     lines.prefix = "nest: ";
-    lines.seconds = options.seconds;
     lines.strip = options.strip;
     // As many threads as searches asked for, at least one per core.
     CommandContext command(options.json ? core::ProgressSink() : ProgressLines(lines),
@@ -118,7 +117,10 @@ void addNestCommand(CLI::App& app, int& status) {
   command->add_option("--machine", options->machine, "Machine profile for the bed")->capture_default_str();
   command->add_option("--spacing", options->spacing, "Least distance between parts (default 1/16 in; 0 with --strip)");
   command->add_flag("--strip", options->strip, "Nest into one strip of the instance's strip_height, least length");
-  command->add_option("--time", options->seconds, "Improvement time budget in seconds")
+  command
+      ->add_option("--time", options->seconds,
+                   "Time budget in seconds, first layout included: the best layout found by then\n"
+                   "is kept (a first layout is always finished)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
   command->add_option("--order", options->order, "strict, window or free: how far parts may move from their order")

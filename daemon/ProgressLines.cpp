@@ -53,14 +53,26 @@ void ProgressLines::operator()(const core::Progress& p) {
         nextCount_ = now + kCountEvery;
       }
     } else if (p.step == "first layout") {
-      step = fmt::format("{} sheet{}, last sheet {:.2f} in long; improving for {} s", p.sheets, plural(p.sheets),
-                         p.length, options_.seconds);
-    } else if (p.step == "improving") {
-      step = fmt::format("{} sheet{}, last sheet {:.2f} in long", p.sheets, plural(p.sheets), p.length);
-    } else if (p.step == "compacting") {
-      step = options_.strip ? fmt::format("compacting: strip {:.2f} long", p.length)
-                            : fmt::format("compacting: {} sheet{}, last sheet {:.2f} in long", p.sheets,
-                                          plural(p.sheets), p.length);
+      const double left = p.budget - p.elapsed;
+      step = fmt::format("{} sheet{}, last sheet {:.2f} in long, in {:.1f} s; {}", p.sheets, plural(p.sheets), p.length,
+                         p.elapsed,
+                         left >= 0.5 ? fmt::format("improving it for up to {:.0f} s more", left)
+                                     : std::string("no time left in --time to improve it"));
+      nextCount_ = std::chrono::steady_clock::now() + kCountEvery;
+    } else if (p.step == "improving" || p.step == "compacting" || p.step == "searching") {
+      // Every better layout; that the search goes on, every few seconds.
+      const auto now = std::chrono::steady_clock::now();
+      if (p.step != "searching" || now > nextCount_) {
+        const std::string layout =
+            options_.strip ? fmt::format("strip {:.2f} long", p.length)
+                           : fmt::format("{} sheet{}, last sheet {:.2f} in long", p.sheets, plural(p.sheets), p.length);
+        step = fmt::format("{}{} ({:.0f} of {:.0f} s)",
+                           p.step == "searching"    ? "searching, best so far "
+                           : p.step == "compacting" ? "compacting: "
+                                                    : "",
+                           layout, p.elapsed, p.budget);
+        nextCount_ = now + kCountEvery;
+      }
     }
     if (!step.empty()) line = options_.nestingPrefix + step;
   } else if (p.phase == "writing" && p.step.empty()) {

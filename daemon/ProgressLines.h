@@ -14,7 +14,6 @@ namespace rotafab::cli {
 struct ProgressLineOptions {
   std::string prefix;         // "make: " or "nest: "
   std::string nestingPrefix;  // before nesting steps: "nesting: " for make
-  double seconds = 0;         // the nesting budget, said after the first layout
   bool strip = false;         // compacting a strip (its length), not beds
   std::string bed;            // "32 x 18 in", for the start of nesting
   bool rows = false;          // the layout is rows, not nesting

@@ -52,7 +52,7 @@ struct MakeRequest {
   bool scoreFolds = false;
   // The planner's (jobs/SheetPlanner.h).
   std::optional<double> kerf;  // default: the material's
-  double seconds = 5.0;
+  double seconds = kDefaultNestingSeconds;
   OrderMode order = OrderMode::Window;
   int window = 8;
   bool freeOrderWhenItSavesSheets = false;  // as PlanOptions'

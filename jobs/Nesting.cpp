@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -66,14 +67,17 @@ void checkNestingParts(const std::vector<NestingPart>& parts) {
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
                    const core::WorkContext& context) {
   checkNestingParts(parts);
+  SharedProgress progress(context, std::chrono::steady_clock::now(), options.seconds);
   const PartShapes shapes(parts, options, context);
   // Searches side by side, one per thread of the executor unless the options
   // say how many, each on its own course; the best layout wins (on a tie,
-  // the lowest seed's). Strict order has nothing to search.
-  const unsigned searches = options.order == OrderMode::Strict || parts.size() < 2 ? 1u
-                            : options.threads > 0 ? static_cast<unsigned>(options.threads)
-                                                  : context.executor().concurrency();
-  SharedProgress progress(context);
+  // the lowest seed's). Strict order has nothing to search, nor has the
+  // window order on a job too large for the sequence search.
+  const bool nothingToSearch =
+      options.order == OrderMode::Strict || (options.order == OrderMode::Window && !shapes.forNoFitPolygons());
+  const unsigned searches = nothingToSearch || parts.size() < 2 ? 1u
+                            : options.threads > 0               ? static_cast<unsigned>(options.threads)
+                                                                : context.executor().concurrency();
   std::vector<NestingResult> results(searches);
   context.executor().parallelFor(searches, [&](size_t search) {
     results[search] = searchLayout(shapes, static_cast<unsigned>(search), progress, context);

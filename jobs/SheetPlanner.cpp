@@ -55,7 +55,10 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.width = bed.width - 2 * bed.margin;
   nesting.height = bed.height - 2 * bed.margin;
   nesting.spacing = options.spacing >= 0 ? options.spacing : 1.0 / 16 + options.kerf;
-  nesting.seconds = options.seconds;
+  // One budget for the whole nesting: with the free order as a fallback,
+  // the window order has half of it and the free order what is left.
+  const bool fallback = !options.rows && options.freeOrderWhenItSavesSheets && options.order == OrderMode::Window;
+  nesting.seconds = fallback ? options.seconds / 2 : options.seconds;
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
@@ -63,10 +66,11 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
   int windowSheets = 0;
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (!options.rows && options.freeOrderWhenItSavesSheets && nesting.order == OrderMode::Window &&
-      nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting) && took <= std::max(10.0, 2 * options.seconds + 1)) {
+  if (fallback && nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting)) {
     NestingOptions free = nesting;
     free.order = OrderMode::Free;
+    // What is left of the budget; a first layout is made whatever is left.
+    free.seconds = std::max(0.0, options.seconds - took);
     NestingResult loose = nest(nestingParts, free, context);
     if (loose.sheets < nested.sheets) windowSheets = nested.sheets, nested = std::move(loose);
   }

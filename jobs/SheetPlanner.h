@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/WorkContext.h"
+#include "jobs/Nesting.h"
 #include "jobs/Part.h"
 #include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
@@ -17,9 +18,9 @@
 namespace rotafab::jobs {
 
 struct PlanOptions {
-  double kerf = 0.0;      // from the material profile
-  double spacing = -1.0;  // between two cut paths; negative: 1/16 in of material plus the kerf
-  double seconds = 5.0;   // nesting improvement budget
+  double kerf = 0.0;                        // from the material profile
+  double spacing = -1.0;                    // between two cut paths; negative: 1/16 in of material plus the kerf
+  double seconds = kDefaultNestingSeconds;  // the whole nesting's budget (NestingOptions::seconds)
   OrderMode order = OrderMode::Window;
   int window = 8;
   // With the window: when the free order fits the parts on fewer sheets,

@@ -56,14 +56,8 @@ std::optional<NestingResult> BottomLeftPacker::pack(const std::vector<int>& sequ
     const int part = sequence[index];
     const int only = shapeOf.empty() ? -1 : shapeOf[part];
     bool done = false;
-    const int firstSheet = policy == OrderMode::Strict ? std::max(0, static_cast<int>(sheets.size()) - 1) : 0;
-    for (int s = firstSheet; s < static_cast<int>(sheets.size()) && !done; ++s) {
-      if (policy == OrderMode::Window && s + 1 < static_cast<int>(sheets.size())) {
-        // Placed on sheet s, the part is cut after every part on sheets 0..s.
-        int cutBefore = 0;
-        for (int k = 0; k <= s; ++k) cutBefore += static_cast<int>(sheets[k].parts.size());
-        if (shapes_.parts()[part].order - cutBefore > shapes_.options().window) continue;
-      }
+    for (int s = 0; s < static_cast<int>(sheets.size()) && !done; ++s) {
+      if (!mayGoOn(shapes_, policy, sheets, s, part)) continue;
       if (sheets[s].freeArea < shapes_.area(part)) continue;  // cannot hold it: skip the no-fit polygons
       if (auto spot = bestSpot(part, sheets[s], only)) {
         put(sheets[s], *spot);
@@ -91,14 +85,7 @@ std::optional<NestingResult> BottomLeftPacker::pack(const std::vector<int>& sequ
       placed.emplace_back(static_cast<int>(sheets.size()) - 1, *spot);
     }
   }
-  // Cutting order: sheet by sheet, each in the order its parts were placed.
-  std::stable_sort(placed.begin(), placed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  lastLayout_.clear();
-  for (auto [sheet, spot] : placed) {
-    spot.at.X += sheet * shapes_.pitch();
-    lastLayout_.push_back(spot);
-  }
-  return shapes_.resultOf(placed, static_cast<int>(sheets.size()));
+  return shapes_.inCuttingOrder(placed, static_cast<int>(sheets.size()), lastLayout_);
 }
 
 void BottomLeftPacker::accept() {

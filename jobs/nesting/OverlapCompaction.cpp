@@ -30,90 +30,6 @@ constexpr double kNoLimit = std::numeric_limits<double>::max();
 constexpr double kFirstShrink = 0.02, kLeastShrink = 0.001;
 constexpr int kTriesPerShrink = 5;
 
-// Whether two shapes, each placed, collide (see OverlapCompaction::colliding).
-bool shapesColliding(const Shape& sa, IntPoint atA, const Shape& sb, IntPoint atB) {
-  // In b's frame; only edges that meet both cores' boxes can cross.
-  const IntPoint shift{atA.X - atB.X, atA.Y - atB.Y};
-  const Box window{std::max(sa.coreBox[0] + shift.X, sb.coreBox[0]), std::max(sa.coreBox[1] + shift.Y, sb.coreBox[1]),
-                   std::min(sa.coreBox[2] + shift.X, sb.coreBox[2]), std::min(sa.coreBox[3] + shift.Y, sb.coreBox[3])};
-  if (window[0] >= window[2] || window[1] >= window[3]) return false;
-  // Closed: an edge on the window's border (the edge that makes a core's
-  // box) still counts.
-  const auto meets = [](const Box& box, IntPoint p, IntPoint q) {
-    return std::max(p.X, q.X) >= box[0] && std::min(p.X, q.X) <= box[2] && std::max(p.Y, q.Y) >= box[1] &&
-           std::min(p.Y, q.Y) <= box[3];
-  };
-  const auto side = [](IntPoint o, IntPoint p, IntPoint q) {
-    const cInt cross = (p.X - o.X) * (q.Y - o.Y) - (p.Y - o.Y) * (q.X - o.X);
-    return (cross > 0) - (cross < 0);
-  };
-  std::array<std::pair<IntPoint, IntPoint>, 64> near;  // b's edges in the window (most shapes: all fit)
-  size_t nearCount = 0;
-  bool overflow = false;
-  const Path& pb = sb.core;
-  for (size_t j = 0; j < pb.size(); ++j) {
-    const IntPoint& r = pb[j];
-    const IntPoint& t = pb[(j + 1) % pb.size()];
-    if (!meets(window, r, t)) continue;
-    if (nearCount == near.size()) {
-      overflow = true;
-      break;
-    }
-    near[nearCount++] = {r, t};
-  }
-  const Path& pa = sa.core;
-  for (size_t i = 0; i < pa.size(); ++i) {
-    const IntPoint p{pa[i].X + shift.X, pa[i].Y + shift.Y};
-    const IntPoint q{pa[(i + 1) % pa.size()].X + shift.X, pa[(i + 1) % pa.size()].Y + shift.Y};
-    if (!meets(window, p, q)) continue;
-    const Box edge{std::min(p.X, q.X), std::min(p.Y, q.Y), std::max(p.X, q.X), std::max(p.Y, q.Y)};
-    const auto crosses = [&](IntPoint r, IntPoint t) {
-      return meets(edge, r, t) && side(p, q, r) * side(p, q, t) < 0 && side(r, t, p) * side(r, t, q) < 0;
-    };
-    if (!overflow) {
-      for (size_t j = 0; j < nearCount; ++j) {
-        if (crosses(near[j].first, near[j].second)) return true;
-      }
-    } else {
-      for (size_t j = 0; j < pb.size(); ++j) {
-        if (crosses(pb[j], pb[(j + 1) % pb.size()])) return true;
-      }
-    }
-  }
-  // No crossing: one may still lie in the other, or their boundaries
-  // meet only along shared lines and at vertices (parts pushed against
-  // the same side of the strip, or two copies side by side). A point of
-  // one strictly inside the other's core then gives it away: a pole's
-  // centre, a vertex or the middle of an edge, in the window.
-  const auto inWindow = [&](IntPoint c) {
-    return c.X >= window[0] && c.X <= window[2] && c.Y >= window[1] && c.Y <= window[3];
-  };
-  // Points in b's frame: inside b's core, or (shifted back) inside a's.
-  const auto inB = [&](IntPoint c) { return inWindow(c) && ClipperLib::PointInPolygon(c, pb) == 1; };
-  const auto inA = [&](IntPoint c) {
-    return inWindow(c) && ClipperLib::PointInPolygon({c.X - shift.X, c.Y - shift.Y}, pa) == 1;
-  };
-  // Only poles wider than the slack: their centres are inside their own core.
-  for (const Shape::Pole& pole : sa.poles) {
-    if (pole.radius > kCollisionSlack + 1 && inB({pole.centre.X + shift.X, pole.centre.Y + shift.Y})) return true;
-  }
-  for (const Shape::Pole& pole : sb.poles) {
-    if (pole.radius > kCollisionSlack + 1 && inA(pole.centre)) return true;
-  }
-  // Middles rounded in each shape's own frame, so that both ways round test the same points.
-  for (size_t i = 0; i < pa.size(); ++i) {
-    const IntPoint& p = pa[i];
-    const IntPoint& q = pa[(i + 1) % pa.size()];
-    if (inB({p.X + shift.X, p.Y + shift.Y}) || inB({(p.X + q.X) / 2 + shift.X, (p.Y + q.Y) / 2 + shift.Y})) return true;
-  }
-  for (size_t j = 0; j < pb.size(); ++j) {
-    const IntPoint& r = pb[j];
-    const IntPoint& t = pb[(j + 1) % pb.size()];
-    if (inA(r) || inA({(r.X + t.X) / 2, (r.Y + t.Y) / 2})) return true;
-  }
-  return false;
-}
-
 // How much two colliding shapes overlap (sparrow's quantification): over
 // every pair of poles, how deep they reach into each other times the
 // smaller radius; pairs apart or barely in still count a little,
@@ -222,6 +138,22 @@ NestingResult OverlapCompaction::compact(std::vector<PlacedShape> layout, std::m
     placed[i].first = sheets - 1;
   }
   return shapes_.resultOf(placed, std::max(sheets, 1));
+}
+
+bool OverlapCompaction::insert(std::vector<PlacedShape>& bed, const PlacedShape& incoming, std::mt19937& random,
+                               const std::function<bool()>& goOn, int& moves) const {
+  const Lanes lanes{{0, shapes_.width()}};
+  std::vector<PlacedShape> trial = bed;
+  trial.push_back(incoming);
+  const IntPoint centre{std::uniform_int_distribution<cInt>(0, shapes_.width())(random),
+                        std::uniform_int_distribution<cInt>(0, shapes_.height())(random)};
+  if (!moveInto(trial.back(), centre, lanes)) return false;
+  const std::vector<double> weights(trial.size() * trial.size(), 1.0);
+  sampledMove(trial, trial.size() - 1, lanes, weights, random);
+  ++moves;
+  if (!separate(trial, lanes, random, goOn, moves)) return false;
+  bed = std::move(trial);
+  return true;
 }
 
 int OverlapCompaction::bedsUsed(const std::vector<PlacedShape>& layout) const {
@@ -361,7 +293,7 @@ bool OverlapCompaction::separate(std::vector<PlacedShape>& layout, const Lanes& 
 // Can miss overlaps whose every crossing is at a vertex or along a shared
 // line and that hold none of those points; apart() has the last word.
 bool OverlapCompaction::colliding(const PlacedShape& a, const PlacedShape& b) const {
-  return shapesColliding(shapes_.at(a.part, a.shape), a.at, shapes_.at(b.part, b.shape), b.at);
+  return coresColliding(shapes_.at(a.part, a.shape), a.at, shapes_.at(b.part, b.shape), b.at);
 }
 // The weighted overlap of layout[i] as shape `k` at `at` with the others,
 // given up (returning at least `enough`) once it reaches `enough`.
@@ -373,7 +305,7 @@ double OverlapCompaction::weightedOverlap(const std::vector<PlacedShape>& layout
   for (size_t j = 0; j < n && total < enough; ++j) {
     if (j == i) continue;
     const Shape& other = shapes_.of(layout[j]);
-    if (!shapesColliding(moving, at, other, layout[j].at)) continue;
+    if (!coresColliding(moving, at, other, layout[j].at)) continue;
     total += weights[i * n + j] * proxy(moving, at, other, layout[j].at);
   }
   return total;
@@ -483,10 +415,7 @@ bool OverlapCompaction::apart(const std::vector<PlacedShape>& layout) const {
     const Shape& a = shapes_.of(layout[i]);
     for (size_t j = i + 1; j < layout.size(); ++j) {
       const Shape& b = shapes_.of(layout[j]);
-      if (boxesApart(a, layout[i].at, b, layout[j].at)) continue;
-      for (const Path& path : intersectionOf(a.core, layout[i].at, b.core, layout[j].at)) {
-        if (std::abs(ClipperLib::Area(path)) > 1.0) return false;
-      }
+      if (!boxesApart(a, layout[i].at, b, layout[j].at) && coresOverlap(a, layout[i].at, b, layout[j].at)) return false;
     }
   }
   return true;

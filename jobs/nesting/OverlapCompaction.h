@@ -36,6 +36,14 @@ class OverlapCompaction {
   NestingResult compact(std::vector<PlacedShape> layout, std::mt19937& random, const std::function<bool()>& goOn,
                         int& moves, const std::function<void(int, double)>& shorter) const;
 
+  // Puts `incoming` on the bed of `bed` (one bed's parts, in its own
+  // coordinates) where it overlaps the others least, of places sampled as
+  // a move samples them, then moves them all apart while `goOn` allows.
+  // True, with `bed` holding it, when nothing overlaps; else `bed` is as
+  // it was. Beds only.
+  bool insert(std::vector<PlacedShape>& bed, const PlacedShape& incoming, std::mt19937& random,
+              const std::function<bool()>& goOn, int& moves) const;
+
  private:
   // The compaction lays the beds side by side in one row, bed s from
   // s * pitch on, a gap wider than any overhang of a grown shape between

@@ -7,7 +7,9 @@
 #include <random>
 
 #include "jobs/nesting/BottomLeftPacker.h"
+#include "jobs/nesting/CollisionPlacer.h"
 #include "jobs/nesting/OverlapCompaction.h"
+#include "jobs/nesting/SheetEmptying.h"
 
 namespace rotafab::jobs::nesting {
 namespace {
@@ -28,16 +30,40 @@ std::pair<int, double> layoutCost(const NestingResult& result, const std::vector
   return {result.sheets, lastExtent};
 }
 
-void SharedProgress::remark(unsigned search, const core::Progress& progress) {
-  const std::lock_guard lock(mutex_);
-  if (search == 0) context_.report(progress);
+// How often a search with nothing better to say says that it goes on.
+constexpr std::chrono::seconds kStillSearchingEvery{2};
+
+void SharedProgress::report(core::Progress& progress) {
+  const auto now = std::chrono::steady_clock::now();
+  progress.elapsed = std::chrono::duration<double>(now - started_).count();
+  progress.budget = budget_;
+  lastReport_ = now;
+  context_.report(progress);
 }
 
-void SharedProgress::improved(const std::pair<int, double>& cost, const core::Progress& progress) {
+void SharedProgress::remark(unsigned search, core::Progress progress) {
+  const std::lock_guard lock(mutex_);
+  if (search == 0) report(progress);
+}
+
+void SharedProgress::improved(const std::pair<int, double>& cost, core::Progress progress) {
   const std::lock_guard lock(mutex_);
   if (best_ && cost >= *best_) return;
   best_ = cost;
-  context_.report(progress);
+  report(progress);
+}
+
+void SharedProgress::stillSearching(unsigned search) {
+  if (search != 0) return;
+  const std::lock_guard lock(mutex_);
+  if (std::chrono::steady_clock::now() - lastReport_ < kStillSearchingEvery || !best_) return;
+  core::Progress progress{"nesting", "searching", 0, 0, best_->first, best_->second};
+  report(progress);
+}
+
+std::chrono::steady_clock::time_point SharedProgress::deadline() const {
+  return started_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                        std::chrono::duration<double>(std::max(0.0, budget_)));
 }
 
 NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProgress& progress,
@@ -45,6 +71,7 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
   const std::vector<NestingPart>& parts = shapes.parts();
   const NestingOptions& options = shapes.options();
   BottomLeftPacker packer(shapes, &context.cancellation());
+  CollisionPlacer placer(shapes, &context.cancellation());
   // The first layout: assembly order, or for free order the largest parts first.
   std::vector<int> sequence(parts.size());
   std::iota(sequence.begin(), sequence.end(), 0);
@@ -66,12 +93,11 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
   // The first layout can take many seconds (25 s for 100 long strips): say so.
   progress.remark(search, {"nesting", "first layout", 0, parts.size()});
-  packer.onProgress = [&](size_t placed, size_t of, size_t sheets) {
+  placer.onProgress = [&](size_t placed, size_t of, size_t sheets) {
     if (placed > 0) progress.remark(search, {"nesting", "first layout", placed, of, static_cast<int>(sheets)});
   };
-  NestingResult best = *packer.pack(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
-  packer.onProgress = nullptr;
-  packer.accept();
+  NestingResult best = placer.place(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
+  std::vector<PlacedShape> bestLayout = placer.layout();
   auto bestCost = layoutCost(best, parts);
   progress.improved(bestCost, {"nesting", "first layout", parts.size(), parts.size(), bestCost.first, bestCost.second});
   // On beds, no layout has fewer sheets than the parts' area fills: once
@@ -87,15 +113,21 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
   // the compaction the rest.
   const bool compaction = options.order == OrderMode::Free && parts.size() > 1;
   const double sequenceShare = compaction ? kSequenceShare : 1.0;
+  // The budget left after the first layout: the sequence search has its
+  // share, the compaction the rest. With a cap on layouts, the cap decides.
   const auto start = std::chrono::steady_clock::now();
+  const auto deadline = options.evaluations > 0 ? std::chrono::steady_clock::time_point::max() : progress.deadline();
   std::mt19937 random(options.seed + search);
-  if (options.order != OrderMode::Strict && parts.size() > 1) {
-    const auto deadline = start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(sequenceShare * options.seconds));
+  if (options.order != OrderMode::Strict && parts.size() > 1 && shapes.forNoFitPolygons()) {
+    const auto searchDeadline = deadline == std::chrono::steady_clock::time_point::max() || deadline <= start
+                                    ? deadline
+                                    : start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                  sequenceShare * (deadline - start));
     const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
-    while (!atBound() && std::chrono::steady_clock::now() < deadline &&
+    while (!atBound() && std::chrono::steady_clock::now() < searchDeadline &&
            (options.evaluations <= 0 || evaluations < lastEvaluation)) {
       context.check();
+      progress.stillSearching(search);
       std::vector<int> trial = sequence, trialShapes = shapeOf;
       const size_t i = random() % trial.size();
       size_t j = i;
@@ -118,8 +150,7 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
       }
       // The parts before the first changed one are placed as before.
       // Without a cap on layouts, a trial that would end past the deadline is given up.
-      auto packed = packer.pack(trial, options.order, std::min(i, j), trialShapes,
-                                options.evaluations > 0 ? std::chrono::steady_clock::time_point::max() : deadline);
+      auto packed = packer.pack(trial, options.order, std::min(i, j), trialShapes, searchDeadline);
       if (!packed) break;
       NestingResult result = std::move(*packed);
       ++evaluations;
@@ -133,12 +164,13 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
         sequence = std::move(trial);
         shapeOf = std::move(trialShapes);
         packer.accept();
+        bestLayout = packer.acceptedLayout();
       }
     }
   }
   if (compaction && !atBound()) {
-    const auto deadline = start + std::chrono::duration<double>(options.seconds);
     const auto goOn = [&] {
+      progress.stillSearching(search);
       return !context.cancelled() && std::chrono::steady_clock::now() < deadline &&
              (options.evaluations <= 0 || evaluations < options.evaluations);
     };
@@ -146,8 +178,12 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
     const auto shorter = [&](int sheets, double length) {
       progress.improved({sheets, length}, {"nesting", "compacting", 0, 0, sheets, length});
     };
+    // On a large job on beds, the whole row of beds is too many pairs for
+    // the compaction: the beds are emptied one at a time instead.
     NestingResult compacted =
-        OverlapCompaction(shapes).compact(packer.acceptedLayout(), random, goOn, evaluations, shorter);
+        options.strip || shapes.forNoFitPolygons()
+            ? OverlapCompaction(shapes).compact(bestLayout, random, goOn, evaluations, shorter)
+            : SheetEmptying(shapes).empty(bestLayout, sheetBound, random, goOn, evaluations, shorter);
     context.check();
     // The compaction lets grown shapes reach into each other by a few grid
     // units; the layout is kept only if the true outlines keep the spacing

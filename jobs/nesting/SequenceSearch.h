@@ -9,6 +9,7 @@
 // is fixed by its seed; the time budget, or a cap on layouts, decides how
 // far along it gets. Several run side by side (nest()), and the best wins.
 
+#include <chrono>
 #include <mutex>
 #include <optional>
 #include <utility>
@@ -23,19 +24,29 @@ namespace rotafab::jobs::nesting {
 // Smaller is better: fewer sheets, then less used of the last sheet (or a shorter strip).
 std::pair<int, double> layoutCost(const NestingResult& result, const std::vector<NestingPart>& parts);
 
-// The progress of searches running side by side: the first layout's
-// progress from the first search only, and a layout only when it beats every
-// search's best so far.
+// The progress of searches running side by side, each report stamped with
+// the seconds since the nesting began and its budget: the first layout's
+// progress from the first search only, a layout only when it beats every
+// search's best so far, and every few seconds without one, that the search
+// goes on (so that a long budget is never silent).
 class SharedProgress {
  public:
-  explicit SharedProgress(const core::WorkContext& context) : context_(context) {}
-  void remark(unsigned search, const core::Progress& progress);
-  void improved(const std::pair<int, double>& cost, const core::Progress& progress);
+  SharedProgress(const core::WorkContext& context, std::chrono::steady_clock::time_point started, double budget)
+      : context_(context), started_(started), budget_(budget), lastReport_(started) {}
+  void remark(unsigned search, core::Progress progress);
+  void improved(const std::pair<int, double>& cost, core::Progress progress);
+  void stillSearching(unsigned search);
+  [[nodiscard]] std::chrono::steady_clock::time_point deadline() const;
 
  private:
+  void report(core::Progress& progress);
+
   const core::WorkContext& context_;
+  const std::chrono::steady_clock::time_point started_;
+  const double budget_;
   std::mutex mutex_;
   std::optional<std::pair<int, double>> best_;
+  std::chrono::steady_clock::time_point lastReport_;
 };
 
 // Search number `search` (seed options.seed + search) on the shared shapes.

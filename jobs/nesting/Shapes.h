@@ -105,7 +105,18 @@ struct Shape {
   double rotation = 0;
 };
 
-Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep);
+// `forNoFitPolygons`: with the convex pieces and discs only the bottom-left
+// packer needs. `turnedFrom`, the same part's shape in another rotation:
+// its poles and discs are turned instead of searched again (their radii
+// less twice kSimplifyTolerance, what the two grown outlines may differ by).
+Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
+                const Shape* turnedFrom = nullptr);
+
+// The bottom-left packer with no-fit polygons re-lays every part after the
+// first one a trial changes: on jobs of more parts than this a trial takes
+// seconds (the bunny's 3674 panels: about 100 s), so the sequence search
+// that uses it is left out, and the shapes are built without what only it needs.
+constexpr size_t kMostPartsForNoFitPolygons = 400;
 
 // A shape placed: its part, its rotation (an index into the part's shapes)
 // and where its reference point (the part's origin) is.
@@ -117,8 +128,25 @@ struct PlacedShape {
 
 // Whether the boxes of two placed grown shapes are apart (touching counts as apart).
 bool boxesApart(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB);
+// Whether two placed shapes' cores (Shape::core) overlap, touching apart:
+// an edge of one properly crosses an edge of the other, or a point of one
+// (a pole's centre, a vertex, the middle of an edge) is strictly inside the
+// other's core. The same both ways round, and a few microseconds. Can miss
+// overlaps whose every crossing is at a vertex or along a shared line and
+// that hold none of those points; coresOverlap() has the last word.
+bool coresColliding(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB);
+// Whether two placed shapes' cores have area in common, by Clipper: exact,
+// and some tens of microseconds.
+bool coresOverlap(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB);
 // What two paths, each moved, have in common.
 Paths intersectionOf(const Path& a, IntPoint atA, const Path& b, IntPoint atB);
+
+class PartShapes;
+// Whether `part` may go on sheet s of `sheets` (each with its `parts`)
+// under `policy`: in a strict order only on the last; in a window, only
+// if it is then cut at most `window` places after its order.
+template <typename Sheets>
+bool mayGoOn(const PartShapes& shapes, OrderMode policy, const Sheets& sheets, int s, int part);
 
 // The shapes of every part in every allowed rotation, which parts are
 // copies of one another, and the area they are laid out in, on the grid.
@@ -152,9 +180,18 @@ class PartShapes {
   [[nodiscard]] cInt height() const { return height_; }
   [[nodiscard]] cInt pitch() const { return pitch_; }
   [[nodiscard]] const RoomScale& roomScale() const { return roomScale_; }
+  // Whether the shapes have what the bottom-left packer needs (kMostPartsForNoFitPolygons).
+  [[nodiscard]] bool forNoFitPolygons() const { return parts_.size() <= kMostPartsForNoFitPolygons; }
 
   // The right end of a placed shape's true outline.
   [[nodiscard]] cInt rightOf(const PlacedShape& s) const { return s.at.X + of(s).maxX; }
+
+  // (sheet, shape) pairs in placing order put in cutting order (sheet by
+  // sheet, each in the order its parts were placed), `row` set to them with
+  // the beds side by side in one row (bed s from s * pitch on), and their
+  // placements in inches.
+  NestingResult inCuttingOrder(std::vector<std::pair<int, PlacedShape>>& placed, int sheets,
+                               std::vector<PlacedShape>& row) const;
 
   // Placements, in inches, of (sheet, shape) pairs in cutting order.
   [[nodiscard]] NestingResult resultOf(const std::vector<std::pair<int, PlacedShape>>& placed, int sheets) const;
@@ -172,5 +209,16 @@ class PartShapes {
   std::vector<double> area_;
   cInt width_ = 0, height_ = 0, pitch_ = 0;
 };
+
+template <typename Sheets>
+bool mayGoOn(const PartShapes& shapes, OrderMode policy, const Sheets& sheets, int s, int part) {
+  const int count = static_cast<int>(sheets.size());
+  if (policy == OrderMode::Strict) return s == count - 1;
+  if (policy != OrderMode::Window || s + 1 == count) return true;
+  // Placed on sheet s, the part is cut after every part on sheets 0..s.
+  int cutBefore = 0;
+  for (int k = 0; k <= s; ++k) cutBefore += static_cast<int>(sheets[k].parts.size());
+  return shapes.parts()[part].order - cutBefore <= shapes.options().window;
+}
 
 }  // namespace rotafab::jobs::nesting

@@ -384,14 +384,14 @@ TEST(MakeCli, TheOrderDoesNotCostASheet) {
   TempDir dir;
   const std::string ball = quoted(kSource / "examples/soccer-ball.obj");
   const CommandResult free =
-      run(kCli + " make " + ball + " --structure band --time 2 --json --out " + quoted(dir.path() / "a"));
+      run(kCli + " make " + ball + " --structure band --time 6 --json --out " + quoted(dir.path() / "a"));
   ASSERT_EQ(free.status, 0) << free.err;
   EXPECT_EQ(nlohmann::json::parse(free.out).at("sheets"), 1);
   EXPECT_NE(free.err.find("cut in the free order: keeping each part within 8 places of the assembly order took 2 "
                           "sheets, the free order 1"),
             std::string::npos)
       << free.err;
-  const CommandResult window = run(kCli + " make " + ball + " --structure band --time 2 --order window --json --out " +
+  const CommandResult window = run(kCli + " make " + ball + " --structure band --time 6 --order window --json --out " +
                                    quoted(dir.path() / "b"));
   ASSERT_EQ(window.status, 0) << window.err;
   EXPECT_EQ(nlohmann::json::parse(window.out).at("sheets"), 2);
