@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <utility>
 
 namespace rotafab::core {
 
@@ -66,6 +67,54 @@ bool outlinesCross(const Polygon2& a, const Polygon2& b) {
     }
   }
   return false;
+}
+
+std::vector<Point2> simplifiedLine(const std::vector<Point2>& points, double tolerance, bool closed) {
+  const size_t n = points.size();
+  if (n < (closed ? 4u : 3u)) return points;
+  std::vector<char> kept(n, 0);
+  // A closed line is split at its first corner and the corner farthest
+  // from it; each half is an open line between kept corners.
+  size_t far = 0;
+  if (closed) {
+    for (size_t i = 1; i < n; ++i) {
+      if ((points[i] - points[0]).squaredNorm() > (points[far] - points[0]).squaredNorm()) far = i;
+    }
+  }
+  std::vector<std::pair<size_t, size_t>> runs;  // (first, last) of runs to simplify; last may be n: corner 0 again
+  kept[0] = 1;
+  if (closed && far > 0) {
+    kept[far] = 1;
+    runs.emplace_back(0, far);
+    runs.emplace_back(far, n);
+  } else {
+    kept[n - 1] = 1;
+    runs.emplace_back(0, n - 1);
+  }
+  while (!runs.empty()) {
+    const auto [first, last] = runs.back();
+    runs.pop_back();
+    const Point2& a = points[first];
+    const Point2& b = points[last % n];
+    double farthest = -1;
+    size_t at = first;
+    for (size_t i = first + 1; i < last; ++i) {
+      const double d = distanceToSegment(points[i], a, b);
+      if (d > farthest) farthest = d, at = i;
+    }
+    if (farthest > tolerance) {
+      kept[at] = 1;
+      runs.emplace_back(first, at);
+      runs.emplace_back(at, last);
+    }
+  }
+  std::vector<Point2> out;
+  for (size_t i = 0; i < n; ++i) {
+    if (kept[i]) out.push_back(points[i]);
+  }
+  // A closed line of two corners has no area: keep a third, the farthest from both.
+  if (closed && out.size() < 3) return points;
+  return out;
 }
 
 }  // namespace rotafab::core

@@ -39,4 +39,13 @@ bool crossesItself(const Polygon2& outline);
 // Whether two closed outlines cross (a side of one properly crosses a side of the other).
 bool outlinesCross(const Polygon2& a, const Polygon2& b);
 
+// The polyline (`closed`: the polygon) with only the corners that the
+// Douglas-Peucker rule keeps (Douglas and Peucker 1973, "Algorithms for the
+// reduction of the number of points required to represent a digitized line
+// or its caricature"): every dropped corner lies within `tolerance` of the
+// side that replaces it, and so the two lines are within `tolerance` of
+// each other everywhere. The ends of an open line are kept, and a closed
+// line keeps at least three corners.
+std::vector<Point2> simplifiedLine(const std::vector<Point2>& points, double tolerance, bool closed);
+
 }  // namespace rotafab::core

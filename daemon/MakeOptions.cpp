@@ -30,6 +30,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.freeOrderWhenItSavesSheets = !options.orderGiven;
   request.window = options.window;
   request.rows = options.layout == "rows";
+  if (!options.formats.empty()) request.formats = jobs::formatsOf(options.formats);  // checked by --formats
   request.names = flagOf;
   return request;
 }
@@ -93,6 +94,19 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
                   "quick preview; --order, --window and --time do not apply)")
       ->capture_default_str()
       ->check(CLI::IsMember({"nest", "rows"}));
+  make.add_option("--formats", options.formats,
+                  "Sheet files to write, of eps, svg and dxf, e.g. eps,svg,dxf (default: eps,svg, and dxf where the\n"
+                  "machine profile's `formats` names it); `rotafab run` and the daemon cut from the SVG")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            try {
+              jobs::formatsOf(value);
+              return std::string();
+            } catch (const std::invalid_argument& error) {
+              return std::string(error.what());
+            }
+          },
+          "eps,svg,dxf"));
 }
 
 }  // namespace rotafab::cli

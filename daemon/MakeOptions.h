@@ -15,6 +15,7 @@ namespace rotafab::cli {
 struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
   std::string size, fastener, kerf, holes = "keep", repair = "auto", up = "y", order = "window", layout = "nest";
+  std::string formats;      // empty: the machine profile's (jobs::defaultFormats())
   bool orderGiven = false;  // --order given: kept even where the free order would save a sheet
   std::optional<double> scale, tension, mergeCoplanar;
   std::optional<int> start, panels;

@@ -13,7 +13,7 @@
 namespace rotafab::jobs {
 namespace {
 
-constexpr int kDecimals = 9;
+constexpr int kDecimals = kSheetDecimals;
 
 class GroupWriter {
  public:

@@ -66,7 +66,8 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
     }
     for (size_t i = 0; i < path.points.size(); ++i) {
       const Point2& p = path.points[i];
-      fmt::format_to(to, "{} {} {}", formatDecimal(p.x() * kPointsPerInch, 4), formatDecimal(p.y() * kPointsPerInch, 4),
+      // 0.001 pt is 0.000014 in: the sheet's 0.0001 in (kSheetDecimals) with room to spare.
+      fmt::format_to(to, "{} {} {}", formatDecimal(p.x() * kPointsPerInch, 3), formatDecimal(p.y() * kPointsPerInch, 3),
                      i == 0 ? "m" : "l");
       buffer.push_back((i + 1) % kPointsPerLine == 0 ? '\n' : ' ');
     }

@@ -31,7 +31,12 @@ SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::jso
   } catch (const nlohmann::json::exception& error) {
     throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
   }
-  if (sheets.empty()) throw core::UserError(fmt::format("{}: lists no SVG sheet", manifestFile.string()));
+  if (sheets.empty()) {
+    throw core::UserError(
+        fmt::format("{}: lists no SVG sheet, which a cut is run from; make it again with svg in "
+                    "--formats (the default)",
+                    manifestFile.string()));
+  }
   return sheets;
 }
 

@@ -427,6 +427,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   }
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;
+  job.formats = request.formats.value_or(defaultFormats(request.machine));
   job.seconds.nesting = lap();
   if (job.sheets.windowSheets > 0) {
     context.note(fmt::format(
@@ -442,7 +443,7 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   Lap lap;
   context.report({"writing", "", 0, job.sheets.sheets.size()});
   OutputFolder output(folder);
-  job.files = writeSheets(job.sheets, output.staging(), context);
+  job.files = writeSheets(job.sheets, job.formats, output.staging(), context);
   context.check();
   writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
     geometry::writeObj(

@@ -53,6 +53,7 @@ struct MakeRequest {
   // The planner's (jobs/SheetPlanner.h).
   std::optional<double> kerf;  // default: the material's
   double seconds = kDefaultNestingSeconds;
+  std::optional<SheetFormats> formats;  // unset: defaultFormats(machine)
   OrderMode order = OrderMode::Window;
   int window = 8;
   bool freeOrderWhenItSavesSheets = false;  // as PlanOptions'
@@ -75,6 +76,7 @@ struct PlannedJob {
   geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
   std::vector<Part> parts;                           // structureParts()
   SheetPlan sheets;
+  SheetFormats formats;
   JobCost cost;
   // Once written (writeJob()):
   std::filesystem::path folder;

@@ -71,7 +71,14 @@ std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure
 
 namespace {
 
-nlohmann::ordered_json point(const Point2& p) { return {p.x(), p.y()}; }
+// To the sheets' 0.0001 in (kSheetDecimals): the outlines are what the sheets
+// cut, and nine more digits of each would only make the file larger.
+double onGrid(double v) {
+  constexpr double kScale = 10000.0;
+  static_assert(kSheetDecimals == 4);
+  return std::round(v * kScale) / kScale + 0.0;  // + 0.0: no "-0.0"
+}
+nlohmann::ordered_json point(const Point2& p) { return {onGrid(p.x()), onGrid(p.y())}; }
 
 // SPEC's `source`: a band panel's face (a cap of --holes fill has none in
 // the file), a woven panel's edge and cycle.

@@ -23,6 +23,14 @@ using Point2 = Eigen::Vector2d;
 using profiles::Operation;
 using profiles::Rgb;
 
+// What a sheet's files resolve: a laser resolves about 0.001 in, so the
+// writers give coordinates to 0.0001 in, and the planner simplifies every
+// path to within kSheetSimplification of its geometry. With the rounding
+// (at most 0.00005 in on each axis), the lines written stay within 0.0002
+// in of the geometry, far inside a kerf's tolerance.
+constexpr int kSheetDecimals = 4;
+constexpr double kSheetSimplification = 0.0002 - 0.00005 * 1.41421356237 - 1e-6;
+
 struct DrawnPath {
   Operation operation = Operation::Cut;
   std::vector<Point2> points;  // at least 2

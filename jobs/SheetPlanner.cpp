@@ -11,6 +11,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "core/Polygon2.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/DxfWriter.h"
 #include "jobs/EpsWriter.h"
@@ -104,6 +105,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
         if (stroke.size() < 2) continue;
         DrawnPath path{operation, {}, closed, partId(parts[placed.part].name)};
         for (const Point2& p : stroke) path.points.push_back(onSheet(placed, p));
+        path.points = core::simplifiedLine(path.points, kSheetSimplification, closed);
         sheet.paths.push_back(std::move(path));
       }
     };
@@ -130,7 +132,39 @@ std::string partId(const std::string& name) {
 
 std::string previewFile(int sheet) { return fmt::format("sheet-{:03}.preview.svg", sheet); }
 
-std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
+SheetFormats defaultFormats(const profiles::MachineProfile& machine) {
+  SheetFormats formats;
+  for (const std::string& format : machine.formats) {
+    formats.eps = formats.eps || format == "eps";
+    formats.svg = formats.svg || format == "svg";
+    formats.dxf = formats.dxf || format == "dxf";
+  }
+  return formats;
+}
+
+SheetFormats formatsOf(const std::string& list) {
+  SheetFormats formats{false, false, false};
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t end = std::min(list.find(',', start), list.size());
+    const std::string format = list.substr(start, end - start);
+    if (format == "eps") {
+      formats.eps = true;
+    } else if (format == "svg") {
+      formats.svg = true;
+    } else if (format == "dxf") {
+      formats.dxf = true;
+    } else {
+      throw std::invalid_argument(
+          fmt::format("'{}' is not a sheet format: give eps, svg or dxf, separated by commas", format));
+    }
+    start = end + 1;
+  }
+  return formats;
+}
+
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const SheetFormats& formats,
+                                                  const std::filesystem::path& folder,
                                                   const core::WorkContext& context) {
   std::filesystem::create_directories(folder);
   std::vector<std::vector<std::string>> files(plan.sheets.size());
@@ -139,14 +173,16 @@ std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const s
   context.parallelFor(plan.sheets.size(), [&](size_t s) {
     const SheetDrawing& sheet = plan.sheets[s];
     const std::string stem = fmt::format("sheet-{:03}", sheet.index);
-    writeFileAtomically(folder / (stem + ".eps"), [&](std::ostream& out) { writeEps(sheet, out); });
-    context.check();
-    writeFileAtomically(folder / (stem + ".svg"), [&](std::ostream& out) { writeSvg(sheet, out); });
-    context.check();
-    writeFileAtomically(folder / (stem + ".dxf"), [&](std::ostream& out) { writeDxf(sheet, out); });
-    context.check();
+    const auto write = [&](bool wanted, const std::string& name, const auto& writer) {
+      if (!wanted) return;
+      writeFileAtomically(folder / name, [&](std::ostream& out) { writer(sheet, out); });
+      files[s].push_back(name);
+      context.check();
+    };
+    write(formats.eps, stem + ".eps", writeEps);
+    write(formats.svg, stem + ".svg", writeSvg);
+    write(formats.dxf, stem + ".dxf", writeDxf);
     writeFileAtomically(folder / previewFile(sheet.index), [&](std::ostream& out) { writeSvgPreview(sheet, out); });
-    files[s] = {stem + ".eps", stem + ".svg", stem + ".dxf"};
   });
   return files;
 }

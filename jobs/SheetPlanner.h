@@ -42,6 +42,15 @@ struct PlannedPart {
   int moved = 0;         // cuttingIndex - assembly order: how far the layout moved the part
 };
 
+// The files written for each sheet (besides its preview for people).
+struct SheetFormats {
+  bool eps = true, svg = true, dxf = false;
+};
+// SPEC's EPS and SVG, and what the machine profile's `formats` adds.
+SheetFormats defaultFormats(const profiles::MachineProfile& machine);
+// "eps,svg,dxf" or any of them; throws std::invalid_argument saying what is wrong.
+SheetFormats formatsOf(const std::string& list);
+
 struct SheetPlan {
   std::vector<SheetDrawing> sheets;
   std::vector<PlannedPart> parts;  // in cutting order
@@ -72,11 +81,12 @@ std::string partId(const std::string& name);
 // The preview of a sheet for people: "sheet-001.preview.svg".
 std::string previewFile(int sheet);
 
-// Writes sheet-001.eps, .svg and .dxf, ... into `folder` (each atomically),
+// Writes sheet-001.eps, .svg and .dxf, ... (those `formats` asks for) into `folder` (each atomically),
 // and each sheet's preview (previewFile()), the sheets shared out on the
 // context's executor; returns the file names of each sheet's cut files
 // (not the preview), in order. Throws core::Cancelled.
-std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const std::filesystem::path& folder,
+std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const SheetFormats& formats,
+                                                  const std::filesystem::path& folder,
                                                   const core::WorkContext& context);
 
 }  // namespace rotafab::jobs

@@ -11,7 +11,7 @@
 namespace rotafab::jobs {
 namespace {
 
-constexpr int kDecimals = 9;
+constexpr int kDecimals = kSheetDecimals;
 constexpr double kHairlineInches = 0.001;
 
 }  // namespace

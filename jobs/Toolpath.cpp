@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -67,12 +68,27 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   std::vector<size_t> order;
   std::vector<size_t> entry(n, 0);
   std::vector<char> done(n, 0);
+  // Each path's box: no corner of a path is nearer than its box, so most
+  // paths are passed over without looking at their corners.
+  std::vector<std::array<double, 4>> boxes;
+  for (const Candidate& c : candidates) {
+    std::array<double, 4> box{c.points[0].x(), c.points[0].y(), c.points[0].x(), c.points[0].y()};
+    for (const Point2& p : c.points) {
+      box[0] = std::min(box[0], p.x()), box[1] = std::min(box[1], p.y());
+      box[2] = std::max(box[2], p.x()), box[3] = std::max(box[3], p.y());
+    }
+    boxes.push_back(box);
+  }
   Point2 at = from;
   for (size_t step = 0; step < n; ++step) {
     size_t best = n;
     double bestDistance = std::numeric_limits<double>::max();
     for (size_t i = 0; i < n; ++i) {
       if (done[i]) continue;
+      const auto& b = boxes[i];
+      const double dx = std::max({b[0] - at.x(), 0.0, at.x() - b[2]}),
+                   dy = std::max({b[1] - at.y(), 0.0, at.y() - b[3]});
+      if (dx * dx + dy * dy >= bestDistance) continue;
       const size_t e = nearestEntry(candidates[i], at);
       const double d = (candidates[i].points[e] - at).squaredNorm();
       if (d < bestDistance) bestDistance = d, best = i, entry[i] = e;
@@ -84,7 +100,11 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   // 2-opt over the open strokes' ends and the closed strokes' entries:
   // reversing order[i..j] also reverses each open stroke in it. A closed
   // stroke is entered and left at the same corner, so only the travel to
-  // and from the run changes. Bounded in time for very large sheets.
+  // and from the run changes. Runs of at most kTwoOptReach strokes: after
+  // the nearest neighbour, the crossings are local (a sheet of the bunny
+  // has 1,500 label strokes, and every pair took seconds). Bounded in time
+  // for very large sheets.
+  constexpr size_t kTwoOptReach = 64;
   const auto entryPoint = [&](size_t k) { return candidates[order[k]].points[entry[order[k]]]; };
   const auto exitPoint = [&](size_t k) { return exitOf(candidates[order[k]], entry[order[k]]); };
   const auto started = std::chrono::steady_clock::now();
@@ -93,7 +113,7 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
     for (size_t i = 0; i + 1 < n; ++i) {
       if (std::chrono::steady_clock::now() - started > std::chrono::seconds(2)) break;
       const Point2 before = i == 0 ? from : exitPoint(i - 1);
-      for (size_t j = i + 1; j < n; ++j) {
+      for (size_t j = i + 1; j < std::min(n, i + 1 + kTwoOptReach); ++j) {
         const bool last = j + 1 == n;
         const double now = (entryPoint(i) - before).norm() + (last ? 0.0 : (entryPoint(j + 1) - exitPoint(j)).norm());
         // Reversed, the run is entered where stroke j is left now, and left where stroke i is entered now.

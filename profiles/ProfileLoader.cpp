@@ -56,9 +56,10 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   const ProfileReader reader(file);
   const YAML::Node root = reader.load();
   requireKind(reader, root, "machine");
-  reader.keys(root, "",
-              {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations", "motion"},
-              {"name", "bed", "driver", "connection", "colours"});
+  reader.keys(
+      root, "",
+      {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations", "motion", "formats"},
+      {"name", "bed", "driver", "connection", "colours"});
   MachineProfile machine;
   machine.source = file;
   machine.name = reader.text(root["name"], "name");
@@ -85,6 +86,18 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
       m.junctionDeviation = reader.length(motion["junction_deviation"], "motion.junction_deviation", 0.0, true);
     }
     machine.motion = m;
+  }
+
+  if (const YAML::Node formats = root["formats"]) {
+    if (!formats.IsSequence()) reader.fail(formats, "formats", "expected a list of sheet formats, e.g. [dxf]");
+    for (size_t i = 0; i < formats.size(); ++i) {
+      const std::string at = fmt::format("formats[{}]", i);
+      const std::string format = reader.text(formats[i], at);
+      if (format != "eps" && format != "svg" && format != "dxf") {
+        reader.fail(formats[i], at, fmt::format("expected eps, svg or dxf, found '{}'", format));
+      }
+      machine.formats.push_back(format);
+    }
   }
 
   machine.driver = reader.text(root["driver"], "driver");

@@ -54,6 +54,9 @@ struct MachineProfile {
   std::vector<ColourSetting> colours;
   std::map<Operation, std::string> operationColour;  // every operation has one
   std::optional<MachineMotion> motion;
+  // Sheet files that `make` writes for this machine besides SPEC's EPS and
+  // SVG, as its software wants them: "dxf" (`formats: [dxf]`).
+  std::vector<std::string> formats;
   std::filesystem::path source;
 
   // The colour table row that `operation` is drawn in.

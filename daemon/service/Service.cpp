@@ -555,6 +555,9 @@ struct Service::Impl {
         options.machine = machine.name;
         if (!materialGiven) options.material = material.name;
         jobs::MakeRequest request = cli::requestOf(options, catalogue);
+        // The daemon cuts from the SVG: it is written whatever --formats says.
+        request.formats = request.formats.value_or(jobs::defaultFormats(machine));
+        request.formats->svg = true;
         const JobId id = job.id;
         auto last = std::make_shared<Clock::time_point>();
         const core::WorkContext context(

@@ -114,7 +114,9 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
     if (onProgress) onProgress(index, sequence.size(), sheets.size());
     const int part = sequence[index];
     bool done = false;
-    for (int s = 0; s < static_cast<int>(sheets.size()) && !done; ++s) {
+    // First fit over the sheets still open: the last kOpenSheets.
+    const int openFrom = std::max(0, static_cast<int>(sheets.size()) - kOpenSheets);
+    for (int s = openFrom; s < static_cast<int>(sheets.size()) && !done; ++s) {
       if (!mayGoOn(shapes_, policy, sheets, s, part)) continue;
       if (sheets[s].freeArea < shapes_.area(part)) continue;
       if (auto spot = bestSpot(part, sheets[s])) {
@@ -133,6 +135,28 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
       put(sheets.back(), *spot);
       placed.emplace_back(static_cast<int>(sheets.size()) - 1, *spot);
     }
+  }
+  // The sheets closed early may still have room for the last sheet's
+  // parts, the smallest: each tries them all, first fit, and the last
+  // sheet goes if it empties. (Its own raster is not updated: nothing
+  // more is placed on it.)
+  if (policy == OrderMode::Free && sheets.size() > static_cast<size_t>(kOpenSheets)) {
+    const int last = static_cast<int>(sheets.size()) - 1;
+    bool emptied = true;
+    for (auto& [sheet, spot] : placed) {
+      if (sheet != last) continue;
+      if (cancellation_) cancellation_->check();
+      bool moved = false;
+      for (int s = 0; s < last - kOpenSheets + 1 && !moved; ++s) {
+        if (sheets[s].freeArea < shapes_.area(spot.part)) continue;
+        if (auto elsewhere = bestSpot(spot.part, sheets[s])) {
+          put(sheets[s], *elsewhere);
+          sheet = s, spot = *elsewhere, moved = true;
+        }
+      }
+      emptied = emptied && moved;
+    }
+    if (emptied) sheets.pop_back();
   }
   return shapes_.inCuttingOrder(placed, static_cast<int>(sheets.size()), layout_);
 }

@@ -82,6 +82,10 @@ class CollisionPlacer {
   cInt cell_ = 1;  // the raster's cell side
   int columns_ = 0, rows_ = 0;
   static constexpr int kBlock = 16;  // raster cells per block side: the scan skips blocks without room
+  // Sheets still open to first fit: trying every sheet for every part made
+  // the cost per part grow with the sheets (3.4 ms a part at 8,000 torus
+  // panels against 0.34 at 500), for 2% fewer sheets.
+  static constexpr int kOpenSheets = 8;
   int blockColumns_ = 0, blockRows_ = 0;
   float cap_ = 0;        // clearances are kept up to this (the largest pole, and a cell)
   float cellReach_ = 0;  // half a cell's diagonal, and the cores' slack: what a lookup may be off by

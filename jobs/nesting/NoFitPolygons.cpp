@@ -81,7 +81,7 @@ const Paths& NoFitPolygons::wholeNoFitPolygon(int movingPart, int movingShape, i
 // the placed part in its first quarter-turn rotation; turned by `turns`,
 // it is the one asked for. Turned outlines are exact on the grid, but the
 // grown shapes built from them may differ from turned grown shapes by up
-// to kSimplifyTolerance (where CleanPolygon starts); both still hold the
+// to kSimplifyTolerance (the simplification); both still hold the
 // outline grown by half the spacing, so the final exact checks hold, and
 // a pair may only look a little more or less apart than it is.
 NoFitPolygons::TurnedRegion NoFitPolygons::noFitPolygonOf(int movingPart, int movingShape, int placedPart,

@@ -45,6 +45,8 @@ cInt toInt(double value);
 Path toPath(const Polygon2& polygon);
 Polygon2 rotated(const Polygon2& polygon, double degrees);
 Path translatedPath(const Path& path, IntPoint by);
+// The closed path with the fewest corners within `tolerance` grid units of it (Douglas-Peucker).
+Path simplifiedPath(const Path& path, double tolerance);
 Box boxOf(const Path& path);
 
 // The path grown by `by` inches (its boundary grown too, as a line: a

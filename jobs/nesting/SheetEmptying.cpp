@@ -32,45 +32,48 @@ NestingResult SheetEmptying::empty(const std::vector<PlacedShape>& layout, int f
     beds[bed].push_back(p);
   }
   std::erase_if(beds, [](const auto& bed) { return bed.empty(); });
-  std::vector<char> triedInVain(beds.size(), 0);
+  // Beds that kept every part through a whole pass since the beds last changed.
+  std::vector<char> stuck(beds.size(), 0);
   while (static_cast<int>(beds.size()) > fewest && goOn()) {
-    // The least-filled bed not yet tried in vain since the beds last changed.
     size_t least = beds.size();
     for (size_t b = 0; b < beds.size(); ++b) {
-      if (!triedInVain[b] && (least == beds.size() || partArea(beds[b]) < partArea(beds[least]))) least = b;
+      if (!stuck[b] && (least == beds.size() || partArea(beds[b]) < partArea(beds[least]))) least = b;
     }
     if (least == beds.size()) break;
+    // Each part that finds room elsewhere leaves at once (the layout is
+    // valid after every move), the largest first; one that does not stays
+    // for the next pass.
     std::vector<PlacedShape> leaving = beds[least];
     std::stable_sort(leaving.begin(), leaving.end(), [&](const PlacedShape& a, const PlacedShape& b) {
       return shapes_.area(a.part) > shapes_.area(b.part);
     });
-    std::vector<std::vector<PlacedShape>> others = beds;
-    others.erase(others.begin() + static_cast<long>(least));
-    bool emptied = true;
+    bool moved = false;
     for (const PlacedShape& part : leaving) {
-      std::vector<size_t> roomiest(others.size());
-      std::iota(roomiest.begin(), roomiest.end(), 0);
+      if (!goOn()) break;
+      std::vector<size_t> roomiest;
+      for (size_t b = 0; b < beds.size(); ++b) {
+        if (b != least) roomiest.push_back(b);
+      }
       std::stable_sort(roomiest.begin(), roomiest.end(),
-                       [&](size_t a, size_t b) { return partArea(others[a]) < partArea(others[b]); });
-      bool placed = false;
-      for (size_t t = 0; t < std::min(kBedsTriedPerPart, roomiest.size()) && !placed; ++t) {
+                       [&](size_t a, size_t b) { return partArea(beds[a]) < partArea(beds[b]); });
+      for (size_t t = 0; t < std::min(kBedsTriedPerPart, roomiest.size()); ++t) {
         const auto until = std::chrono::steady_clock::now() + kMostPerInsertion;
         const auto bounded = [&] { return goOn() && std::chrono::steady_clock::now() < until; };
-        placed = compaction_.insert(others[roomiest[t]], part, random, bounded, moves);
-      }
-      if (!placed) {
-        emptied = false;
-        break;
+        if (compaction_.insert(beds[roomiest[t]], part, random, bounded, moves)) {
+          std::erase_if(beds[least], [&](const PlacedShape& p) { return p.part == part.part; });
+          moved = true;
+          break;
+        }
       }
     }
-    if (emptied) {
-      beds = std::move(others);
-      triedInVain.assign(beds.size(), 0);
+    if (beds[least].empty()) {
+      beds.erase(beds.begin() + static_cast<long>(least));
+      stuck.assign(beds.size(), 0);
       cInt lastLength = 0;
       for (const PlacedShape& p : beds.back()) lastLength = std::max(lastLength, shapes_.rightOf(p));
       fewer(static_cast<int>(beds.size()), static_cast<double>(lastLength) / kScale);
-    } else {
-      triedInVain[least] = 1;
+    } else if (!moved) {
+      stuck[least] = 1;
     }
   }
   std::vector<std::pair<int, PlacedShape>> placed;

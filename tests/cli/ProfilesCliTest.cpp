@@ -17,7 +17,7 @@ TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
   EXPECT_EQ(refused.status, 1);
   EXPECT_EQ(refused.err, "error: " + bad.string() +
                              ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
-                             "connection, colours, operations, motion)\n");
+                             "connection, colours, operations, motion, formats)\n");
   EXPECT_EQ(refused.out, "") << "nothing on standard output before, or instead of, the error";
   const CommandResult accepted = run(std::string(ROTAFAB_CLI) + " profiles --json " + good.string());
   EXPECT_EQ(accepted.status, 0) << accepted.err;

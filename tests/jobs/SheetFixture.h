@@ -90,7 +90,12 @@ struct ReadPath {
   bool closed = false;
 };
 
-inline void expectSamePaths(const SheetDrawing& sheet, const std::vector<ReadPath>& read, double tolerance = 1e-6) {
+// The files give coordinates to kSheetDecimals (0.0001 in): each read back
+// within half a unit on each axis of the drawing.
+constexpr double kWrittenTolerance = 0.00005 * 1.41421356237 + 1e-9;
+
+inline void expectSamePaths(const SheetDrawing& sheet, const std::vector<ReadPath>& read,
+                            double tolerance = kWrittenTolerance) {
   for (Operation operation : profiles::kAllOperations) {
     SCOPED_TRACE(std::string(profiles::operationName(operation)));
     std::vector<const DrawnPath*> drawn;

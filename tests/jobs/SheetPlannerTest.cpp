@@ -7,8 +7,11 @@
 
 #include <cmath>
 #include <numbers>
+#include <regex>
 #include <sstream>
 
+#include "core/Polygon2.h"
+#include "jobs/SheetReader.h"
 #include "support/TestContext.h"
 #include "support/TestSupport.h"
 
@@ -184,7 +187,7 @@ TEST(SheetPlanner, WritesEpsSvgAndDxfForEverySheet) {
   options.title = "test";
   const SheetPlan plan = planSheets(parts, workshop(), options, test::context());
   test::TempDir dir;
-  const auto files = writeSheets(plan, dir.path(), test::context());
+  const auto files = writeSheets(plan, {true, true, true}, dir.path(), test::context());
   ASSERT_EQ(files.size(), plan.sheets.size());
   EXPECT_EQ(files[0], (std::vector<std::string>{"sheet-001.eps", "sheet-001.svg", "sheet-001.dxf"}));
   const std::string eps = test::readFile(dir.path() / "sheet-001.eps");
@@ -201,6 +204,72 @@ TEST(SheetPlanner, WritesEpsSvgAndDxfForEverySheet) {
   EXPECT_NEAR(box[1], 0, 0.1);
   EXPECT_NEAR(box[2], 2304, 0.1);
   EXPECT_NEAR(box[3], 1296, 0.1);
+}
+
+// The sheets are as small as their meaning: a finely sampled outline comes
+// out with far fewer corners, to 0.0001 in, and the SVG read back stays
+// within 0.0002 in of the geometry everywhere (the largest distance either
+// way between the written line and the outline as planned, measured).
+TEST(SheetPlanner, SheetsKeepTheGeometryWithin0_0002InchesInFewCornersToATenThousandth) {
+  Part part = panel(0);
+  part.outline = circle({1.5, 1.5}, 1.5, 20000);  // a rail sampled every 0.0005 in
+  part.holes = {circle({1.5, 1.5}, 0.0625, 720)};
+  PlanOptions options;
+  options.seconds = 0;
+  options.kerf = 0;
+  const SheetPlan plan = planSheets({part}, workshop(), options, test::context());
+  ASSERT_EQ(plan.sheets.size(), 1u);
+  test::TempDir dir;
+  writeSheets(plan, {false, true, false}, dir.path(), test::context());
+  const std::string svg = test::readFile(dir.path() / "sheet-001.svg");
+  EXPECT_FALSE(std::regex_search(svg, std::regex(R"([ML]-?\d+\.\d{5})"))) << "more than 4 decimals";
+  const SheetDrawing read = readSheetSvg(dir.path() / "sheet-001.svg");
+  const PlannedPart& placed = plan.parts.front();
+  const auto lineDistance = [](const Point2& p, const std::vector<Point2>& line) {
+    double best = 1e9;
+    for (size_t i = 0; i < line.size(); ++i)
+      best = std::min(best, core::distanceToSegment(p, line[i], line[(i + 1) % line.size()]));
+    return best;
+  };
+  int checked = 0;
+  for (const Polygon2* local : {&part.outline, &part.holes.front()}) {
+    std::vector<Point2> planned;
+    for (const Point2& p : *local) planned.push_back(onSheet(placed, p));
+    // The written cut whose first corner is nearest the planned line.
+    const DrawnPath* written = nullptr;
+    for (const DrawnPath& path : read.paths) {
+      if (path.operation != Operation::Cut) continue;
+      if (!written || lineDistance(path.points.front(), planned) < lineDistance(written->points.front(), planned))
+        written = &path;
+    }
+    ASSERT_NE(written, nullptr);
+    EXPECT_LT(written->points.size(), local->size() / 10) << "not simplified";
+    double deviation = 0;
+    for (const Point2& p : planned) deviation = std::max(deviation, lineDistance(p, written->points));
+    for (size_t i = 0; i < written->points.size(); ++i) {
+      const Point2& a = written->points[i];
+      const Point2& b = written->points[(i + 1) % written->points.size()];
+      for (double t : {0.0, 0.25, 0.5, 0.75}) deviation = std::max(deviation, lineDistance(a + t * (b - a), planned));
+    }
+    EXPECT_LE(deviation, 0.0002) << written->points.size() << " corners";
+    EXPECT_GT(deviation, 0.00005) << "simplified no more than the rounding";
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
+}
+
+TEST(SheetPlanner, SheetFormatsAreSpecsAndWhatTheMachineNamesOrWhatIsAsked) {
+  profiles::MachineProfile machine = workshop();
+  SheetFormats formats = defaultFormats(machine);
+  EXPECT_TRUE(formats.eps && formats.svg && !formats.dxf);
+  machine.formats = {"dxf"};
+  formats = defaultFormats(machine);
+  EXPECT_TRUE(formats.eps && formats.svg && formats.dxf);
+  formats = formatsOf("dxf");
+  EXPECT_TRUE(!formats.eps && !formats.svg && formats.dxf);
+  formats = formatsOf("svg,eps");
+  EXPECT_TRUE(formats.eps && formats.svg && !formats.dxf);
+  for (const char* bad : {"", "pdf", "svg,,eps", "svg,"}) EXPECT_THROW(formatsOf(bad), std::invalid_argument) << bad;
 }
 
 }  // namespace

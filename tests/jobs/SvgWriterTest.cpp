@@ -281,7 +281,7 @@ TEST(SvgWriter, EachPartIsAGroupAndTheBedALayerOfItsOwn) {
     const bool found = std::any_of(read.paths.begin(), read.paths.end(), [&](const DrawnPath& p) {
       if (p.operation != written.operation || p.points.size() != written.points.size()) return false;
       for (size_t k = 0; k < p.points.size(); ++k)
-        if ((p.points[k] - written.points[k]).norm() > 1e-9) return false;
+        if ((p.points[k] - written.points[k]).norm() > kWrittenTolerance) return false;
       return true;
     });
     EXPECT_TRUE(found);

@@ -125,7 +125,11 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
   const std::vector<Case> cases = {
       {"unknown key", replaced(good, "driver: spool", "drivr: spool"),
        "p.yaml:4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, connection, colours, "
-       "operations, motion)"},
+       "operations, motion, formats)"},
+      {"unknown sheet format", replaced(good, "driver: spool", "formats: [dxf, pdf]\ndriver: spool"),
+       "p.yaml:4:16: formats[1]: expected eps, svg or dxf, found 'pdf'"},
+      {"formats not a list", replaced(good, "driver: spool", "formats: dxf\ndriver: spool"),
+       "p.yaml:4:10: formats: expected a list of sheet formats, e.g. [dxf]"},
       {"wrong type", replaced(good, "width: 32in", "width: wide"),
        "p.yaml:3:14: bed.width: expected a length such as 0.25in, 6.35mm or 0.635cm, found 'wide'"},
       {"negative power", replaced(good, "power: 50", "power: -5"),
