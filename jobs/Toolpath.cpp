@@ -108,7 +108,10 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   const auto entryPoint = [&](size_t k) { return candidates[order[k]].points[entry[order[k]]]; };
   const auto exitPoint = [&](size_t k) { return exitOf(candidates[order[k]], entry[order[k]]); };
   const auto started = std::chrono::steady_clock::now();
-  for (bool improved = true; improved && n > 2;) {
+  // At most a few passes, so that the work per stroke is bounded.
+  constexpr int kTwoOptPasses = 4;
+  int passes = 0;
+  for (bool improved = true; improved && n > 2 && passes < kTwoOptPasses; ++passes) {
     improved = false;
     for (size_t i = 0; i + 1 < n; ++i) {
       if (std::chrono::steady_clock::now() - started > std::chrono::seconds(2)) break;
