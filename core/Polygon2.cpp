@@ -112,7 +112,7 @@ std::vector<Point2> simplifiedLine(const std::vector<Point2>& points, double tol
   for (size_t i = 0; i < n; ++i) {
     if (kept[i]) out.push_back(points[i]);
   }
-  // A closed line of two corners has no area: keep a third, the farthest from both.
+  // A closed line of two corners has no area: such a line is given back whole.
   if (closed && out.size() < 3) return points;
   return out;
 }

@@ -67,7 +67,8 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
   int windowSheets = 0;
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  if (fallback && nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting)) {
+  // Only with budget left: the free order's first layout is extra work.
+  if (fallback && nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting) && took < options.seconds) {
     NestingOptions free = nesting;
     free.order = OrderMode::Free;
     // What is left of the budget; a first layout is made whatever is left.

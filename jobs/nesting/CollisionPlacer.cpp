@@ -84,7 +84,8 @@ CollisionPlacer::CollisionPlacer(const PartShapes& shapes, const core::Cancellat
     sizes.push_back(std::max(first.grownMaxX - first.grownMinX, first.grownMaxY - first.grownMinY));
   }
   cap_ = static_cast<float>(largestPole + static_cast<double>(cell_));
-  cellReach_ = static_cast<float>(static_cast<double>(cell_) * std::sqrt(0.5) + kCollisionSlack + 1);
+  // The core is `grown` shrunk with mitres: at a reflex corner up to twice kCollisionSlack inside it.
+  cellReach_ = static_cast<float>(static_cast<double>(cell_) * std::sqrt(0.5) + 2 * kCollisionSlack + 2);
   // Hazard cells about as large as a typical part: a query meets a few
   // cells of a few parts each.
   std::nth_element(sizes.begin(), sizes.begin() + static_cast<long>(sizes.size() / 2), sizes.end());

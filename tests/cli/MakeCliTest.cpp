@@ -417,7 +417,7 @@ TEST(MakeCli, TheOrderDoesNotCostASheet) {
   TempDir dir;
   const std::string ball = quoted(kSource / "examples/soccer-ball.obj");
   const CommandResult free =
-      run(kCli + " make " + ball + " --structure band --time 6 --json --out " + quoted(dir.path() / "a"));
+      run(kCli + " make " + ball + " --structure band --time 16 --json --out " + quoted(dir.path() / "a"));
   ASSERT_EQ(free.status, 0) << free.err;
   EXPECT_EQ(nlohmann::json::parse(free.out).at("sheets"), 1);
   EXPECT_NE(free.err.find("cut in the free order: keeping each part within 8 places of the assembly order took 2 "
