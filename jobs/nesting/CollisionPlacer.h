@@ -9,7 +9,7 @@
 //
 // Which places are worth an exact test comes from a clearance raster per
 // sheet: for each cell, how far its centre is from the nearest placed
-// shape (capped at the largest pole of any part). A pole of radius r can
+// shape (capped at the largest pole of any part, and a cell). A pole of radius r can
 // only go where the clearance is at least r, less half a cell's diagonal,
 // so a part's largest poles rule out nearly every place on a filling sheet
 // by table lookups, and a sheet (or a column of it) with no room for the

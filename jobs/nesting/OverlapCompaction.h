@@ -10,7 +10,7 @@
 // used.
 //
 // Preconditions: a layout without overlaps to start from (the accepted
-// layout of BottomLeftPacker, in its frame). One compaction per search; not
+// layout of CollisionPlacer or BottomLeftPacker, in their frame). One compaction per search; not
 // for two threads at once.
 
 #include <functional>

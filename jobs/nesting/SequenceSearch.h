@@ -1,11 +1,13 @@
 #pragma once
-// One search for a layout (jobs/Nesting.h): the first layout by bottom-left
-// placement (BottomLeftPacker.h) in assembly order (largest first in free
-// order), then a local search over the sequence and the rotations, as in
-// Jakobs 1996 and Gomes and Oliveira 2002 (swap two parts, within the
-// window when the order is bounded, or fix or free a part's rotation; keep
-// the change when the layout is no worse), and in free order the
-// compaction (OverlapCompaction.h) for the rest of the budget. Its course
+// One search for a layout (jobs/Nesting.h): the first layout by the
+// collision placer (CollisionPlacer.h) in assembly order (largest first in
+// free order); then, on jobs of up to kMostPartsForNoFitPolygons parts, a
+// local search over the sequence and the rotations by bottom-left placement
+// on no-fit polygons (BottomLeftPacker.h), as in Jakobs 1996 and Gomes and
+// Oliveira 2002 (swap two parts, within the window when the order is
+// bounded, or fix or free a part's rotation; keep the change when the
+// layout is no worse), and in free order the compaction (OverlapCompaction.h,
+// or on larger jobs on beds SheetEmptying.h) for the rest of the budget. Its course
 // is fixed by its seed; the time budget, or a cap on layouts, decides how
 // far along it gets. Several run side by side (nest()), and the best wins.
 
