@@ -17,7 +17,7 @@ int runManifest(const std::string& folder, const std::string& format) {
   try {
     const nlohmann::json manifest = jobs::readManifest(folder);
     if (format == "json") {
-      std::cout << manifest.dump(1) << '\n';
+      std::cout << jobs::manifestJsonText(manifest);
       return kSuccess;
     }
     std::filesystem::path file(folder);

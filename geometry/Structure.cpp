@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <map>
+#include <unordered_map>
 
 namespace rotafab::geometry {
 
@@ -68,12 +69,29 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
 
 PolygonMesh surfaceMesh(const Structure& structure) {
   PolygonMesh surface;
+  // A panel's polygons share the corners they have in common (the same
+  // point exactly), so that each panel is one connected surface; panels
+  // share none, being separate pieces of material.
+  struct Hash {
+    size_t operator()(const Point3& p) const {
+      size_t h = 0;
+      for (int axis = 0; axis < 3; ++axis) h = h * 0x9E3779B97F4A7C15ull + std::hash<double>{}(p[axis]);
+      return h;
+    }
+  };
+  struct Equal {
+    bool operator()(const Point3& a, const Point3& b) const { return a == b; }
+  };
+  std::unordered_map<Point3, int, Hash, Equal> corners;
   for (const Panel& panel : structure.panels) {
+    corners.clear();
     for (const auto& polygon : panel.surface) {
       std::vector<int> face;
+      face.reserve(polygon.size());
       for (const Point3& p : polygon) {
-        face.push_back(surface.vertexCount());
-        surface.positions.push_back(p);
+        const auto [at, added] = corners.try_emplace(p, surface.vertexCount());
+        if (added) surface.positions.push_back(p);
+        face.push_back(at->second);
       }
       surface.faces.push_back(std::move(face));
     }

@@ -191,6 +191,13 @@ void writeDxf(const SheetDrawing& sheet, std::ostream& out) {
   group(2, "ENTITIES");
   for (const DrawnPath& path : sheet.paths) {
     const std::string layer = dxfLayerName(path.operation);
+    if (path.circle) {
+      group(0, "CIRCLE");
+      group(8, layer);
+      group.point(10, path.circle->centre.x(), path.circle->centre.y());
+      group(40, formatDecimal(path.circle->radius, kDecimals));
+      continue;
+    }
     if (!path.closed && path.points.size() == 2) {
       group(0, "LINE");
       group(8, layer);

@@ -13,6 +13,7 @@ namespace {
 constexpr double kPointsPerInch = 72.0;
 constexpr double kHairlineInches = 0.001;
 constexpr int kPointsPerLine = 8;  // keeps lines well under DSC's 255 bytes
+constexpr int kDecimals = 3;       // of a point
 
 }  // namespace
 
@@ -47,6 +48,8 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
   line("/l { lineto } bind def");
   line("/s { stroke } bind def");
   line("/cs { closepath stroke } bind def");
+  line("/r { rlineto } bind def");
+  line("/o { 0 360 arc closepath stroke } bind def");
   line("/c { setrgbcolor } bind def");
   line("end");
   line("%%EndProlog");
@@ -64,12 +67,29 @@ void writeEps(const SheetDrawing& sheet, std::ostream& out) {
                      formatDecimal(rgb.g / 255.0, 6), formatDecimal(rgb.b / 255.0, 6));
       current = path.operation;
     }
+    // 0.001 pt is 0.000014 in: the sheet's 0.0001 in (kSheetDecimals) with room to spare.
+    const auto units = [](double inches) { return unitsOf(inches * kPointsPerInch, kDecimals); };
+    const auto number = [&buffer](int64_t value) {
+      appendUnits(buffer, value, kDecimals);
+      buffer.push_back(' ');
+    };
+    if (path.circle) {
+      number(units(path.circle->centre.x()));
+      number(units(path.circle->centre.y()));
+      number(units(path.circle->radius));
+      line("o");
+      continue;
+    }
+    // The first point, then moves in whole units, which add up exactly to
+    // the rounded points.
+    int64_t x = 0, y = 0;
     for (size_t i = 0; i < path.points.size(); ++i) {
-      const Point2& p = path.points[i];
-      // 0.001 pt is 0.000014 in: the sheet's 0.0001 in (kSheetDecimals) with room to spare.
-      fmt::format_to(to, "{} {} {}", formatDecimal(p.x() * kPointsPerInch, 3), formatDecimal(p.y() * kPointsPerInch, 3),
-                     i == 0 ? "m" : "l");
+      const int64_t px = units(path.points[i].x()), py = units(path.points[i].y());
+      number(px - x);
+      number(py - y);
+      buffer.push_back(i == 0 ? 'm' : 'r');
       buffer.push_back((i + 1) % kPointsPerLine == 0 ? '\n' : ' ');
+      x = px, y = py;
     }
     line(path.closed ? "cs" : "s");
   }

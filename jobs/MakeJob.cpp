@@ -450,13 +450,13 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
         stream, geometry::surfaceMesh(job.structure),
         fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
                     job.meshFile.string(), job.structure.panels.size()),
-        geometry::panelGroups(job.structure));
+        geometry::panelGroups(job.structure), kSheetDecimals);
   });
   job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
   job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
   job.manifest["stability"] = stabilityJson(job.stability);
   job.manifest["cost"] = costJson(job.cost);
-  writeFileAtomically(output.staging() / "manifest.json", job.manifest.dump(1) + "\n");
+  writeFileAtomically(output.staging() / "manifest.json", manifestJsonText(job.manifest));
   writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
   context.check();
   // manifest.json last: until it moves in, the folder's manifest is the old job's.

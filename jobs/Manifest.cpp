@@ -27,16 +27,7 @@ std::vector<Part> structureParts(const geometry::Structure& structure) {
     part.name = name;
     part.order = order;
     part.outline = outline;
-    for (const geometry::PanelHole& hole : holes) {
-      // The polygon around the circle (its sides touch it), so the fastener passes.
-      const double radius = hole.diameter / 2 / std::cos(std::numbers::pi / kHoleSides);
-      Polygon2 circle;
-      for (int i = 0; i < kHoleSides; ++i) {
-        const double a = 2 * std::numbers::pi * i / kHoleSides;
-        circle.push_back(hole.xy + radius * Point2(std::cos(a), std::sin(a)));
-      }
-      part.holes.push_back(std::move(circle));
-    }
+    for (const geometry::PanelHole& hole : holes) part.circles.push_back({hole.xy, hole.diameter / 2});
     for (const geometry::PanelLabel& label : labels) {
       part.etch.insert(part.etch.end(), label.strokes.begin(), label.strokes.end());
     }
@@ -478,5 +469,33 @@ the same number on the panel named; fasten them through their holes.</p>
     throw std::invalid_argument(fmt::format("the manifest is not SPEC's version 1: {}", jsonErrorText(error)));
   }
 }
+
+template <class Json>
+std::string manifestJsonText(const Json& manifest) {
+  if (!manifest.is_object()) return manifest.dump() + "\n";
+  std::string text = "{";
+  bool first = true;
+  for (const auto& [key, value] : manifest.items()) {
+    text += first ? "\n " : ",\n ";
+    first = false;
+    text += Json(key).dump();
+    text += ": ";
+    if (value.is_array() && !value.empty() && (key == "sheets" || key == "panels")) {
+      text += "[";
+      for (size_t i = 0; i < value.size(); ++i) {
+        text += i == 0 ? "\n  " : ",\n  ";
+        text += value[i].dump();
+      }
+      text += "\n ]";
+    } else {
+      text += value.dump();
+    }
+  }
+  text += "\n}\n";
+  return text;
+}
+
+template std::string manifestJsonText(const nlohmann::json&);
+template std::string manifestJsonText(const nlohmann::ordered_json&);
 
 }  // namespace rotafab::jobs

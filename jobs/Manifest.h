@@ -41,12 +41,10 @@ nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified
 // "footprint" (its corners on the ground)}; inches.
 nlohmann::ordered_json stabilityJson(const geometry::Stability& stability);
 
-// The panels as parts for the planner: outline, holes (polygons of
-// kHoleSides sides around the circle, so the fastener still passes), labels
-// to etch, folds to score. The parts' order runs over the panels in
+// The panels as parts for the planner: outline, fastener holes (circles),
+// labels to etch, folds to score. The parts' order runs over the panels in
 // assembly order, each panel's pieces (geometry::PanelPiece) right after it
 // as parts of their own.
-constexpr int kHoleSides = 32;
 std::vector<Part> structureParts(const geometry::Structure& structure);
 
 // For each of structureParts()'s parts, in its order: its panel (index) and
@@ -63,6 +61,12 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
 // with the fasteners of each; totals at the end. Throws
 // std::invalid_argument naming the first key that is missing or wrong.
 std::string manifestText(const nlohmann::json& manifest);
+
+// manifest.json's text: a line for each member of the top level, and a line
+// for each sheet and each panel (people and grep read it a panel to a line;
+// indented, a large job's manifest was twice the bytes).
+template <class Json>
+std::string manifestJsonText(const Json& manifest);
 
 // The same as one HTML page, fit to print: the steps as a table, then each
 // sheet (its SVG file from `folder`, inlined) on a page of its own, with

@@ -47,6 +47,13 @@ Part compensateKerf(const Part& part, double kerf) {
       throw std::invalid_argument(fmt::format("{}: hole {} is narrower than the kerf ({} in)", part.name, h + 1, kerf));
     }
   }
+  for (size_t c = 0; c < part.circles.size(); ++c) {
+    cut.circles[c].radius -= kerf / 2;
+    if (!(cut.circles[c].radius > 0)) {
+      throw std::invalid_argument(
+          fmt::format("{}: hole {} is narrower than the kerf ({} in)", part.name, part.holes.size() + c + 1, kerf));
+    }
+  }
   return cut;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "jobs/Nesting.h"
+#include "jobs/SheetDrawing.h"
 
 namespace rotafab::jobs {
 
@@ -18,6 +19,7 @@ struct Part {
   int order = 0;                 // assembly order, 0-based
   Polygon2 outline;              // outer contour
   std::vector<Polygon2> holes;   // inner contours, cut before the outline
+  std::vector<Circle> circles;   // round holes (fasteners), cut with the holes
   std::vector<Polyline2> score;  // fold lines
   std::vector<Polyline2> etch;   // labels
   std::vector<double> rotations{0.0, 90.0, 180.0, 270.0};
@@ -30,8 +32,9 @@ Polygon2 offsetPolygon(const Polygon2& polygon, double distance);
 
 // Kerf compensation: the beam removes kerf/2 on each side of its path, so
 // the outer contour is cut kerf/2 outside the design and each hole kerf/2
-// inside it; strokes stay on their centre lines. Throws std::invalid_argument
-// naming the part when a hole is narrower than the kerf.
+// inside it (a circle's radius kerf/2 less); strokes stay on their centre
+// lines. Throws std::invalid_argument naming the part when a hole is
+// narrower than the kerf.
 Part compensateKerf(const Part& part, double kerf);
 
 }  // namespace rotafab::jobs

@@ -6,6 +6,7 @@
 #include <charconv>
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 namespace rotafab::jobs {
@@ -24,6 +25,11 @@ void checkDrawable(const SheetDrawing& sheet) {
     if (path.points.size() < 2)
       throw std::invalid_argument(fmt::format("sheet {}: path {} ({}) has {} point(s); a path needs at least 2",
                                               sheet.index, i + 1, name, path.points.size()));
+    if (path.circle && !(path.closed && path.circle->centre.allFinite() && std::isfinite(path.circle->radius) &&
+                         path.circle->radius > 0))
+      throw std::invalid_argument(
+          fmt::format("sheet {}: path {} ({}) is a circle of radius {}; it needs a positive one", sheet.index, i + 1,
+                      name, path.circle->radius));
     for (const Point2& p : path.points)
       if (!p.allFinite() || p.x() < -slack || p.y() < -slack || p.x() > sheet.width + slack ||
           p.y() > sheet.height + slack)
@@ -59,6 +65,21 @@ void appendDecimal(fmt::memory_buffer& out, double value, int decimals) {
     return;
   }
   out.append(digits, end);
+}
+
+std::vector<Point2> circlePolygon(const Circle& circle) {
+  const double outer = circle.radius / std::cos(std::numbers::pi / kCircleSides);
+  std::vector<Point2> polygon;
+  polygon.reserve(kCircleSides);
+  for (int i = 0; i < kCircleSides; ++i) {
+    const double a = 2 * std::numbers::pi * i / kCircleSides;
+    polygon.push_back(circle.centre + outer * Point2(std::cos(a), std::sin(a)));
+  }
+  return polygon;
+}
+
+DrawnPath circlePath(Operation operation, const Circle& circle, std::string part) {
+  return {operation, circlePolygon(circle), true, std::move(part), circle};
 }
 
 std::string formatDecimal(double value, int decimals) {

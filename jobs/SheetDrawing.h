@@ -8,12 +8,15 @@
 
 #include <fmt/format.h>
 #include <Eigen/Core>
+#include <cstdint>
 #include <map>
+#include <optional>
 
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "core/Decimal.h"
 #include "profiles/Operation.h"
 
 namespace rotafab::jobs {
@@ -31,12 +34,31 @@ using profiles::Rgb;
 constexpr int kSheetDecimals = 4;
 constexpr double kSheetSimplification = 0.0002 - 0.00005 * 1.41421356237 - 1e-6;
 
+// A round hole as the files give it: one true circle (SVG arcs, PostScript's
+// arc, a DXF CIRCLE) rather than the dozens of corners of its polygon, which
+// were half the bytes of a sheet of panels.
+struct Circle {
+  Point2 centre = Point2::Zero();
+  double radius = 0;
+};
+
+// The polygon a toolpath follows around a circle: kCircleSides sides that
+// touch it, so that a fastener of the circle's diameter still passes.
+constexpr int kCircleSides = 32;
+std::vector<Point2> circlePolygon(const Circle& circle);
+
 struct DrawnPath {
   Operation operation = Operation::Cut;
   std::vector<Point2> points;  // at least 2
   bool closed = false;         // the last point joins the first (not repeated)
   std::string part = {};       // the part it belongs to, as an id ("panel-17"); empty: the bed's
+  // A closed path that is this circle: the files write the circle, and
+  // `points` is its circlePolygon().
+  std::optional<Circle> circle = {};
 };
+
+// The drawn path of a circle: its polygon, closed, with the circle kept.
+DrawnPath circlePath(Operation operation, const Circle& circle, std::string part = {});
 
 struct SheetDrawing {
   int index = 1;        // 1-based sheet number
@@ -59,6 +81,11 @@ void checkDrawable(const SheetDrawing& sheet);
 std::string formatDecimal(double value, int decimals);
 // The same, appended to `out` without a string of its own (the writers' inner loops).
 void appendDecimal(fmt::memory_buffer& out, double value, int decimals);
+
+// The writers give a path's points after its first as moves in whole units
+// (core/Decimal.h), so that the moves add up exactly to the rounded points.
+using core::appendUnits;
+using core::unitsOf;
 
 // Text for a one-line header field: printable ASCII only ('?' for anything
 // else), at most 200 characters.

@@ -116,8 +116,14 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
         add(stage, stage == Operation::Etch ? cut[placed.part].etch : cut[placed.part].score, placed, false);
       }
     }
-    for (const PlannedPart& placed : plan.parts)
-      if (placed.sheet == s) add(Operation::Cut, cut[placed.part].holes, placed, true);
+    for (const PlannedPart& placed : plan.parts) {
+      if (placed.sheet != s) continue;
+      add(Operation::Cut, cut[placed.part].holes, placed, true);
+      for (const Circle& circle : cut[placed.part].circles) {
+        sheet.paths.push_back(circlePath(Operation::Cut, {onSheet(placed, circle.centre), circle.radius},
+                                         partId(parts[placed.part].name)));
+      }
+    }
     for (const PlannedPart& placed : plan.parts)
       if (placed.sheet == s) add(Operation::Cut, {cut[placed.part].outline}, placed, true);
     plan.sheets.push_back(std::move(sheet));

@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <optional>
 #include <regex>
@@ -21,6 +23,85 @@ bool number(std::string_view text, size_t& at, double& value) {
 }
 
 bool contains(const std::string& line, std::string_view tag) { return line.find(tag) != std::string::npos; }
+
+// The path data rotafab writes: "M x y", then absolute "L x y" or relative
+// "l dx dy" pairs (a command's letter may be left out before its next pair),
+// and "Z" to close; or a circle, "M x y" at its rightmost point and two half
+// arcs "a r r 0 1 0 -2r 0 a r r 0 1 0 2r 0 Z". Sheet y is up, the SVG's down.
+template <class Fail>
+DrawnPath pathOf(std::string_view d, double height, const Fail& fail) {
+  DrawnPath path;
+  size_t at = 0;
+  const auto skipSpaces = [&] {
+    while (at < d.size() && (d[at] == ' ' || d[at] == ',')) ++at;
+  };
+  const auto pair = [&](double& x, double& y) {
+    if (!number(d, at, x) || !number(d, at, y)) throw fail(at, "no coordinate pair");
+  };
+  const auto startsNumber = [&] {
+    skipSpaces();
+    return at < d.size() && (d[at] == '-' || d[at] == '+' || d[at] == '.' || (d[at] >= '0' && d[at] <= '9'));
+  };
+  double x = 0, y = 0;
+  char command = 0;
+  while (true) {
+    skipSpaces();
+    if (at >= d.size()) break;
+    if (!startsNumber()) {
+      command = d[at];
+      const bool allowed = path.closed                                          ? false
+                           : command == 'M'                                     ? path.points.empty()
+                           : command == 'L' || command == 'l' || command == 'Z' ? !path.points.empty()
+                           : command == 'a'                                     ? path.points.size() == 1
+                                                                                : false;
+      if (!allowed)
+        throw fail(at, fmt::format("'{}' (rotafab writes M, then L or l, then Z; or a circle's M a a Z)", d[at]));
+      ++at;
+      if (command == 'Z') {
+        if (path.points.size() < 2) throw fail(at - 1, "Z after fewer than 2 points");
+        path.closed = true;
+      }
+      if (command != 'a') continue;
+      // A circle: both half arcs at once.
+      double r[2][2], flags[2][3], across[2][2];
+      for (int half = 0; half < 2; ++half) {
+        if (half == 1) {
+          skipSpaces();
+          if (at >= d.size() || d[at] != 'a') throw fail(at, "a circle's second half arc missing");
+          ++at;
+        }
+        pair(r[half][0], r[half][1]);
+        for (double& flag : flags[half])
+          if (!number(d, at, flag)) throw fail(at, "no arc flags");
+        pair(across[half][0], across[half][1]);
+      }
+      const double radius = r[0][0];
+      const auto near = [&](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); };
+      if (!(radius > 0 && near(r[0][1], radius) && near(r[1][0], radius) && near(r[1][1], radius) &&
+            near(across[0][0], -2 * radius) && near(across[1][0], 2 * radius) && across[0][1] == 0 &&
+            across[1][1] == 0 && flags[0][0] == 0 && flags[1][0] == 0))
+        throw fail(at, "arcs that are not a circle's two halves (rotafab writes circles only)");
+      skipSpaces();
+      if (at >= d.size() || d[at] != 'Z') throw fail(at, "a circle not closed by Z");
+      ++at;
+      path = circlePath(path.operation, Circle{{x - radius, height - y}, radius});
+      skipSpaces();
+      if (at < d.size()) throw fail(at, "more after a circle");
+      break;
+    }
+    if (command != 'M' && command != 'L' && command != 'l') throw fail(at, "a number without a command");
+    double px = 0, py = 0;
+    pair(px, py);
+    if (command == 'l') {
+      x += px, y += py;
+    } else {
+      x = px, y = py;
+    }
+    path.points.emplace_back(x, height - y);
+    if (command == 'M') command = 'L';  // SVG: pairs after M's first are lines
+  }
+  return path;
+}
 
 }  // namespace
 
@@ -54,28 +135,10 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
       if (!sized) throw fail(lineNumber, "a path before the <svg> element's viewBox");
       const std::string_view d =
           std::string_view(line).substr(pathStart.size(), line.size() - pathStart.size() - pathEnd.size());
-      DrawnPath path{group, {}, false};
-      size_t at = 0;
-      while (at < d.size()) {
-        const char command = d[at];
-        if (command == ' ') {
-          ++at;
-        } else if (command == 'Z' && path.points.size() >= 2 && !path.closed) {
-          path.closed = true;
-          ++at;
-        } else if (!path.closed &&
-                   ((command == 'M' && path.points.empty()) || (command == 'L' && !path.points.empty()))) {
-          ++at;
-          double x = 0, y = 0;
-          if (!number(d, at, x) || !number(d, at, y)) {
-            throw fail(lineNumber, fmt::format("path data: no coordinate pair at character {}", at + 1));
-          }
-          path.points.emplace_back(x, sheet.height - y);
-        } else {
-          throw fail(lineNumber, fmt::format("path data: '{}' at character {} (rotafab writes M, then L, then Z)",
-                                             command, at + 1));
-        }
-      }
+      DrawnPath path = pathOf(d, sheet.height, [&](size_t at, const std::string& what) {
+        return fail(lineNumber, fmt::format("path data: {} at character {}", what, at + 1));
+      });
+      path.operation = group;
       if (path.points.size() < 2) throw fail(lineNumber, "a path of fewer than 2 points");
       sheet.paths.push_back(std::move(path));
       // (Each regular expression only where its tag is: most lines are none of these.)

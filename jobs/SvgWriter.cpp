@@ -13,6 +13,9 @@ namespace {
 
 constexpr int kDecimals = kSheetDecimals;
 constexpr double kHairlineInches = 0.001;
+// The preview is for people's eyes: a thousandth of an inch is far finer
+// than a screen or a print shows.
+constexpr int kPreviewDecimals = 3;
 
 }  // namespace
 
@@ -78,13 +81,43 @@ std::vector<Operation> operationsOf(const SheetDrawing& sheet) {
   return order;
 }
 
-void appendPath(fmt::memory_buffer& buffer, const SheetDrawing& sheet, const DrawnPath& path, std::string_view extra) {
-  const auto to = std::back_inserter(buffer);
-  fmt::format_to(to, "<path d=\"");
-  for (size_t i = 0; i < path.points.size(); ++i)
-    fmt::format_to(to, "{}{} {}", i == 0 ? "M" : " L", formatDecimal(path.points[i].x(), kDecimals),
-                   formatDecimal(sheet.height - path.points[i].y(), kDecimals));
-  fmt::format_to(to, "{}\"{}/>\n", path.closed ? " Z" : "", extra);
+// A number of the path data: after a command letter or before a minus sign
+// no space is needed (SVG's path grammar), elsewhere one.
+void appendCoordinate(fmt::memory_buffer& buffer, int64_t units, int decimals, bool afterCommand) {
+  if (!afterCommand && units >= 0) buffer.push_back(' ');
+  appendUnits(buffer, units, decimals);
+}
+
+// The first point absolute (M), then relative moves (l) in whole units, so
+// that they add up exactly to the rounded points; a circle as two half arcs
+// from its rightmost point.
+void appendPath(fmt::memory_buffer& buffer, double height, const DrawnPath& path, int decimals) {
+  buffer.append(std::string_view("<path d=\"M"));
+  if (path.circle) {
+    const int64_t r = unitsOf(path.circle->radius, decimals);
+    const int64_t x = unitsOf(path.circle->centre.x(), decimals) + r;
+    appendCoordinate(buffer, x, decimals, true);
+    appendCoordinate(buffer, unitsOf(height - path.circle->centre.y(), decimals), decimals, false);
+    for (const int64_t across : {-2 * r, 2 * r}) {
+      buffer.push_back('a');
+      appendCoordinate(buffer, r, decimals, true);
+      appendCoordinate(buffer, r, decimals, false);
+      buffer.append(std::string_view(" 0 1 0"));
+      appendCoordinate(buffer, across, decimals, false);
+      buffer.append(std::string_view(" 0"));
+    }
+    buffer.append(std::string_view("Z\"/>\n"));
+    return;
+  }
+  int64_t x = 0, y = 0;
+  for (size_t i = 0; i < path.points.size(); ++i) {
+    const int64_t px = unitsOf(path.points[i].x(), decimals), py = unitsOf(height - path.points[i].y(), decimals);
+    if (i == 1) buffer.push_back('l');
+    appendCoordinate(buffer, px - x, decimals, i <= 1);
+    appendCoordinate(buffer, py - y, decimals, false);
+    x = px, y = py;
+  }
+  buffer.append(path.closed ? std::string_view("Z\"/>\n") : std::string_view("\"/>\n"));
 }
 
 }  // namespace
@@ -121,7 +154,7 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
       if (!part.empty()) {
         fmt::format_to(to, "<g id=\"{}{}\">\n", xmlText(part), operation == Operation::Cut ? "" : "-" + name);
       }
-      for (const DrawnPath* path : paths) appendPath(buffer, sheet, *path, "");
+      for (const DrawnPath* path : paths) appendPath(buffer, sheet.height, *path, kDecimals);
       if (!part.empty()) fmt::format_to(to, "</g>\n");
     }
     fmt::format_to(to, "</g>\n");
@@ -164,7 +197,7 @@ void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out) {
                    profiles::operationName(look.operation), look.style);
     for (const auto& [part, paths] : partsOf(sheet, look.operation)) {
       fmt::format_to(to, "<g class=\"{}\">\n", xmlText(part));
-      for (const DrawnPath* path : paths) appendPath(buffer, sheet, *path, "");
+      for (const DrawnPath* path : paths) appendPath(buffer, sheet.height, *path, kPreviewDecimals);
       fmt::format_to(to, "</g>\n");
     }
     fmt::format_to(to, "</g>\n");

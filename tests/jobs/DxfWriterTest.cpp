@@ -34,8 +34,8 @@ std::optional<Operation> operationOfLayer(const std::string& layer) {
 }
 
 // A reader for the R12 subset the writer uses: group code / value line
-// pairs; HEADER variables; LAYER table entries; LINE and POLYLINE-VERTEX-
-// SEQEND entities.
+// pairs; HEADER variables; LAYER table entries; LINE, CIRCLE and
+// POLYLINE-VERTEX-SEQEND entities.
 DxfContent readDxf(const std::string& text) {
   std::vector<std::pair<int, std::string>> groups;
   std::istringstream in(text);
@@ -82,6 +82,10 @@ DxfContent readDxf(const std::string& text) {
             {operation.value_or(Operation::Cut),
              {{std::stod(field(10)), std::stod(field(20))}, {std::stod(field(11)), std::stod(field(21))}},
              false});
+      } else if (value == "CIRCLE") {
+        ReadPath path{operation.value_or(Operation::Cut), {}, true};
+        path.circle = Circle{{std::stod(field(10)), std::stod(field(20))}, std::stod(field(40))};
+        content.paths.push_back(path);
       } else if (value == "POLYLINE") {
         EXPECT_EQ(field(66), "1");
         ReadPath path{operation.value_or(Operation::Cut), {}, (std::stoi(field(70)) & 1) != 0};
@@ -187,8 +191,11 @@ for e in doc.modelspace():
     elif kind == "POLYLINE":
         points, closed = [list(v.dxf.location)[:2] for v in e.vertices], bool(e.is_closed)
     else:
-        points, closed = [], False
-    out["entities"].append({"type": kind, "layer": e.dxf.layer, "closed": closed, "points": points})
+        points, closed = [], kind == "CIRCLE"
+    entity = {"type": kind, "layer": e.dxf.layer, "closed": closed, "points": points}
+    if kind == "CIRCLE":
+        entity["centre"], entity["radius"] = list(e.dxf.center)[:2], e.dxf.radius
+    out["entities"].append(entity)
 print(json.dumps(out))
 )py");
   // Debian's python3-ezdxf installs for Debian's own interpreter.
@@ -206,6 +213,8 @@ print(json.dumps(out))
     ASSERT_TRUE(operation) << entity.dump();
     ReadPath path{*operation, {}, entity["closed"]};
     for (const auto& p : entity["points"]) path.points.emplace_back(p[0].get<double>(), p[1].get<double>());
+    if (entity["type"] == "CIRCLE")
+      path.circle = Circle{{entity["centre"][0].get<double>(), entity["centre"][1].get<double>()}, entity["radius"]};
     paths.push_back(path);
   }
   expectSamePaths(sheet, paths);

@@ -181,7 +181,23 @@ TEST(EpsWriter, CoordinatesHaveAThousandthOfAPoint) {
   SheetDrawing sheet = sampleSheet();
   sheet.paths = {{Operation::Cut, {{1.0000001, 2.00001}, {3.123456, 4.5}}, false}};
   const std::string eps = epsOf(sheet);
-  EXPECT_NE(eps.find("\n72 144.001 m 224.889 324 l s\n"), std::string::npos) << eps;
+  // The first point, then the move to the next in whole thousandths, which
+  // add up to its rounded position (224.889 324).
+  EXPECT_NE(eps.find("\n72 144.001 m 152.889 179.999 r s\n"), std::string::npos) << eps;
+}
+
+TEST(EpsWriter, CirclesAreArcs) {
+  SheetDrawing sheet = sampleSheet();
+  sheet.paths = {circlePath(Operation::Cut, {{1, 2}, 0.0625})};
+  const std::string eps = epsOf(sheet);
+  EXPECT_NE(eps.find("\n72 144 4.5 o\n"), std::string::npos) << eps;
+  TempDir dir;
+  const Box painted = ghostscriptBoundingBox(dir.write("circle.eps", eps));
+  // Ghostscript's box of the painted ink, to the point: the circle's, 9 pt across.
+  EXPECT_NEAR(painted.x0, 67.5, 1.0);
+  EXPECT_NEAR(painted.x1, 76.5, 1.0);
+  EXPECT_NEAR(painted.y0, 139.5, 1.0);
+  EXPECT_NEAR(painted.y1, 148.5, 1.0);
 }
 
 }  // namespace

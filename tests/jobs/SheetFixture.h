@@ -63,6 +63,7 @@ inline SheetDrawing sampleSheet() {
     const double angle = 2 * std::numbers::pi * k / 5 + 0.1;
     pentagon.points.emplace_back(5.123456789 + (2 - 0.1 * k) * std::cos(angle), 5.0 + (2 - 0.1 * k) * std::sin(angle));
   }
+  sheet.paths.push_back(circlePath(Operation::Cut, {{5.2345678, 5.0}, 0.0625}));  // a fastener hole in it
   sheet.paths.push_back(pentagon);
   sheet.paths.push_back(
       {Operation::Cut, {{10.1234567, 2.5}, {13.6543219, 2.5}, {13.6543219, 6.25}, {10.1234567, 6.25}}, true});
@@ -88,6 +89,7 @@ struct ReadPath {
   Operation operation = Operation::Cut;
   std::vector<Point2> points;
   bool closed = false;
+  std::optional<Circle> circle = {};  // a circle, written as one: no points read
 };
 
 // The files give coordinates to kSheetDecimals (0.0001 in): each read back
@@ -107,6 +109,12 @@ inline void expectSamePaths(const SheetDrawing& sheet, const std::vector<ReadPat
     ASSERT_EQ(back.size(), drawn.size());
     for (size_t i = 0; i < drawn.size(); ++i) {
       EXPECT_EQ(back[i]->closed, drawn[i]->closed) << "path " << i;
+      ASSERT_EQ(back[i]->circle.has_value(), drawn[i]->circle.has_value()) << "path " << i;
+      if (drawn[i]->circle) {
+        EXPECT_LE((back[i]->circle->centre - drawn[i]->circle->centre).norm(), tolerance) << "path " << i;
+        EXPECT_LE(std::abs(back[i]->circle->radius - drawn[i]->circle->radius), tolerance) << "path " << i;
+        continue;
+      }
       ASSERT_EQ(back[i]->points.size(), drawn[i]->points.size()) << "path " << i;
       for (size_t k = 0; k < drawn[i]->points.size(); ++k)
         EXPECT_LE((back[i]->points[k] - drawn[i]->points[k]).norm(), tolerance)

@@ -37,7 +37,8 @@ struct SvgContent {
 };
 
 // A reader for the subset of SVG the writer uses: <g> elements directly in
-// <svg>, each holding <path d> elements of absolute M, L and Z commands.
+// <svg>, each holding <path d> elements of M, then absolute L or relative l
+// pairs, and Z; or circles of two arcs.
 SvgContent readSvg(const std::string& svg) {
   SvgContent content;
   std::smatch match;
@@ -68,28 +69,58 @@ SvgContent readSvg(const std::string& svg) {
       const auto d = attributesOf((*p)[1])["d"];
       ReadPath read;
       read.operation = *operation;
-      // Command letters may touch their numbers ("M1 2L3 4"), as SVG allows.
-      const std::regex token(R"([MLZ]|[-+]?[0-9.]+(?:[eE][-+]?[0-9]+)?|\S)");
+      // Command letters may touch their numbers ("M1 2l3-4"), as SVG allows,
+      // and a command's letter may be left out before its next numbers.
+      const std::regex token(R"([MLlaZ]|[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?|\S)");
       std::vector<std::string> tokens;
       for (auto t = std::sregex_iterator(d.begin(), d.end(), token); t != std::sregex_iterator(); ++t)
         tokens.push_back((*t)[0]);
+      const auto isNumber = [](const std::string& t) { return std::isdigit(static_cast<unsigned char>(t.back())); };
       char command = 0;
+      double x = 0, y = 0;
       for (size_t t = 0; t < tokens.size(); ++t) {
-        if (tokens[t] == "M" || tokens[t] == "L" || tokens[t] == "Z") {
+        if (!isNumber(tokens[t])) {
           command = tokens[t][0];
           if (command == 'M') {
             EXPECT_TRUE(read.points.empty()) << "a second M in one path: " << d;
           }
           if (command == 'Z') read.closed = true;
+          if (command == 'a') {
+            // A circle: two half arcs from its rightmost point, back to it.
+            std::vector<double> numbers;
+            for (size_t k = t; k < tokens.size() && numbers.size() < 14; ++k)
+              if (isNumber(tokens[k])) numbers.push_back(std::stod(tokens[k]));
+            if (numbers.size() != 14u) {
+              ADD_FAILURE() << "a circle of " << numbers.size() << " numbers: " << d;
+              break;
+            }
+            const double r = numbers[0];
+            EXPECT_EQ(std::vector<double>(numbers.begin(), numbers.begin() + 7),
+                      (std::vector<double>{r, r, 0, 1, 0, -2 * r, 0}))
+                << d;
+            EXPECT_EQ(std::vector<double>(numbers.begin() + 7, numbers.end()),
+                      (std::vector<double>{r, r, 0, 1, 0, 2 * r, 0}))
+                << d;
+            EXPECT_EQ(tokens.back(), "Z") << d;
+            read.circle = Circle{{x - r, viewHeight - y}, r};
+            read.points.clear();
+            read.closed = true;
+            break;
+          }
           continue;
         }
-        if (!(command == 'M' || command == 'L') || read.closed || t + 1 >= tokens.size() ||
-            !std::isdigit(static_cast<unsigned char>(tokens[t].back())) ||
-            !std::isdigit(static_cast<unsigned char>(tokens[t + 1].back()))) {
+        if (!(command == 'M' || command == 'L' || command == 'l') || read.closed || t + 1 >= tokens.size() ||
+            !isNumber(tokens[t + 1])) {
           ADD_FAILURE() << "unexpected \"" << tokens[t] << "\" in " << d;
           break;
         }
-        read.points.emplace_back(std::stod(tokens[t]), viewHeight - std::stod(tokens[t + 1]));
+        const double a = std::stod(tokens[t]), b = std::stod(tokens[t + 1]);
+        if (command == 'l') {
+          x += a, y += b;
+        } else {
+          x = a, y = b;
+        }
+        read.points.emplace_back(x, viewHeight - y);
         ++t;
       }
       content.paths.push_back(read);
@@ -268,7 +299,11 @@ TEST(SvgWriter, EachPartIsAGroupAndTheBedALayerOfItsOwn) {
   ASSERT_TRUE(std::regex_search(result.out, box, std::regex(R"(panel-17,([-0-9.]+),([-0-9.]+),([-0-9.]+),([-0-9.]+))")))
       << result.out;
   Box pentagon{1e9, 1e9, -1e9, -1e9};
-  for (const Point2& p : sheet.paths[0].points) {
+  const auto pentagonPath = std::find_if(sheet.paths.begin(), sheet.paths.end(), [](const DrawnPath& p) {
+    return p.operation == Operation::Cut && p.points.size() == 5;
+  });
+  ASSERT_NE(pentagonPath, sheet.paths.end());
+  for (const Point2& p : pentagonPath->points) {
     pentagon.x0 = std::min(pentagon.x0, p.x()), pentagon.x1 = std::max(pentagon.x1, p.x());
   }
   EXPECT_NEAR(std::stod(box[1]) / 96, pentagon.x0, 0.002);
@@ -312,6 +347,43 @@ TEST(SvgWriter, ThePreviewShowsTheSheetToPeople) {
   int count = 0;
   pixelBox(image, Rgb{0x1f, 0x3a, 0x93}, 36, sheet.height + 0.8, &count);
   EXPECT_GT(count, 100) << "the cuts drawn wide enough to see at 36 dpi";
+}
+
+// `rotafab run` and the daemon cut from the SVG: its circles come back as
+// circles (and the polygon a toolpath follows), its moves as the points.
+TEST(SheetReader, CirclesAndMovesReadBack) {
+  TempDir dir;
+  const SheetDrawing sheet = sampleSheet();
+  const SheetDrawing read = readSheetSvg(dir.write("sheet.svg", svgOf(sheet)));
+  ASSERT_EQ(read.paths.size(), sheet.paths.size());
+  std::vector<ReadPath> paths;
+  for (const DrawnPath& path : read.paths) paths.push_back({path.operation, path.points, path.closed, path.circle});
+  expectSamePaths(sheet, paths);
+  const auto circle = std::find_if(read.paths.begin(), read.paths.end(), [](const DrawnPath& p) { return p.circle; });
+  ASSERT_NE(circle, read.paths.end());
+  EXPECT_EQ(circle->points.size(), static_cast<size_t>(kCircleSides));
+  for (const Point2& p : circle->points) EXPECT_GE((p - circle->circle->centre).norm(), circle->circle->radius - 1e-12);
+}
+
+// Sheets written before the moves (absolute L) are still in queues.
+TEST(SheetReader, ReadsAbsoluteLines) {
+  TempDir dir;
+  const std::string head =
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"32in\" height=\"18in\" viewBox=\"0 0 32 18\">\n"
+      "<desc>rotafab sheet 1 of 1; units: inches; bed 32 x 18 in, margin 0.25 in</desc>\n"
+      "<g id=\"cut\" fill=\"none\" stroke=\"#0000ff\">\n";
+  const SheetDrawing read = readSheetSvg(dir.write("old.svg", head + "<path d=\"M1 2 L3 4 L5 2 Z\"/>\n</g>\n</svg>\n"));
+  ASSERT_EQ(read.paths.size(), 1u);
+  EXPECT_TRUE(read.paths[0].closed);
+  EXPECT_EQ(read.paths[0].points, (std::vector<Point2>{{1, 16}, {3, 14}, {5, 16}}));
+  // Arcs that are not a circle's two halves are not rotafab's.
+  try {
+    readSheetSvg(dir.write("arc.svg", head + "<path d=\"M1 2a1 2 0 1 0-2 0a1 2 0 1 0 2 0Z\"/>\n</g>\n</svg>\n"));
+    ADD_FAILURE() << "an ellipse read as a circle";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_NE(std::string(error.what()).find("arc.svg:4: path data: arcs that are not a circle"), std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace
