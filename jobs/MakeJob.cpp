@@ -436,6 +436,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
         name, request.window, job.sheets.windowSheets, job.sheets.sheets.size()));
   }
   job.cost = jobCost(job, request, context);
+  job.seconds.estimate = lap();
   return job;
 }
 
@@ -469,12 +470,16 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
 
 nlohmann::ordered_json summaryJson(const PlannedJob& job) {
   const PhaseSeconds& s = job.seconds;
-  nlohmann::ordered_json summary = {
-      {"panels", job.structure.panels.size()},
-      {"sheets", job.sheets.sheets.size()},
-      {"fasteners", job.structure.fasteners},
-      {"utilization", job.sheets.utilization},
-      {"seconds", {{"import", s.import}, {"geometry", s.geometry}, {"nesting", s.nesting}, {"writing", s.writing}}}};
+  nlohmann::ordered_json summary = {{"panels", job.structure.panels.size()},
+                                    {"sheets", job.sheets.sheets.size()},
+                                    {"fasteners", job.structure.fasteners},
+                                    {"utilization", job.sheets.utilization},
+                                    {"seconds",
+                                     {{"import", s.import},
+                                      {"geometry", s.geometry},
+                                      {"nesting", s.nesting},
+                                      {"estimate", s.estimate},
+                                      {"writing", s.writing}}}};
   if (job.mesh.simplified) summary["simplified"] = simplifiedJson(*job.mesh.simplified);
   summary["size"] = {job.size.x(), job.size.y(), job.size.z()};
   summary["stability"] = stabilityJson(job.stability);

@@ -64,6 +64,7 @@ struct MakeRequest {
 
 struct PhaseSeconds {
   double import = 0, geometry = 0, nesting = 0, writing = 0;
+  double estimate = 0;  // the cutting time's, sheet by sheet (jobCost), between nesting and writing
 };
 
 struct PlannedJob {
@@ -106,7 +107,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
 // SPEC's summary of a written job (`make --json`): {"panels", "sheets",
-// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "writing"}}, and
+// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "estimate", "writing"}}, and
 // "simplified": {"asked", "faces"} when a panel count was asked, "size": [X, Y, Z] (the
 // structure's box, inches), and "stability" (stabilityJson()).
 nlohmann::ordered_json summaryJson(const PlannedJob& job);

@@ -79,19 +79,57 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
     }
     boxes.push_back(box);
   }
+  // A grid of the boxes, so that each step looks at the paths near the head
+  // rather than at every path left: cells about two paths' spacing wide,
+  // searched in rings outwards until no nearer path can be further out.
+  std::array<double, 4> all = boxes.empty() ? std::array<double, 4>{0, 0, 0, 0} : boxes[0];
+  for (const auto& b : boxes) {
+    all[0] = std::min(all[0], b[0]), all[1] = std::min(all[1], b[1]);
+    all[2] = std::max(all[2], b[2]), all[3] = std::max(all[3], b[3]);
+  }
+  const double spanX = all[2] - all[0], spanY = all[3] - all[1];
+  const double cell = std::max({2 * std::sqrt(spanX * spanY / static_cast<double>(std::max<size_t>(n, 1))),
+                                std::max(spanX, spanY) / 1024, 1e-6});
+  const int columns = static_cast<int>(spanX / cell) + 1, rows = static_cast<int>(spanY / cell) + 1;
+  const auto column = [&](double x) { return std::clamp(static_cast<int>((x - all[0]) / cell), 0, columns - 1); };
+  const auto row = [&](double y) { return std::clamp(static_cast<int>((y - all[1]) / cell), 0, rows - 1); };
+  std::vector<std::vector<size_t>> cells(static_cast<size_t>(columns) * static_cast<size_t>(rows));
+  for (size_t i = 0; i < n; ++i)
+    for (int y = row(boxes[i][1]); y <= row(boxes[i][3]); ++y)
+      for (int x = column(boxes[i][0]); x <= column(boxes[i][2]); ++x)
+        cells[static_cast<size_t>(y) * static_cast<size_t>(columns) + static_cast<size_t>(x)].push_back(i);
   Point2 at = from;
   for (size_t step = 0; step < n; ++step) {
     size_t best = n;
     double bestDistance = std::numeric_limits<double>::max();
-    for (size_t i = 0; i < n; ++i) {
-      if (done[i]) continue;
+    const auto consider = [&](size_t i) {
       const auto& b = boxes[i];
       const double dx = std::max({b[0] - at.x(), 0.0, at.x() - b[2]}),
                    dy = std::max({b[1] - at.y(), 0.0, at.y() - b[3]});
-      if (dx * dx + dy * dy >= bestDistance) continue;
+      const double boxDistance = dx * dx + dy * dy;
+      if (boxDistance > bestDistance || (boxDistance == bestDistance && i > best)) return;
       const size_t e = nearestEntry(candidates[i], at);
       const double d = (candidates[i].points[e] - at).squaredNorm();
-      if (d < bestDistance) bestDistance = d, best = i, entry[i] = e;
+      // (Ties to the lowest index, the order the paths were drawn in.)
+      if (d < bestDistance || (d == bestDistance && i < best)) bestDistance = d, best = i, entry[i] = e;
+    };
+    const int cx = column(at.x()), cy = row(at.y());
+    const int reach = std::max({cx, columns - 1 - cx, cy, rows - 1 - cy});
+    for (int ring = 0; ring <= reach; ++ring) {
+      for (int y = cy - ring; y <= cy + ring; ++y) {
+        if (y < 0 || y >= rows) continue;
+        const bool edge = y == cy - ring || y == cy + ring;
+        for (int x = cx - ring; x <= cx + ring; x += edge ? 1 : 2 * std::max(ring, 1)) {
+          if (x < 0 || x >= columns) continue;
+          auto& here = cells[static_cast<size_t>(y) * static_cast<size_t>(columns) + static_cast<size_t>(x)];
+          // Paths done leave their cells as they are met.
+          std::erase_if(here, [&](size_t i) { return done[i] != 0; });
+          for (size_t i : here) consider(i);
+        }
+      }
+      // Every cell of the next ring is at least `ring` cells from the head.
+      const double beyond = ring * cell;
+      if (best < n && beyond * beyond > bestDistance) break;
     }
     done[best] = 1;
     order.push_back(best);
@@ -105,8 +143,14 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   // has 1,500 label strokes, and every pair took seconds). Bounded in time
   // for very large sheets.
   constexpr size_t kTwoOptReach = 64;
-  const auto entryPoint = [&](size_t k) { return candidates[order[k]].points[entry[order[k]]]; };
-  const auto exitPoint = [&](size_t k) { return exitOf(candidates[order[k]], entry[order[k]]); };
+  // Where each stroke in the order is entered and left, kept in step with
+  // the order: a reversed run swaps each stroke's two (the same point for a
+  // closed stroke).
+  std::vector<Point2> in(n), leave(n);
+  for (size_t k = 0; k < n; ++k) {
+    in[k] = candidates[order[k]].points[entry[order[k]]];
+    leave[k] = exitOf(candidates[order[k]], entry[order[k]]);
+  }
   const auto started = std::chrono::steady_clock::now();
   // At most a few passes, so that the work per stroke is bounded.
   constexpr int kTwoOptPasses = 4;
@@ -115,15 +159,25 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
     improved = false;
     for (size_t i = 0; i + 1 < n; ++i) {
       if (std::chrono::steady_clock::now() - started > std::chrono::seconds(2)) break;
-      const Point2 before = i == 0 ? from : exitPoint(i - 1);
+      const Point2 before = i == 0 ? from : leave[i - 1];
       for (size_t j = i + 1; j < std::min(n, i + 1 + kTwoOptReach); ++j) {
         const bool last = j + 1 == n;
-        const double now = (entryPoint(i) - before).norm() + (last ? 0.0 : (entryPoint(j + 1) - exitPoint(j)).norm());
-        // Reversed, the run is entered where stroke j is left now, and left where stroke i is entered now.
-        const double then = (exitPoint(j) - before).norm() + (last ? 0.0 : (entryPoint(j + 1) - entryPoint(i)).norm());
+        // Reversed, the run is entered where stroke j is left now, and left
+        // where stroke i is entered now. It is shorter only if one of those
+        // two travels is shorter than the one it replaces: most pairs are
+        // passed over on squared lengths, without a square root.
+        const double intoNow = (in[i] - before).squaredNorm(), intoThen = (leave[j] - before).squaredNorm();
+        const double onNow = last ? 0.0 : (in[j + 1] - leave[j]).squaredNorm();
+        const double onThen = last ? 0.0 : (in[j + 1] - in[i]).squaredNorm();
+        if (intoThen >= intoNow && onThen >= onNow) continue;
+        const double now = std::sqrt(intoNow) + std::sqrt(onNow), then = std::sqrt(intoThen) + std::sqrt(onThen);
         if (then < now - 1e-9) {
-          std::reverse(order.begin() + static_cast<long>(i), order.begin() + static_cast<long>(j) + 1);
+          const auto first = static_cast<long>(i), end = static_cast<long>(j) + 1;
+          std::reverse(order.begin() + first, order.begin() + end);
+          std::reverse(in.begin() + first, in.begin() + end);
+          std::reverse(leave.begin() + first, leave.begin() + end);
           for (size_t k = i; k <= j; ++k) {
+            std::swap(in[k], leave[k]);
             const Candidate& c = candidates[order[k]];
             if (!c.closed) entry[order[k]] = entry[order[k]] == 0 ? c.points.size() - 1 : 0;
           }

@@ -516,7 +516,7 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   const auto summary = nlohmann::json::parse(ok.out);
   EXPECT_EQ(summary.at("panels"), 32);
   EXPECT_EQ(summary.at("fasteners"), 180);
-  for (const char* phase : {"import", "geometry", "nesting", "writing"})
+  for (const char* phase : {"import", "geometry", "nesting", "estimate", "writing"})
     EXPECT_TRUE(summary.at("seconds").contains(phase));
 
   const auto fails = [&](const std::string& args, int status, const std::string& says) {
