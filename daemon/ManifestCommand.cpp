@@ -15,7 +15,7 @@ namespace {
 
 int runManifest(const std::string& folder, const std::string& format) {
   try {
-    const nlohmann::json manifest = jobs::readManifest(folder);
+    const nlohmann::ordered_json manifest = jobs::readManifest(folder);
     if (format == "json") {
       std::cout << jobs::manifestJsonText(manifest);
       return kSuccess;

@@ -17,7 +17,7 @@ namespace {
 using SheetFiles = std::vector<std::pair<int, std::filesystem::path>>;  // (number, SVG file)
 
 // The SVG sheets an output folder's manifest lists.
-SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::json& manifest) {
+SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
   const auto manifestFile = folder / "manifest.json";
   SheetFiles sheets;
   try {
@@ -80,7 +80,7 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::op
   return readSheets(sheetFiles(target, only));
 }
 
-std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::json& manifest) {
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
   return readSheets(listedSheets(folder, manifest));
 }
 

@@ -23,7 +23,7 @@ struct JobSheet {
 // folder, the manifest or the sheet file and what is wrong.
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only);
 // All the sheets of an output folder whose manifest (readManifest) the caller has read already.
-std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::json& manifest);
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest);
 
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);

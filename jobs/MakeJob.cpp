@@ -446,18 +446,24 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   OutputFolder output(folder);
   job.files = writeSheets(job.sheets, job.formats, output.staging(), context);
   context.check();
-  writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
-    geometry::writeObj(
-        stream, geometry::surfaceMesh(job.structure),
-        fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
-                    job.meshFile.string(), job.structure.panels.size()),
-        geometry::panelGroups(job.structure), kSheetDecimals);
+  // structure.obj and the manifest, each on a core of its own.
+  context.parallelFor(2, [&](size_t task) {
+    if (task == 0) {
+      writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
+        geometry::writeObj(
+            stream, geometry::surfaceMesh(job.structure),
+            fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
+                        job.meshFile.string(), job.structure.panels.size()),
+            geometry::panelGroups(job.structure), kSheetDecimals);
+      });
+    } else {
+      job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
+      job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
+      job.manifest["stability"] = stabilityJson(job.stability);
+      job.manifest["cost"] = costJson(job.cost);
+    }
   });
-  job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
-  job.manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
-  job.manifest["stability"] = stabilityJson(job.stability);
-  job.manifest["cost"] = costJson(job.cost);
-  writeFileAtomically(output.staging() / "manifest.json", manifestJsonText(job.manifest));
+  writeFileAtomically(output.staging() / "manifest.json", manifestJsonText(job.manifest, context));
   writeFileAtomically(output.staging() / "manifest.txt", manifestText(job.manifest));
   context.check();
   // manifest.json last: until it moves in, the folder's manifest is the old job's.

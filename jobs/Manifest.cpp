@@ -224,8 +224,8 @@ struct Step {
 
 // The steps of a manifest read back: its panels in id order, as far as the
 // steps need them (joins, holes' edges, pieces).
-std::vector<Step> stepsOf(const nlohmann::json& manifest) {
-  std::map<int, const nlohmann::json*> byId;
+std::vector<Step> stepsOf(const nlohmann::ordered_json& manifest) {
+  std::map<int, const nlohmann::ordered_json*> byId;
   for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
   std::vector<geometry::Panel> panels;
   std::vector<Step> steps;
@@ -264,7 +264,7 @@ std::vector<Step> stepsOf(const nlohmann::json& manifest) {
       if (other < id && panel->contains("edges")) {
         edge = panel->at("edges").at(j).get<int>();
       } else if (other < id && byId.count(other)) {
-        const auto look = [&](const nlohmann::json& holes) {
+        const auto look = [&](const nlohmann::ordered_json& holes) {
           for (const auto& hole : holes) {
             const int e = hole.at("edge").get<int>();
             if (e != 0 && edgesHere.count(e)) edge = e;  // 0: a tab's fastener, no edge
@@ -326,7 +326,7 @@ std::string describeJoins(const Step& step) {
   return text;
 }
 
-std::string headline(const nlohmann::json& manifest) {
+std::string headline(const nlohmann::ordered_json& manifest) {
   const size_t sheets = manifest.at("sheets").size();
   const size_t panels = manifest.at("panels").size();
   const int fasteners = manifest.at("fasteners").get<int>();
@@ -338,7 +338,7 @@ std::string headline(const nlohmann::json& manifest) {
 // What the builders should know before they start, from the manifest's
 // optional keys: how the mesh was repaired and simplified, and whether the
 // structure will stand or must be hung. One sentence each.
-std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
+std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
   std::vector<std::string> notes;
   if (manifest.contains("cost"))
     notes.push_back(fmt::format("It takes {}.", costLine(costFromJson(manifest.at("cost")))));
@@ -363,7 +363,7 @@ std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
       notes.push_back(
           fmt::format("It stands: its centre of mass is {:.2f} in inside its footprint.{}", margin, weighs));
     } else {
-      const auto point = [](const nlohmann::json& p) {
+      const auto point = [](const nlohmann::ordered_json& p) {
         return fmt::format("({:.2f}, {:.2f}, {:.2f})", p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
       };
       const auto& hang = stability.at("hang_points");
@@ -382,7 +382,7 @@ std::vector<std::string> buildNotes(const nlohmann::json& manifest) {
 
 }  // namespace
 
-std::string manifestText(const nlohmann::json& manifest) {
+std::string manifestText(const nlohmann::ordered_json& manifest) {
   try {
     std::string text = fmt::format(
         "Assembly manifest: {}\n"
@@ -406,7 +406,7 @@ std::string manifestText(const nlohmann::json& manifest) {
   }
 }
 
-std::string manifestHtml(const nlohmann::json& manifest, const std::filesystem::path& folder) {
+std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder) {
   try {
     std::string html = fmt::format(R"(<!DOCTYPE html>
 <html lang="en">
@@ -470,8 +470,12 @@ the same number on the panel named; fasten them through their holes.</p>
   }
 }
 
-template <class Json>
-std::string manifestJsonText(const Json& manifest) {
+namespace {
+
+// manifestJsonText() with `linesOf(array, text)` giving an array's elements
+// a line each (after the first's "[").
+template <class Json, class Lines>
+std::string jsonTextWithLines(const Json& manifest, const Lines& linesOf) {
   if (!manifest.is_object()) return manifest.dump() + "\n";
   std::string text = "{";
   bool first = true;
@@ -482,10 +486,7 @@ std::string manifestJsonText(const Json& manifest) {
     text += ": ";
     if (value.is_array() && !value.empty() && (key == "sheets" || key == "panels")) {
       text += "[";
-      for (size_t i = 0; i < value.size(); ++i) {
-        text += i == 0 ? "\n  " : ",\n  ";
-        text += value[i].dump();
-      }
+      linesOf(value, text);
       text += "\n ]";
     } else {
       text += value.dump();
@@ -495,7 +496,34 @@ std::string manifestJsonText(const Json& manifest) {
   return text;
 }
 
+template <class Json>
+void appendLines(const Json& array, size_t from, size_t to, std::string& text) {
+  for (size_t i = from; i < to; ++i) {
+    text += i == 0 ? "\n  " : ",\n  ";
+    text += array[i].dump();
+  }
+}
+
+}  // namespace
+
+template <class Json>
+std::string manifestJsonText(const Json& manifest) {
+  return jsonTextWithLines(manifest,
+                           [](const Json& array, std::string& text) { appendLines(array, 0, array.size(), text); });
+}
+
 template std::string manifestJsonText(const nlohmann::json&);
 template std::string manifestJsonText(const nlohmann::ordered_json&);
+
+std::string manifestJsonText(const nlohmann::ordered_json& manifest, const core::WorkContext& context) {
+  return jsonTextWithLines(manifest, [&](const nlohmann::ordered_json& array, std::string& text) {
+    constexpr size_t kChunk = 2048;
+    std::vector<std::string> chunks((array.size() + kChunk - 1) / kChunk);
+    context.parallelFor(chunks.size(), [&](size_t c) {
+      appendLines(array, c * kChunk, std::min(array.size(), (c + 1) * kChunk), chunks[c]);
+    });
+    for (const std::string& chunk : chunks) text += chunk;
+  });
+}
 
 }  // namespace rotafab::jobs

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "core/WorkContext.h"
 #include "geometry/MeshRepair.h"
 #include "geometry/Simplification.h"
 #include "geometry/Stability.h"
@@ -60,18 +61,20 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
 // the panels already placed that it joins and the edge numbers to fasten
 // with the fasteners of each; totals at the end. Throws
 // std::invalid_argument naming the first key that is missing or wrong.
-std::string manifestText(const nlohmann::json& manifest);
+std::string manifestText(const nlohmann::ordered_json& manifest);
 
 // manifest.json's text: a line for each member of the top level, and a line
 // for each sheet and each panel (people and grep read it a panel to a line;
 // indented, a large job's manifest was twice the bytes).
 template <class Json>
 std::string manifestJsonText(const Json& manifest);
+// The same, its panels' lines shared out among the context's threads.
+std::string manifestJsonText(const nlohmann::ordered_json& manifest, const core::WorkContext& context);
 
 // The same as one HTML page, fit to print: the steps as a table, then each
 // sheet (its SVG file from `folder`, inlined) on a page of its own, with
 // the panels it holds in cutting order. Throws std::invalid_argument as
 // manifestText(), or naming a sheet's SVG file that cannot be read.
-std::string manifestHtml(const nlohmann::json& manifest, const std::filesystem::path& folder);
+std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder);
 
 }  // namespace rotafab::jobs

@@ -12,7 +12,7 @@
 
 namespace rotafab::jobs {
 
-nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
+nlohmann::ordered_json readManifest(const std::filesystem::path& folderOrFile) {
   std::filesystem::path file(folderOrFile);
   std::error_code error;
   const auto status = std::filesystem::status(file, error);
@@ -36,7 +36,7 @@ nlohmann::json readManifest(const std::filesystem::path& folderOrFile) {
   in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (!in) throw core::UserError(fmt::format("{}: cannot read it: {}", file.string(), std::strerror(errno)));
   try {
-    return nlohmann::json::parse(text);
+    return nlohmann::ordered_json::parse(text);
   } catch (const nlohmann::json::parse_error& error) {
     throw core::UserError(fmt::format("{}: not JSON: {}", file.string(), jsonErrorText(error)));
   }

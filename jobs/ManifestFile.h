@@ -10,6 +10,6 @@ namespace rotafab::jobs {
 // A manifest.json, or the one in an output folder. Throws core::UserError
 // naming the file or folder when there is none, it cannot be read or it is
 // not JSON.
-nlohmann::json readManifest(const std::filesystem::path& folderOrFile);
+nlohmann::ordered_json readManifest(const std::filesystem::path& folderOrFile);
 
 }  // namespace rotafab::jobs

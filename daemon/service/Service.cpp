@@ -467,7 +467,7 @@ struct Service::Impl {
   // A planned folder's plan: its sheets read and checked against the bed
   // they are to be cut on; the summary the queue shows, from its manifest.
   static json planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine) {
-    const json manifest = jobs::readManifest(folder);
+    const auto manifest = jobs::readManifest(folder);
     const auto planned = jobs::readJobSheets(folder, manifest);
     jobs::checkSheetsFitBed(planned, machine);
     json summary{{"sheets", static_cast<int>(planned.size())}};
