@@ -1,9 +1,7 @@
 #pragma once
 // Writes a polygon mesh as Wavefront OBJ (1-based `f` lines, polygons kept),
-// with the shortest decimal that reads back to each coordinate exactly, or
-// to a given number of decimals.
+// with the shortest decimal that reads back to each coordinate exactly.
 
-#include <optional>
 #include <ostream>
 #include <string>
 #include <string_view>
@@ -19,10 +17,8 @@ struct ObjGroup {
   std::string name;
 };
 
-// `groups` in the order of their first faces; faces before the first are in
-// none. With `decimals`, coordinates are rounded to that many (a structure
-// in inches needs no more than its sheets' 0.0001 in) instead of exact.
+// `groups` in the order of their first faces; faces before the first are in none.
 void writeObj(std::ostream& out, const PolygonMesh& mesh, std::string_view comment = {},
-              const std::vector<ObjGroup>& groups = {}, std::optional<int> decimals = std::nullopt);
+              const std::vector<ObjGroup>& groups = {});
 
 }  // namespace rotafab::geometry

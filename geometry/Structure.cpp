@@ -5,6 +5,8 @@
 #include <map>
 #include <unordered_map>
 
+#include "core/Decimal.h"
+
 namespace rotafab::geometry {
 
 std::string_view structureName(StructureKind kind) { return kind == StructureKind::Band ? "band" : "weave"; }
@@ -67,11 +69,31 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels) {
   return steps;
 }
 
-PolygonMesh surfaceMesh(const Structure& structure) {
-  PolygonMesh surface;
-  // A panel's polygons share the corners they have in common (the same
-  // point exactly), so that each panel is one connected surface; panels
-  // share none, being separate pieces of material.
+namespace {
+
+// The corners of a panel's polygons, each point once (the same point
+// exactly), so that each panel is one connected surface; panels share none,
+// being separate pieces of material. Kept from panel to panel for its
+// buckets.
+class PanelCorners {
+ public:
+  PolygonMesh surface(const Panel& panel) {
+    corners_.clear();
+    PolygonMesh surface;
+    for (const auto& polygon : panel.surface) {
+      std::vector<int> face;
+      face.reserve(polygon.size());
+      for (const Point3& p : polygon) {
+        const auto [at, added] = corners_.try_emplace(p, surface.vertexCount());
+        if (added) surface.positions.push_back(p);
+        face.push_back(at->second);
+      }
+      surface.faces.push_back(std::move(face));
+    }
+    return surface;
+  }
+
+ private:
   struct Hash {
     size_t operator()(const Point3& p) const {
       size_t h = 0;
@@ -82,31 +104,58 @@ PolygonMesh surfaceMesh(const Structure& structure) {
   struct Equal {
     bool operator()(const Point3& a, const Point3& b) const { return a == b; }
   };
-  std::unordered_map<Point3, int, Hash, Equal> corners;
+  std::unordered_map<Point3, int, Hash, Equal> corners_;
+};
+
+}  // namespace
+
+PolygonMesh surfaceMesh(const Structure& structure) {
+  PolygonMesh surface;
+  PanelCorners corners;
   for (const Panel& panel : structure.panels) {
-    corners.clear();
-    for (const auto& polygon : panel.surface) {
-      std::vector<int> face;
-      face.reserve(polygon.size());
-      for (const Point3& p : polygon) {
-        const auto [at, added] = corners.try_emplace(p, surface.vertexCount());
-        if (added) surface.positions.push_back(p);
-        face.push_back(at->second);
-      }
+    PolygonMesh here = corners.surface(panel);
+    const int offset = surface.vertexCount();
+    surface.positions.insert(surface.positions.end(), here.positions.begin(), here.positions.end());
+    for (auto& face : here.faces) {
+      for (int& v : face) v += offset;
       surface.faces.push_back(std::move(face));
     }
   }
   return surface;
 }
 
-std::vector<ObjGroup> panelGroups(const Structure& structure) {
-  std::vector<ObjGroup> groups;
-  int face = 0;
+void writeStructureObj(std::ostream& out, const Structure& structure, std::string_view comment, int decimals) {
+  fmt::memory_buffer buffer;
+  fmt::format_to(std::back_inserter(buffer), "# {}\n", comment);
+  size_t written = 0;  // vertices, before this panel's
+  PanelCorners corners;
   for (const Panel& panel : structure.panels) {
-    groups.push_back({face, fmt::format("panel-{}", panel.id)});
-    face += static_cast<int>(panel.surface.size());
+    const PolygonMesh surface = corners.surface(panel);
+    for (const Point3& p : surface.positions) {
+      buffer.push_back('v');
+      for (int axis = 0; axis < 3; ++axis) {
+        buffer.push_back(' ');
+        core::appendUnits(buffer, core::unitsOf(p[axis], decimals), decimals);
+      }
+      buffer.push_back('\n');
+    }
+    fmt::format_to(std::back_inserter(buffer), "g panel-{}\n", panel.id);
+    for (const auto& face : surface.faces) {
+      buffer.push_back('f');
+      for (int v : face) {
+        buffer.push_back(' ');
+        core::appendUnits(buffer, static_cast<int64_t>(written) + v + 1, 0);
+      }
+      buffer.push_back('\n');
+    }
+    written += surface.positions.size();
+    // A few megabytes at a time: a large structure's text is never held whole.
+    if (buffer.size() >= (size_t{4} << 20)) {
+      out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      buffer.clear();
+    }
   }
-  return groups;
+  out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
 }
 
 }  // namespace rotafab::geometry

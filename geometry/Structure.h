@@ -123,11 +123,13 @@ struct Structure {
 // and a band's half cut off either panel goes on with the join of its edge.
 std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
 
-// The panels' 3D surfaces as one mesh, polygon by polygon.
+// The panels' 3D surfaces as one mesh, polygon by polygon, each panel's
+// polygons sharing their common corners (panels share none).
 PolygonMesh surfaceMesh(const Structure& structure);
 
-// Where each panel's polygons start in surfaceMesh, named "panel-17": a
-// group per panel in structure.obj, to find a panel in any 3D viewer.
-std::vector<ObjGroup> panelGroups(const Structure& structure);
+// structure.obj: surfaceMesh() as Wavefront OBJ, a group "g panel-17" per
+// panel, coordinates to `decimals`, written a panel at a time (a 50,000-panel
+// structure's mesh is never held whole). `comment` is its first line.
+void writeStructureObj(std::ostream& out, const Structure& structure, std::string_view comment, int decimals);
 
 }  // namespace rotafab::geometry

@@ -450,11 +450,11 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   context.parallelFor(2, [&](size_t task) {
     if (task == 0) {
       writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
-        geometry::writeObj(
-            stream, geometry::surfaceMesh(job.structure),
+        geometry::writeStructureObj(
+            stream, job.structure,
             fmt::format("rotafab {} structure of {}: {} panels, inches", geometry::structureName(job.structure.kind),
                         job.meshFile.string(), job.structure.panels.size()),
-            geometry::panelGroups(job.structure), kSheetDecimals);
+            kSheetDecimals);
       });
     } else {
       job.manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
