@@ -92,7 +92,13 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     room.push_back(insidePolygon(region, centre) ? distanceToSides(centre) : -1.0);
     most = std::max(most, room.back());
   }
-  const auto clear = [&](const Point2& p, double gap) { return insidePolygon(region, p) && distanceToSides(p) >= gap; };
+  // Clear of the outline by `gap`: a point near a candidate centre is at
+  // least the centre's room less their distance from the sides (the
+  // triangle inequality), which spares most points their own distance.
+  const auto clear = [&](const Point2& p, double gap, size_t c) {
+    return insidePolygon(region, p) &&
+           (room[c] - (p - candidates[c]).norm() >= gap + 1e-9 || distanceToSides(p) >= gap);
+  };
   // The region's extent along the text and across it: a box longer or
   // taller than that cannot fit anywhere. (Not with the gaps: the gap is
   // kept from the cut outline, and the region's side may be a fold.)
@@ -112,11 +118,11 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
       // The cheap tests first: holes, the corners, then the other labels and the whole perimeter.
       bool fits = true;
       for (size_t i = 0; fits && i < holes.size(); ++i) fits = box.distanceTo(holes[i].centre) >= holes[i].radius + gap;
-      for (const Point2& corner : box.corners()) fits = fits && clear(corner, gap);
+      for (const Point2& corner : box.corners()) fits = fits && clear(corner, gap, c);
       for (size_t i = 0; fits && i < taken.size(); ++i) fits = boxesApart(box, taken[i], gap);
       if (!fits) continue;
       for (const Point2& p : perimeter(box, gap)) {
-        if (!clear(p, gap)) {
+        if (!clear(p, gap, c)) {
           fits = false;
           break;
         }
