@@ -26,6 +26,7 @@
 #include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
 #include "jobs/MakeJob.h"
+#include "jobs/Manifest.h"
 #include "jobs/Nesting.h"
 #include "jobs/nesting/CollisionPlacer.h"
 #include "jobs/nesting/Shapes.h"
@@ -45,7 +46,7 @@ std::vector<jobs::NestingPart> partsOf(const std::filesystem::path& mesh, const 
   request.rows = true;
   const jobs::PlannedJob job = jobs::planJob(request, context);
   std::vector<jobs::NestingPart> parts;
-  for (const jobs::Part& part : job.parts) {
+  for (const jobs::Part& part : jobs::structureParts(job.structure)) {
     const jobs::Part cut = jobs::compensateKerf(part, request.material.kerf);
     parts.push_back({cut.name, cut.outline, cut.rotations, cut.order});
   }

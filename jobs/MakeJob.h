@@ -1,7 +1,7 @@
 #pragma once
 // The whole of `rotafab make` (SPEC, "make") as one call, for the command
 // line and the daemon alike: a request in (a mesh file and the options), a
-// planned job out (its structure, parts, sheets, manifest and files). The
+// planned job out (its structure, sheets and files). The
 // phases, each reported as progress: import (read, check, fill holes,
 // scale), geometry (the structure's builder), nesting (the planner), writing
 // (the output folder, by OutputFolder's rule).
@@ -75,14 +75,12 @@ struct PlannedJob {
   geometry::Structure structure;
   geometry::Stability stability;                     // of the structure as built, standing on the request's up axis
   geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
-  std::vector<Part> parts;                           // structureParts()
   SheetPlan sheets;
   SheetFormats formats;
   JobCost cost;
   // Once written (writeJob()):
   std::filesystem::path folder;
   std::vector<std::vector<std::string>> files;  // per sheet
-  nlohmann::ordered_json manifest;
   PhaseSeconds seconds;
 };
 
@@ -103,7 +101,9 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 // Writes the job into `folder`: sheet-001.eps/.svg/.dxf ..., manifest.json,
 // manifest.txt, structure.obj. On any failure or a cancel the folder is left
 // as it was. Throws std::runtime_error naming a file that cannot be
-// written, core::Cancelled.
+// written, core::Cancelled. Once the sheets' files are written their drawn
+// paths are let go (a 50,000-panel job's are hundreds of megabytes); their
+// placements and counts stay.
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
 // SPEC's summary of a written job (`make --json`): {"panels", "sheets",
