@@ -5,9 +5,6 @@
 #include <algorithm>
 #include <cctype>
 #include <chrono>
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
 #include <cmath>
 #include <functional>
 #include <regex>
@@ -338,17 +335,6 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   }
 }
 
-// Gives the pages of memory freed back to the system. glibc's malloc keeps
-// them otherwise, and a large job's next phase takes fresh pages on top of
-// them: on a 50,000-panel job the planner's copies, the drawings and the
-// manifest were 700 MB more at once. (Only between phases: a freed page
-// given back costs a fault when it is used again.)
-void releaseFreedMemory() {
-#ifdef __GLIBC__
-  malloc_trim(0);
-#endif
-}
-
 // Square inches to square metres: the areal density is in grams per square metre.
 constexpr double kSquareMetresPerSquareInch = 0.0254 * 0.0254;
 
@@ -467,16 +453,14 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
                     job.meshFile.string(), job.structure.panels.size()),
         kSheetDecimals);
   });
-  // The drawings, and what the planner freed, before the manifest is built.
-  for (SheetDrawing& sheet : job.sheets.sheets) std::vector<DrawnPath>().swap(sheet.paths);
-  releaseFreedMemory();
   {
-    nlohmann::ordered_json manifest = structureManifest(job.structure, job.mesh, job.bed, job.sheets, job.files);
-    manifest["size"] = {job.size.x(), job.size.y(), job.size.z()};
-    manifest["stability"] = stabilityJson(job.stability);
-    manifest["cost"] = costJson(job.cost);
-    writeFileAtomically(output.staging() / "manifest.json", manifestJsonText(manifest, context));
-    writeFileAtomically(output.staging() / "manifest.txt", manifestText(manifest));
+    const nlohmann::ordered_json more = {{"size", {job.size.x(), job.size.y(), job.size.z()}},
+                                         {"stability", stabilityJson(job.stability)},
+                                         {"cost", costJson(job.cost)}};
+    ManifestFiles manifest = manifestFiles(job.structure, job.mesh, job.bed, job.sheets, job.files, more, context);
+    writeFileAtomically(output.staging() / "manifest.json", manifest.json);
+    std::string().swap(manifest.json);
+    writeFileAtomically(output.staging() / "manifest.txt", manifest.text);
   }
   context.check();
   // manifest.json last: until it moves in, the folder's manifest is the old job's.

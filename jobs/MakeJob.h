@@ -101,9 +101,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 // Writes the job into `folder`: sheet-001.eps/.svg/.dxf ..., manifest.json,
 // manifest.txt, structure.obj. On any failure or a cancel the folder is left
 // as it was. Throws std::runtime_error naming a file that cannot be
-// written, core::Cancelled. Once the sheets' files are written their drawn
-// paths are let go (a 50,000-panel job's are hundreds of megabytes); their
-// placements and counts stay.
+// written, core::Cancelled.
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
 // SPEC's summary of a written job (`make --json`): {"panels", "sheets",

@@ -106,9 +106,34 @@ nlohmann::ordered_json stabilityJson(const geometry::Stability& stability) {
           {"footprint", footprint}};
 }
 
-nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
-                                         const profiles::Bed& bed, const SheetPlan& plan,
-                                         const std::vector<std::vector<std::string>>& files) {
+namespace {
+
+// Where each panel and each piece was placed, from the planned parts in
+// structureParts()'s order.
+struct Placements {
+  std::vector<const PlannedPart*> panels;
+  std::map<std::pair<int, int>, const PlannedPart*> pieces;
+};
+
+Placements placementsOf(const geometry::Structure& structure, const SheetPlan& plan) {
+  const std::vector<std::pair<int, int>> owners = partOwners(structure);
+  Placements placements;
+  placements.panels.resize(structure.panels.size());
+  for (const PlannedPart& placed : plan.parts) {
+    const auto [panel, piece] = owners.at(placed.part);
+    if (piece < 0) {
+      placements.panels[panel] = &placed;
+    } else {
+      placements.pieces[{panel, piece}] = &placed;
+    }
+  }
+  return placements;
+}
+
+// Everything but "panels".
+nlohmann::ordered_json manifestHead(const geometry::Structure& structure, const BuiltMesh& mesh,
+                                    const profiles::Bed& bed, const SheetPlan& plan,
+                                    const std::vector<std::vector<std::string>>& files) {
   nlohmann::ordered_json manifest;
   manifest["version"] = 1;
   manifest["structure"] = geometry::structureName(structure.kind);
@@ -121,18 +146,7 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
   if (mesh.simplified) manifest["simplified"] = simplifiedJson(*mesh.simplified);
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
-  // Which panel (and piece) each planned part is, in structureParts()'s order.
   const std::vector<std::pair<int, int>> owners = partOwners(structure);
-  std::vector<const PlannedPart*> placement(structure.panels.size());
-  std::map<std::pair<int, int>, const PlannedPart*> piecePlacement;
-  for (const PlannedPart& placed : plan.parts) {
-    const auto [panel, piece] = owners.at(placed.part);
-    if (piece < 0) {
-      placement[panel] = &placed;
-    } else {
-      piecePlacement[{panel, piece}] = &placed;
-    }
-  }
   manifest["sheets"] = nlohmann::ordered_json::array();
   for (size_t s = 0; s < plan.sheets.size(); ++s) {
     nlohmann::ordered_json panels = nlohmann::ordered_json::array(), pieces = nlohmann::ordered_json::array();
@@ -150,64 +164,85 @@ nlohmann::ordered_json structureManifest(const geometry::Structure& structure, c
     if (!pieces.empty()) sheet["pieces"] = pieces;            // extension: the pieces of split panels it holds
     manifest["sheets"].push_back(sheet);
   }
-  manifest["panels"] = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < structure.panels.size(); ++i) {
-    const geometry::Panel& panel = structure.panels[i];
-    const PlannedPart& placed = *placement[i];
-    nlohmann::ordered_json entry;
-    entry["id"] = panel.id;
-    entry["order"] = placed.cuttingIndex + 1;  // its place in the cutting order
-    entry["sheet"] = placed.sheet;
-    entry["source"] = sourceOf(panel.source);
+  return manifest;
+}
+
+// Panel i's entry. Without its shapes (outlines, placements, holes' places)
+// it is what the assembly steps read (stepsOf), in a fraction of the memory.
+nlohmann::ordered_json panelEntry(const geometry::Structure& structure, size_t i, const Placements& placements,
+                                  bool shapes) {
+  const geometry::Panel& panel = structure.panels[i];
+  const PlannedPart& placed = *placements.panels[i];
+  nlohmann::ordered_json entry;
+  entry["id"] = panel.id;
+  entry["order"] = placed.cuttingIndex + 1;  // its place in the cutting order
+  entry["sheet"] = placed.sheet;
+  entry["source"] = sourceOf(panel.source);
+  if (shapes) {
     entry["outline"] = nlohmann::ordered_json::array();
     for (const Point2& p : panel.outline) entry["outline"].push_back(point(p));
     entry["placement"] = {{"x", placed.x}, {"y", placed.y}, {"rotation", placed.rotation}};
-    entry["holes"] = nlohmann::ordered_json::array();
-    for (const auto& hole : panel.holes) {
-      entry["holes"].push_back({{"edge", hole.edge}, {"xy", point(hole.xy)}, {"diameter", hole.diameter}});
-    }
-    entry["labels"] = nlohmann::ordered_json::array();
-    for (const auto& label : panel.labels) {
-      // The number the label shows (without the mark of 6 and 9): an edge's, or the panel's own.
-      nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
-      if (label.edge > 0) l["edge"] = label.edge;
-      l["role"] = geometry::roleName(label.role);
-      entry["labels"].push_back(l);
-    }
-    std::vector<int> neighbors, edges;
-    for (const geometry::PanelJoin& join : panel.joins) neighbors.push_back(join.panel), edges.push_back(join.edge);
-    entry["neighbors"] = neighbors;
-    entry["area"] = panel.area;
-    // Extensions: the edge number joining each neighbour (same order), and
-    // how far the layout moved the panel from its assembly order.
-    entry["edges"] = edges;
-    entry["moved"] = placed.moved;
-    // Extension: the bands cut off a panel that would overlap itself (V.4),
-    // each a part of its own with a tab fastened to the vertex band, or the
-    // far half of a band cut across, held by the band's other copy.
-    if (!panel.pieces.empty()) {
-      entry["pieces"] = nlohmann::ordered_json::array();
-      for (size_t k = 0; k < panel.pieces.size(); ++k) {
-        const geometry::PanelPiece& piece = panel.pieces[k];
-        const PlannedPart& at = *piecePlacement.at({static_cast<int>(i), static_cast<int>(k)});
-        nlohmann::ordered_json p;
-        p["name"] = piece.name;
-        p["edge"] = piece.edge;
-        p["sheet"] = at.sheet;
-        p["order"] = at.cuttingIndex + 1;
+  }
+  const auto holeEntry = [&](const geometry::PanelHole& hole) {
+    return shapes ? nlohmann::ordered_json{{"edge", hole.edge}, {"xy", point(hole.xy)}, {"diameter", hole.diameter}}
+                  : nlohmann::ordered_json{{"edge", hole.edge}};
+  };
+  entry["holes"] = nlohmann::ordered_json::array();
+  for (const auto& hole : panel.holes) entry["holes"].push_back(holeEntry(hole));
+  entry["labels"] = nlohmann::ordered_json::array();
+  for (const auto& label : panel.labels) {
+    // The number the label shows (without the mark of 6 and 9): an edge's, or the panel's own.
+    nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
+    if (label.edge > 0) l["edge"] = label.edge;
+    l["role"] = geometry::roleName(label.role);
+    entry["labels"].push_back(l);
+  }
+  std::vector<int> neighbors, edges;
+  for (const geometry::PanelJoin& join : panel.joins) neighbors.push_back(join.panel), edges.push_back(join.edge);
+  entry["neighbors"] = neighbors;
+  entry["area"] = panel.area;
+  // Extensions: the edge number joining each neighbour (same order), and
+  // how far the layout moved the panel from its assembly order.
+  entry["edges"] = edges;
+  entry["moved"] = placed.moved;
+  // Extension: the bands cut off a panel that would overlap itself (V.4),
+  // each a part of its own with a tab fastened to the vertex band, or the
+  // far half of a band cut across, held by the band's other copy.
+  if (!panel.pieces.empty()) {
+    entry["pieces"] = nlohmann::ordered_json::array();
+    for (size_t k = 0; k < panel.pieces.size(); ++k) {
+      const geometry::PanelPiece& piece = panel.pieces[k];
+      const PlannedPart& at = *placements.pieces.at({static_cast<int>(i), static_cast<int>(k)});
+      nlohmann::ordered_json p;
+      p["name"] = piece.name;
+      p["edge"] = piece.edge;
+      p["sheet"] = at.sheet;
+      p["order"] = at.cuttingIndex + 1;
+      if (shapes) {
         p["outline"] = nlohmann::ordered_json::array();
         for (const Point2& q : piece.outline) p["outline"].push_back(point(q));
         p["placement"] = {{"x", at.x}, {"y", at.y}, {"rotation", at.rotation}};
-        p["holes"] = nlohmann::ordered_json::array();
-        for (const auto& hole : piece.holes) {
-          p["holes"].push_back({{"edge", hole.edge}, {"xy", point(hole.xy)}, {"diameter", hole.diameter}});
-        }
-        p["area"] = piece.area;
-        p["fastened"] = geometry::fasteningName(piece.fastening);  // extension: by a tab, or by its band
-        entry["pieces"].push_back(p);
       }
+      p["holes"] = nlohmann::ordered_json::array();
+      for (const auto& hole : piece.holes) p["holes"].push_back(holeEntry(hole));
+      p["area"] = piece.area;
+      p["fastened"] = geometry::fasteningName(piece.fastening);  // extension: by a tab, or by its band
+      entry["pieces"].push_back(p);
     }
-    manifest["panels"].push_back(entry);
+  }
+  return entry;
+}
+
+}  // namespace
+
+nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
+                                         const profiles::Bed& bed, const SheetPlan& plan,
+                                         const std::vector<std::vector<std::string>>& files) {
+  nlohmann::ordered_json manifest = manifestHead(structure, mesh, bed, plan, files);
+  const Placements placements = placementsOf(structure, plan);
+  manifest["panels"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < structure.panels.size(); ++i) {
+    manifest["panels"].push_back(panelEntry(structure, i, placements, true));
   }
   return manifest;
 }
@@ -486,7 +521,7 @@ std::string jsonTextWithLines(const Json& manifest, const Lines& linesOf) {
     text += ": ";
     if (value.is_array() && !value.empty() && (key == "sheets" || key == "panels")) {
       text += "[";
-      linesOf(value, text);
+      linesOf(key, value, text);
       text += "\n ]";
     } else {
       text += value.dump();
@@ -508,22 +543,46 @@ void appendLines(const Json& array, size_t from, size_t to, std::string& text) {
 
 template <class Json>
 std::string manifestJsonText(const Json& manifest) {
-  return jsonTextWithLines(manifest,
-                           [](const Json& array, std::string& text) { appendLines(array, 0, array.size(), text); });
+  return jsonTextWithLines(manifest, [](const std::string&, const Json& array, std::string& text) {
+    appendLines(array, 0, array.size(), text);
+  });
 }
 
 template std::string manifestJsonText(const nlohmann::json&);
 template std::string manifestJsonText(const nlohmann::ordered_json&);
 
-std::string manifestJsonText(const nlohmann::ordered_json& manifest, const core::WorkContext& context) {
-  return jsonTextWithLines(manifest, [&](const nlohmann::ordered_json& array, std::string& text) {
-    constexpr size_t kChunk = 2048;
-    std::vector<std::string> chunks((array.size() + kChunk - 1) / kChunk);
-    context.parallelFor(chunks.size(), [&](size_t c) {
-      appendLines(array, c * kChunk, std::min(array.size(), (c + 1) * kChunk), chunks[c]);
-    });
-    for (const std::string& chunk : chunks) text += chunk;
-  });
+ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMesh& mesh, const profiles::Bed& bed,
+                            const SheetPlan& plan, const std::vector<std::vector<std::string>>& files,
+                            const nlohmann::ordered_json& more, const core::WorkContext& context) {
+  // The manifest without the panels' shapes: what manifest.txt reads, and
+  // the frame of manifest.json, whose panels' lines are made from the
+  // structure a chunk at a time.
+  nlohmann::ordered_json manifest = manifestHead(structure, mesh, bed, plan, files);
+  const Placements placements = placementsOf(structure, plan);
+  manifest["panels"] = nlohmann::ordered_json::array();
+  for (size_t i = 0; i < structure.panels.size(); ++i) {
+    manifest["panels"].push_back(panelEntry(structure, i, placements, false));
+  }
+  for (const auto& [key, value] : more.items()) manifest[key] = value;
+  ManifestFiles out;
+  out.json =
+      jsonTextWithLines(manifest, [&](const std::string& key, const nlohmann::ordered_json& array, std::string& text) {
+        if (key != "panels") {
+          appendLines(array, 0, array.size(), text);
+          return;
+        }
+        constexpr size_t kChunk = 1024;
+        std::vector<std::string> chunks((array.size() + kChunk - 1) / kChunk);
+        context.parallelFor(chunks.size(), [&](size_t c) {
+          for (size_t i = c * kChunk; i < std::min(array.size(), (c + 1) * kChunk); ++i) {
+            chunks[c] += i == 0 ? "\n  " : ",\n  ";
+            chunks[c] += panelEntry(structure, i, placements, true).dump();
+          }
+        });
+        for (const std::string& chunk : chunks) text += chunk;
+      });
+  out.text = manifestText(manifest);
+  return out;
 }
 
 }  // namespace rotafab::jobs

@@ -68,8 +68,17 @@ std::string manifestText(const nlohmann::ordered_json& manifest);
 // indented, a large job's manifest was twice the bytes).
 template <class Json>
 std::string manifestJsonText(const Json& manifest);
-// The same, its panels' lines shared out among the context's threads.
-std::string manifestJsonText(const nlohmann::ordered_json& manifest, const core::WorkContext& context);
+
+// `make`'s manifest.json (structureManifest() and then the members of
+// `more`, as manifestJsonText() gives it) and manifest.txt (manifestText()),
+// made without the whole manifest in memory: the panels' lines a chunk at a
+// time, on the context's threads (a 50,000-panel manifest was 660 MB).
+struct ManifestFiles {
+  std::string json, text;
+};
+ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMesh& mesh, const profiles::Bed& bed,
+                            const SheetPlan& plan, const std::vector<std::vector<std::string>>& files,
+                            const nlohmann::ordered_json& more, const core::WorkContext& context);
 
 // The same as one HTML page, fit to print: the steps as a table, then each
 // sheet (its SVG file from `folder`, inlined) on a page of its own, with

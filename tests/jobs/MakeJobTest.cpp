@@ -46,7 +46,7 @@ struct CancelPoint {
 TEST(MakeJob, CancelledInAnyPhaseStopsWithinASecondAndLeavesNothing) {
   const CancelPoint points[] = {
       {"import", "", false, 0.0},  {"geometry", "band decomposition", false, 0.0}, {"geometry", "labels", false, 0.05},
-      {"nesting", "", false, 0.5}, {"nesting", "first layout", false, 2},          {"writing", "", true, 0.2}};
+      {"nesting", "", false, 0.5}, {"nesting", "first layout", false, 0.3},        {"writing", "", true, 0.2}};
   for (const CancelPoint& point : points) {
     SCOPED_TRACE(point.phase + " " + point.step);
     test::TempDir dir;
