@@ -11,6 +11,7 @@ int64_t unitsOf(double value, int decimals) {
 }
 
 void appendUnits(fmt::memory_buffer& out, int64_t units, int decimals) {
+  decimals = std::clamp(decimals, 0, 9);  // as unitsOf
   char digits[32];
   char* const end = digits + sizeof digits;
   char* at = end;

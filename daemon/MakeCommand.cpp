@@ -57,8 +57,8 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
   fmt::print("  built, {:.1f} x {:.1f} x {:.1f} in; {}\n", job.size.x(), job.size.y(), job.size.z(),
              stabilityLine(job.stability));
   fmt::print("  it takes {}\n", jobs::costLine(job.cost));
-  fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, cutting time {:.2f} s, writing {:.2f} s\n",
-             s.import, s.geometry, s.nesting, s.estimate, s.writing);
+  fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, estimate {:.2f} s, writing {:.2f} s\n", s.import,
+             s.geometry, s.nesting, s.estimate, s.writing);
   fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", job.folder.string(), job.folder.string());
 }
 

@@ -49,7 +49,8 @@ Part compensateKerf(const Part& part, double kerf) {
   }
   for (size_t c = 0; c < part.circles.size(); ++c) {
     cut.circles[c].radius -= kerf / 2;
-    if (!(cut.circles[c].radius > 0)) {
+    // (Less than the sheets' 0.0001 in left is no hole a file can give.)
+    if (!(cut.circles[c].radius >= 1e-4)) {
       throw std::invalid_argument(
           fmt::format("{}: hole {} is narrower than the kerf ({} in)", part.name, part.holes.size() + c + 1, kerf));
     }

@@ -79,7 +79,8 @@ DrawnPath pathOf(std::string_view d, double height, const Fail& fail) {
       const auto near = [&](double a, double b) { return std::abs(a - b) <= 1e-9 * std::max(1.0, std::abs(b)); };
       if (!(radius > 0 && near(r[0][1], radius) && near(r[1][0], radius) && near(r[1][1], radius) &&
             near(across[0][0], -2 * radius) && near(across[1][0], 2 * radius) && across[0][1] == 0 &&
-            across[1][1] == 0 && flags[0][0] == 0 && flags[1][0] == 0))
+            across[1][1] == 0 && flags[0][0] == 0 && flags[1][0] == 0 && flags[0][1] == 1 && flags[1][1] == 1 &&
+            flags[0][2] == 0 && flags[1][2] == 0))
         throw fail(at, "arcs that are not a circle's two halves (rotafab writes circles only)");
       skipSpaces();
       if (at >= d.size() || d[at] != 'Z') throw fail(at, "a circle not closed by Z");

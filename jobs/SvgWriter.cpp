@@ -94,7 +94,8 @@ void appendCoordinate(fmt::memory_buffer& buffer, int64_t units, int decimals, b
 void appendPath(fmt::memory_buffer& buffer, double height, const DrawnPath& path, int decimals) {
   buffer.append(std::string_view("<path d=\"M"));
   if (path.circle) {
-    const int64_t r = unitsOf(path.circle->radius, decimals);
+    // (At least one unit: a circle, however small, stays one when read back.)
+    const int64_t r = std::max<int64_t>(1, unitsOf(path.circle->radius, decimals));
     const int64_t x = unitsOf(path.circle->centre.x(), decimals) + r;
     appendCoordinate(buffer, x, decimals, true);
     appendCoordinate(buffer, unitsOf(height - path.circle->centre.y(), decimals), decimals, false);

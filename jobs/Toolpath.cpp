@@ -127,8 +127,9 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
           for (size_t i : here) consider(i);
         }
       }
-      // Every cell of the next ring is at least `ring` cells from the head.
-      const double beyond = ring * cell;
+      // Every cell of the next ring is at least `ring` cells from the head
+      // (less a hair, for the rounding of the cells' numbers).
+      const double beyond = ring * cell * (1 - 1e-9);
       if (best < n && beyond * beyond > bestDistance) break;
     }
     done[best] = 1;
