@@ -6,12 +6,12 @@
 // joins; the assembly steps; the fasteners; warnings. Lengths in inches,
 // panel coordinates in the panel's own frame.
 
+#include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/Polygon2.h"
-#include "geometry/ObjWriter.h"
 #include "geometry/PanelLabels.h"
 #include "geometry/PolygonMesh.h"
 

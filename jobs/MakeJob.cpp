@@ -18,7 +18,6 @@
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/ObjWriter.h"
 #include "geometry/Simplification.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/OutputFolder.h"
@@ -363,7 +362,7 @@ JobCost jobCost(const PlannedJob& job, const MakeRequest& request, const core::W
   cost.fastenerDiameter = request.fastener.value_or(request.material.fastenerDiameter);
   cost.motionGiven = request.machine.motion.has_value();
   const MotionLimits limits = profileMotion(request.machine);
-  // (The toolpath's stroke order takes the bunny's 30 sheets 7 s: shared out among the threads.)
+  // (Each sheet's stroke order is its own work: shared out among the threads.)
   std::vector<double> seconds(job.sheets.sheets.size(), 0.0);
   std::vector<std::string> refused(seconds.size());
   context.parallelFor(seconds.size(), [&](size_t s) {

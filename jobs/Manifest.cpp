@@ -235,18 +235,6 @@ nlohmann::ordered_json panelEntry(const geometry::Structure& structure, size_t i
 
 }  // namespace
 
-nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
-                                         const profiles::Bed& bed, const SheetPlan& plan,
-                                         const std::vector<std::vector<std::string>>& files) {
-  nlohmann::ordered_json manifest = manifestHead(structure, mesh, bed, plan, files);
-  const Placements placements = placementsOf(structure, plan);
-  manifest["panels"] = nlohmann::ordered_json::array();
-  for (size_t i = 0; i < structure.panels.size(); ++i) {
-    manifest["panels"].push_back(panelEntry(structure, i, placements, true));
-  }
-  return manifest;
-}
-
 namespace {
 
 // One assembly step (geometry::stepsInPanelOrder) and where its panel and
@@ -507,17 +495,17 @@ the same number on the panel named; fasten them through their holes.</p>
 
 namespace {
 
-// manifestJsonText() with `linesOf(array, text)` giving an array's elements
-// a line each (after the first's "[").
-template <class Json, class Lines>
-std::string jsonTextWithLines(const Json& manifest, const Lines& linesOf) {
+// manifestJsonText() with `linesOf(key, array, text)` giving the elements
+// of the arrays "sheets" and "panels" a line each (after the first's "[").
+template <class Lines>
+std::string jsonTextWithLines(const nlohmann::ordered_json& manifest, const Lines& linesOf) {
   if (!manifest.is_object()) return manifest.dump() + "\n";
   std::string text = "{";
   bool first = true;
   for (const auto& [key, value] : manifest.items()) {
     text += first ? "\n " : ",\n ";
     first = false;
-    text += Json(key).dump();
+    text += nlohmann::ordered_json(key).dump();
     text += ": ";
     if (value.is_array() && !value.empty() && (key == "sheets" || key == "panels")) {
       text += "[";
@@ -531,25 +519,22 @@ std::string jsonTextWithLines(const Json& manifest, const Lines& linesOf) {
   return text;
 }
 
-template <class Json>
-void appendLines(const Json& array, size_t from, size_t to, std::string& text) {
+// Elements `from` to `to` of an array, a line each, as `line(i)` gives them.
+template <class Line>
+void appendLines(size_t from, size_t to, std::string& text, const Line& line) {
   for (size_t i = from; i < to; ++i) {
     text += i == 0 ? "\n  " : ",\n  ";
-    text += array[i].dump();
+    text += line(i);
   }
 }
 
 }  // namespace
 
-template <class Json>
-std::string manifestJsonText(const Json& manifest) {
-  return jsonTextWithLines(manifest, [](const std::string&, const Json& array, std::string& text) {
-    appendLines(array, 0, array.size(), text);
+std::string manifestJsonText(const nlohmann::ordered_json& manifest) {
+  return jsonTextWithLines(manifest, [](const std::string&, const nlohmann::ordered_json& array, std::string& text) {
+    appendLines(0, array.size(), text, [&](size_t i) { return array[i].dump(); });
   });
 }
-
-template std::string manifestJsonText(const nlohmann::json&);
-template std::string manifestJsonText(const nlohmann::ordered_json&);
 
 ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMesh& mesh, const profiles::Bed& bed,
                             const SheetPlan& plan, const std::vector<std::vector<std::string>>& files,
@@ -568,16 +553,14 @@ ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMes
   out.json =
       jsonTextWithLines(manifest, [&](const std::string& key, const nlohmann::ordered_json& array, std::string& text) {
         if (key != "panels") {
-          appendLines(array, 0, array.size(), text);
+          appendLines(0, array.size(), text, [&](size_t i) { return array[i].dump(); });
           return;
         }
         constexpr size_t kChunk = 1024;
         std::vector<std::string> chunks((array.size() + kChunk - 1) / kChunk);
         context.parallelFor(chunks.size(), [&](size_t c) {
-          for (size_t i = c * kChunk; i < std::min(array.size(), (c + 1) * kChunk); ++i) {
-            chunks[c] += i == 0 ? "\n  " : ",\n  ";
-            chunks[c] += panelEntry(structure, i, placements, true).dump();
-          }
+          appendLines(c * kChunk, std::min(array.size(), (c + 1) * kChunk), chunks[c],
+                      [&](size_t i) { return panelEntry(structure, i, placements, true).dump(); });
         });
         for (const std::string& chunk : chunks) text += chunk;
       });

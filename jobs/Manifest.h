@@ -52,11 +52,6 @@ std::vector<Part> structureParts(const geometry::Structure& structure);
 // its piece (index, -1 for the panel itself).
 std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure);
 
-// `files[s]`: the files written for sheet s + 1.
-nlohmann::ordered_json structureManifest(const geometry::Structure& structure, const BuiltMesh& mesh,
-                                         const profiles::Bed& bed, const SheetPlan& plan,
-                                         const std::vector<std::vector<std::string>>& files);
-
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
 // the panels already placed that it joins and the edge numbers to fasten
 // with the fasteners of each; totals at the end. Throws
@@ -66,13 +61,14 @@ std::string manifestText(const nlohmann::ordered_json& manifest);
 // manifest.json's text: a line for each member of the top level, and a line
 // for each sheet and each panel (people and grep read it a panel to a line;
 // indented, a large job's manifest was twice the bytes).
-template <class Json>
-std::string manifestJsonText(const Json& manifest);
+std::string manifestJsonText(const nlohmann::ordered_json& manifest);
 
-// `make`'s manifest.json (structureManifest() and then the members of
-// `more`, as manifestJsonText() gives it) and manifest.txt (manifestText()),
-// made without the whole manifest in memory: the panels' lines a chunk at a
-// time, on the context's threads (a 50,000-panel manifest was 660 MB).
+// `make`'s manifest.json (SPEC's version 1 for the structure as planned, and
+// then the members of `more`, as manifestJsonText() gives it) and
+// manifest.txt (manifestText()), made without the whole manifest in memory:
+// the panels' lines a chunk at a time, on the context's threads (a
+// 50,000-panel manifest was 660 MB). `files[s]`: the files written for
+// sheet s + 1.
 struct ManifestFiles {
   std::string json, text;
 };

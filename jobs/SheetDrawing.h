@@ -8,7 +8,6 @@
 
 #include <fmt/format.h>
 #include <Eigen/Core>
-#include <cstdint>
 #include <map>
 #include <optional>
 

@@ -29,9 +29,9 @@ TEST(Decimal, UnitsAsDecimalsWithoutTrailingZeros) {
 }
 
 TEST(Decimal, TheSameDigitsAsPrintf) {
-  // printf rounds the binary value exactly; unitsOf rounds value * 10^d,
-  // which differs only at exact ties (x.xxxx5), which coordinates never hit
-  // in practice: none among a million random ones.
+  // printf rounds the binary value exactly; unitsOf rounds value * 10^d.
+  // The two can differ only within a rounding error of a tie (x.xxxx5):
+  // none of a million random coordinates does.
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> coordinate(-40, 40);
   int differ = 0;
