@@ -64,7 +64,8 @@ Measure firstLayout(const std::vector<jobs::NestingPart>& parts, jobs::OrderMode
   jobs::NestingOptions options;
   options.spacing = 1.0 / 16 + 0.008;
   options.order = order;
-  const jobs::nesting::PartShapes shapes(parts, options, context);
+  jobs::nesting::PartShapes shapes(parts, options, context);
+  shapes.buildAll(context);
   std::vector<int> sequence(parts.size());
   std::iota(sequence.begin(), sequence.end(), 0);
   if (order == jobs::OrderMode::Free) {

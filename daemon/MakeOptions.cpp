@@ -78,7 +78,7 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
   make.add_flag("--score-folds", options.scoreFolds, "Score the folds between each vertex band and its bands");
   make.add_option("--time", options.seconds,
                   "Nesting time budget in seconds, first layout included: the best layout found\n"
-                  "by then is kept (a first layout is always finished)")
+                  "by then is kept; parts the first layout has not reached by then go in rows (with a note)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
   make.add_option("--order", options.order,

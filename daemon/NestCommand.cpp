@@ -120,7 +120,8 @@ void addNestCommand(CLI::App& app, int& status) {
   command
       ->add_option("--time", options->seconds,
                    "Time budget in seconds, first layout included: the best layout found by then\n"
-                   "is kept (a first layout is always finished)")
+                   "is kept; parts the first layout has not reached by then go in rows (not with\n"
+                   "--strip or --evaluations: the first layout is then always finished)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
   command->add_option("--order", options->order, "strict, window or free: how far parts may move from their order")

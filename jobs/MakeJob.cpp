@@ -434,6 +434,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
         "free order {} (manifest.json's `moved` says how far each part moved; --order window keeps the window)",
         name, request.window, job.sheets.windowSheets, job.sheets.sheets.size()));
   }
+  if (!job.sheets.inRowsNote.empty()) context.note(fmt::format("{}: {}", name, job.sheets.inRowsNote));
   job.cost = jobCost(job, request, context);
   job.seconds.estimate = lap();
   return job;

@@ -45,6 +45,7 @@ NestedInstance nestInstance(const NestRequest& request, const core::WorkContext&
   // Never seen: every placement is checked as it is made; said as the command line has always said it.
   if (!problems.empty()) throw core::UserError("internal: the layout failed its own check: " + problems.front());
   const NestingResult& result = nested.result;
+  if (result.inRows > 0) context.note(fmt::format("{}: {}", name, inRowsNote(result)));
   const auto none = nlohmann::ordered_json(nullptr);
   auto& summary = nested.summary;
   summary["sheets"] = result.sheets;
@@ -55,6 +56,7 @@ NestedInstance nestInstance(const NestRequest& request, const core::WorkContext&
       request.strip ? nlohmann::ordered_json(result.partArea / (options.height * result.stripLength)) : none;
   summary["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   summary["layouts"] = result.evaluations;
+  summary["in_rows"] = result.inRows;
   return nested;
 }
 

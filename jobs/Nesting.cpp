@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "core/Polygon2.h"
+#include "jobs/RowLayout.h"
 #include "jobs/nesting/SequenceSearch.h"
 #include "jobs/nesting/Shapes.h"
 
@@ -64,11 +65,39 @@ void checkNestingParts(const std::vector<NestingPart>& parts) {
   }
 }
 
+namespace {
+
+// When the budget runs out in the first layout, the parts it has not
+// reached are laid out in rows by their boxes (RowLayout.h, linear in the
+// parts) on sheets of their own after its last: a valid layout when the
+// budget says, on more sheets, and a note that says so.
+NestingResult withTheRestInRows(const std::vector<NestingPart>& parts, const NestingOptions& options,
+                                const nesting::FirstLayout& first, nesting::SharedProgress& progress) {
+  std::vector<NestingPart> rest;
+  for (size_t i = first.placed; i < first.sequence.size(); ++i) rest.push_back(parts[first.sequence[i]]);
+  NestingResult inRows = rowLayout(rest, options);
+  NestingResult result = first.result;
+  for (PartPlacement placement : inRows.placements) {
+    placement.part = first.sequence[first.placed + static_cast<size_t>(placement.part)];
+    placement.sheet += first.result.sheets;
+    result.placements.push_back(placement);
+  }
+  result.sheets += inRows.sheets;
+  result.evaluations = 1;
+  result.inRows = static_cast<int>(rest.size());
+  for (const auto& part : parts) result.partArea += std::abs(polygonArea(part.outline));
+  const auto cost = nesting::layoutCost(result, parts);
+  progress.improved(cost, {"nesting", "first layout", parts.size(), parts.size(), cost.first, cost.second});
+  return result;
+}
+
+}  // namespace
+
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
                    const core::WorkContext& context) {
   checkNestingParts(parts);
   SharedProgress progress(context, std::chrono::steady_clock::now(), options.seconds);
-  const PartShapes shapes(parts, options, context);
+  PartShapes shapes(parts, options, context);
   // Searches side by side, one per thread of the executor unless the options
   // say how many, each on its own course; the best layout wins (on a tie,
   // the lowest seed's). Strict order has nothing to search, nor has the
@@ -78,9 +107,12 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   const unsigned searches = nothingToSearch || parts.size() < 2 ? 1u
                             : options.threads > 0               ? static_cast<unsigned>(options.threads)
                                                                 : context.executor().concurrency();
+  const FirstLayout first = firstLayout(shapes, progress, context);
+  if (first.placed < parts.size()) return withTheRestInRows(parts, options, first, progress);
+  shapes.buildAll(context);
   std::vector<NestingResult> results(searches);
   context.executor().parallelFor(searches, [&](size_t search) {
-    results[search] = searchLayout(shapes, static_cast<unsigned>(search), progress, context);
+    results[search] = searchLayout(shapes, first, static_cast<unsigned>(search), progress, context);
   });
   size_t winner = 0;
   int evaluations = 0;
@@ -92,6 +124,22 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   best.evaluations = evaluations;
   for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));
   return best;
+}
+
+std::string inRowsNote(const NestingResult& result) {
+  if (result.inRows <= 0) return "";
+  const size_t total = result.placements.size(), nested = total - static_cast<size_t>(result.inRows);
+  const int firstInRows = result.placements[nested].sheet;
+  const std::string sheets = firstInRows == result.sheets ? fmt::format("sheet {}", firstInRows)
+                                                          : fmt::format("sheets {}-{}", firstInRows, result.sheets);
+  return nested == 0 ? fmt::format(
+                           "the time budget ran out before the first layout began: the {} parts are laid out "
+                           "in rows by their boxes, on more sheets; a longer --time nests them",
+                           total)
+                     : fmt::format(
+                           "the time budget ran out in the first layout after {} of {} parts: the other {} are "
+                           "laid out in rows by their boxes, on {}; a longer --time nests them all",
+                           nested, total, result.inRows, sheets);
 }
 
 std::vector<std::string> layoutProblems(const std::vector<NestingPart>& parts, const NestingResult& result,

@@ -55,9 +55,12 @@ struct NestingOptions {
   bool strip = false;       // one strip of fixed height, least length
   double spacing = 0.0625;  // least distance between two outlines
   // The budget (wall clock) of the whole nesting, from the call: the
-  // parts' shapes, the first layout and the improvement. The first layout
-  // is always finished, since a layout is needed; the improvement stops
-  // when the budget runs out, with the best layout it found.
+  // parts' shapes, the first layout and the improvement. When it runs out
+  // in the first layout, the parts not yet placed are laid out in rows by
+  // their boxes (NestingResult::inRows, and a note), so that there is a
+  // layout when the budget says; after it, the improvement stops with the
+  // best layout it found. Not with a cap on layouts (`evaluations`), nor
+  // in the strip: the first layout is then always finished.
   double seconds = kDefaultNestingSeconds;
   int evaluations = 0;  // if positive, each search stops after this many layouts (and compaction moves)
   OrderMode order = OrderMode::Free;
@@ -82,6 +85,9 @@ struct NestingResult {
   double stripLength = 0;  // strip mode: the rightmost extent of any part
   double partArea = 0;     // sum of the outlines' areas
   int evaluations = 0;     // layouts tried (and compaction moves), all searches together
+  // Parts laid out in rows by their boxes (RowLayout.h), after the rest,
+  // because the budget ran out before the first layout reached them.
+  int inRows = 0;
 };
 
 // Throws std::invalid_argument naming the part when a part cannot fit the usable
@@ -92,6 +98,10 @@ struct NestingResult {
 // (each better layout, by sheets and length; in the strip, its length).
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
                    const core::WorkContext& context);
+
+// What a person needs to know of NestingResult::inRows, in one line, or
+// nothing when every part was nested.
+std::string inRowsNote(const NestingResult& result);
 
 // Throws std::invalid_argument naming the first part whose outline is not a
 // polygon with area, or that has no allowed rotation.

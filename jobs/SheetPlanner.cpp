@@ -84,6 +84,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
                           static_cast<int>(i) - parts[p.part].order});
   }
   plan.windowSheets = windowSheets;
+  plan.inRowsNote = inRowsNote(nested);
   for (const Part& part : parts) plan.partArea += std::abs(polygonArea(part.outline));
   plan.utilization = plan.partArea / (nested.sheets * nesting.width * nesting.height);
 

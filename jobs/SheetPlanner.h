@@ -59,6 +59,8 @@ struct SheetPlan {
   // The window order would have taken this many sheets, the free order took
   // fewer; 0: the order asked was kept.
   int windowSheets = 0;
+  // What the nesting had no time for (NestingResult::inRows, inRowsNote()), else empty.
+  std::string inRowsNote;
 };
 
 // Throws std::invalid_argument naming the part that cannot be planned (larger

@@ -74,16 +74,12 @@ CollisionPlacer::CollisionPlacer(const PartShapes& shapes, const core::Cancellat
   rows_ = static_cast<int>((shapes.height() + 2 * cell_) / cell_) + 1;
   blockColumns_ = (columns_ + kBlock - 1) / kBlock;
   blockRows_ = (rows_ + kBlock - 1) / kBlock;
-  double largestPole = 0;
+  // Any cap no less than every pole's radius and a cell gives the same
+  // layout (a pole tests the raster against its own radius); a larger one
+  // only makes put()'s windows larger.
+  cap_ = static_cast<float>(shapes.largestPoleBound() + static_cast<double>(cell_));
   std::vector<cInt> sizes;
-  for (size_t part = 0; part < shapes.parts().size(); ++part) {
-    for (const Shape& shape : shapes.of(static_cast<int>(part))) {
-      if (!shape.poles.empty()) largestPole = std::max(largestPole, shape.poles.front().radius);
-    }
-    const Shape& first = shapes.at(static_cast<int>(part), 0);
-    sizes.push_back(std::max(first.grownMaxX - first.grownMinX, first.grownMaxY - first.grownMinY));
-  }
-  cap_ = static_cast<float>(largestPole + static_cast<double>(cell_));
+  for (size_t part = 0; part < shapes.parts().size(); ++part) sizes.push_back(shapes.sizeBound(static_cast<int>(part)));
   // The core is `grown` shrunk with mitres: at a reflex corner up to twice kCollisionSlack inside it.
   cellReach_ = static_cast<float>(static_cast<double>(cell_) * std::sqrt(0.5) + 2 * kCollisionSlack + 2);
   // Hazard cells about as large as a typical part: a query meets a few
@@ -106,12 +102,20 @@ CollisionPlacer::Sheet CollisionPlacer::newSheet() const {
   return sheet;
 }
 
-NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode policy) {
+NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode policy,
+                                     std::chrono::steady_clock::time_point deadline) {
   std::vector<Sheet> sheets;
   std::vector<std::pair<int, PlacedShape>> placed;  // (sheet, shape) in placing order
   const NestingOptions& options = shapes_.options();
+  const bool timed = deadline != std::chrono::steady_clock::time_point::max();
+  size_t aheadTo = 0;  // beforeParts has been called for the sequence up to here
   for (size_t index = 0; index < sequence.size(); ++index) {
     if (cancellation_) cancellation_->check();
+    if (beforeParts && index == aheadTo) {
+      aheadTo = std::min(sequence.size(), index + kPartsAhead);
+      beforeParts(std::span<const int>(sequence).subspan(index, aheadTo - index));
+    }
+    if (timed && std::chrono::steady_clock::now() >= deadline) break;
     if (onProgress) onProgress(index, sequence.size(), sheets.size());
     const int part = sequence[index];
     bool done = false;
@@ -141,7 +145,8 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
   // parts, the smallest: each tries them all, first fit, and the last
   // sheet goes if it empties. (Its own raster is not updated: nothing
   // more is placed on it.)
-  if (policy == OrderMode::Free && sheets.size() > static_cast<size_t>(kOpenSheets)) {
+  if (policy == OrderMode::Free && sheets.size() > static_cast<size_t>(kOpenSheets) &&
+      placed.size() == sequence.size()) {
     const int last = static_cast<int>(sheets.size()) - 1;
     bool emptied = true;
     for (auto& [sheet, spot] : placed) {
@@ -333,8 +338,9 @@ void CollisionPlacer::put(Sheet& sheet, const PlacedShape& spot) {
   const int i0 = cellOf(at.X + shape.coreBox[0] - reach), i1 = cellOf(at.X + shape.coreBox[2] + reach);
   const int j0 = rowOf(at.Y + shape.coreBox[1] - reach), j1 = rowOf(at.Y + shape.coreBox[3] + reach);
   const int width = i1 - i0 + 1, height = j1 - j0 + 1;
-  std::vector<float> squared(static_cast<size_t>(width) * height, kFar);  // column-major within the window
-  std::vector<double> xs;
+  std::vector<float>& squared = scratch_.squared;  // column-major within the window
+  squared.assign(static_cast<size_t>(width) * height, kFar);
+  std::vector<double>& xs = scratch_.xs;
   bool any = false;
   for (int j = rowOf(at.Y + shape.coreBox[1]); j <= rowOf(at.Y + shape.coreBox[3]); ++j) {
     const double y = static_cast<double>(static_cast<cInt>(j) * cell_ - cell_ + cell_ / 2);
@@ -352,8 +358,8 @@ void CollisionPlacer::put(Sheet& sheet, const PlacedShape& spot) {
     }
   }
   if (!any) return;  // too thin to hold a cell's centre: it blocks nothing in the raster
-  std::vector<float> line, out, bounds;
-  std::vector<int> roots;
+  std::vector<float>&line = scratch_.line, &out = scratch_.out, &bounds = scratch_.bounds;
+  std::vector<int>& roots = scratch_.roots;
   for (int i = 0; i < width; ++i) {  // along each column
     line.assign(squared.begin() + static_cast<long>(i) * height, squared.begin() + static_cast<long>(i + 1) * height);
     distanceTransform(line, roots, bounds, out);

@@ -25,10 +25,12 @@
 // same order window as the bottom-left packer. One placer per search; not
 // for two threads at once.
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "core/Cancellation.h"
@@ -42,10 +44,12 @@ class CollisionPlacer {
 
   // Lays out the parts in `sequence`; returns placements in cutting order.
   // `policy` Strict fills only the last sheet; otherwise first fit over all
-  // sheets (within the order window for Window). Throws
-  // std::invalid_argument naming a part that fits no empty sheet (or the
-  // strip), core::Cancelled.
-  NestingResult place(const std::vector<int>& sequence, OrderMode policy);
+  // sheets (within the order window for Window). At `deadline` it stops:
+  // the result then holds the parts of the sequence placed so far, a
+  // leading run of it. Throws std::invalid_argument naming a part that
+  // fits no empty sheet (or the strip), core::Cancelled.
+  NestingResult place(const std::vector<int>& sequence, OrderMode policy,
+                      std::chrono::steady_clock::time_point deadline = std::chrono::steady_clock::time_point::max());
 
   // The last layout, in cutting order, the beds side by side in one row
   // (bed s from s * pitch on: OverlapCompaction's frame).
@@ -53,6 +57,10 @@ class CollisionPlacer {
 
   // Called for every part placed: parts placed so far, of how many, on how many sheets.
   std::function<void(size_t, size_t, size_t)> onProgress;
+  // Called before the next parts of the sequence are placed, kPartsAhead
+  // at a time (their shapes can be built then: PartShapes::build()).
+  std::function<void(std::span<const int>)> beforeParts;
+  static constexpr size_t kPartsAhead = 256;
 
  private:
   struct Sheet {
@@ -93,6 +101,14 @@ class CollisionPlacer {
   int hazardColumns_ = 0, hazardRows_ = 0;
   std::vector<uint32_t> seen_;  // per part on a sheet: the query that last met it
   uint32_t query_ = 0;
+  // put()'s working space, kept between parts: a window can be the whole
+  // bed (0.9 MB), and a fresh one each time was a sixth of a large job's
+  // first layout in the kernel's clearing of new pages.
+  struct Scratch {
+    std::vector<float> squared, line, out, bounds;
+    std::vector<int> roots;
+    std::vector<double> xs;
+  } scratch_;
   std::vector<PlacedShape> layout_;
 };
 

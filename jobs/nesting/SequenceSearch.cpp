@@ -66,14 +66,12 @@ std::chrono::steady_clock::time_point SharedProgress::deadline() const {
                         std::chrono::duration<double>(std::max(0.0, budget_)));
 }
 
-NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProgress& progress,
-                           const core::WorkContext& context) {
+FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core::WorkContext& context) {
   const std::vector<NestingPart>& parts = shapes.parts();
   const NestingOptions& options = shapes.options();
-  BottomLeftPacker packer(shapes, &context.cancellation());
-  CollisionPlacer placer(shapes, &context.cancellation());
-  // The first layout: assembly order, or for free order the largest parts first.
-  std::vector<int> sequence(parts.size());
+  FirstLayout first;
+  first.sequence.resize(parts.size());
+  std::vector<int>& sequence = first.sequence;
   std::iota(sequence.begin(), sequence.end(), 0);
   std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) { return parts[a].order < parts[b].order; });
   if (options.order == OrderMode::Free) {
@@ -81,6 +79,34 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
       return std::abs(polygonArea(parts[a].outline)) > std::abs(polygonArea(parts[b].outline));
     });
   }
+  CollisionPlacer placer(shapes, &context.cancellation());
+  placer.beforeParts = [&](std::span<const int> upcoming) { shapes.build(upcoming, context); };
+  // The first layout can take many seconds (25 s for 100 long strips): say so.
+  progress.remark(0, {"nesting", "first layout", 0, parts.size()});
+  placer.onProgress = [&](size_t placed, size_t of, size_t sheets) {
+    if (placed > 0) progress.remark(0, {"nesting", "first layout", placed, of, static_cast<int>(sheets)});
+  };
+  // The budget holds for the first layout too, except with a cap on
+  // layouts (the same layout on every machine) and in the strip (whose
+  // parts could go nowhere else).
+  const bool timed = options.evaluations <= 0 && !options.strip;
+  first.result = placer.place(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order,
+                              timed ? progress.deadline() : std::chrono::steady_clock::time_point::max());
+  first.layout = placer.layout();
+  first.placed = first.result.placements.size();
+  if (first.placed == parts.size()) {
+    const auto cost = layoutCost(first.result, parts);
+    progress.improved(cost, {"nesting", "first layout", parts.size(), parts.size(), cost.first, cost.second});
+  }
+  return first;
+}
+
+NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, unsigned search,
+                           SharedProgress& progress, const core::WorkContext& context) {
+  const std::vector<NestingPart>& parts = shapes.parts();
+  const NestingOptions& options = shapes.options();
+  BottomLeftPacker packer(shapes, &context.cancellation());
+  std::vector<int> sequence = first.sequence;
   // Window: start from the strict layout (nothing moves) and accept only
   // layouts in which no part is cut more than `window` places from its order.
   auto withinWindow = [&](const NestingResult& result) {
@@ -91,15 +117,9 @@ NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProg
     return true;
   };
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
-  // The first layout can take many seconds (25 s for 100 long strips): say so.
-  progress.remark(search, {"nesting", "first layout", 0, parts.size()});
-  placer.onProgress = [&](size_t placed, size_t of, size_t sheets) {
-    if (placed > 0) progress.remark(search, {"nesting", "first layout", placed, of, static_cast<int>(sheets)});
-  };
-  NestingResult best = placer.place(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order);
-  std::vector<PlacedShape> bestLayout = placer.layout();
+  NestingResult best = first.result;
+  std::vector<PlacedShape> bestLayout = first.layout;
   auto bestCost = layoutCost(best, parts);
-  progress.improved(bestCost, {"nesting", "first layout", parts.size(), parts.size(), bestCost.first, bestCost.second});
   // On beds, no layout has fewer sheets than the parts' area fills: once
   // there, the search stops (what it could still do, shorten the last
   // sheet, is not worth the user's wait).

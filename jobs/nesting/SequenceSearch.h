@@ -1,7 +1,7 @@
 #pragma once
-// One search for a layout (jobs/Nesting.h): the first layout by the
+// One search for a layout (jobs/Nesting.h): from the first layout by the
 // collision placer (CollisionPlacer.h) in assembly order (largest first in
-// free order); then, on jobs of up to kMostPartsForNoFitPolygons parts, a
+// free order), made once for all searches, on jobs of up to kMostPartsForNoFitPolygons parts, a
 // local search over the sequence and the rotations by bottom-left placement
 // on no-fit polygons (BottomLeftPacker.h), as in Jakobs 1996 and Gomes and
 // Oliveira 2002 (swap two parts, within the window when the order is
@@ -51,9 +51,26 @@ class SharedProgress {
   std::chrono::steady_clock::time_point lastReport_;
 };
 
-// Search number `search` (seed options.seed + search) on the shared shapes.
+// The first layout, the same for every search and so made once: the
+// collision placer in assembly order, or for free order the largest parts
+// first; in window order, the strict layout (nothing moves).
+struct FirstLayout {
+  std::vector<int> sequence;        // the parts in the order they were placed
+  NestingResult result;             // the parts placed, in cutting order
+  std::vector<PlacedShape> layout;  // the same, the beds side by side (CollisionPlacer::layout())
+  // How many of `sequence` were placed: all, unless the budget ran out
+  // first (never with a cap on layouts, nor in the strip).
+  size_t placed = 0;
+};
+
 // Throws core::Cancelled when the context is cancelled.
-NestingResult searchLayout(const PartShapes& shapes, unsigned search, SharedProgress& progress,
-                           const core::WorkContext& context);
+// The parts' shapes are built as the layout reaches them.
+FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core::WorkContext& context);
+
+// Search number `search` (seed options.seed + search) on the shared shapes,
+// from a complete first layout, once every shape is built. Throws core::Cancelled when the context is
+// cancelled.
+NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, unsigned search,
+                           SharedProgress& progress, const core::WorkContext& context);
 
 }  // namespace rotafab::jobs::nesting

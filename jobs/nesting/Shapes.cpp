@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <stdexcept>
 #include <tuple>
 
@@ -204,8 +205,65 @@ Path translatedPath(const Path& path, IntPoint by) {
   return out;
 }
 
+namespace {
+
+// Quarter turns of a whole number of them (rotatedPoint() is exact for
+// those), else -1.
+int quarterTurns(double degrees) {
+  const double quarters = degrees / 90.0;
+  if (std::abs(quarters - std::round(quarters)) >= 1e-12) return -1;
+  return static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
+}
+
+// `shape` turned by `quarters` quarter turns about the origin: on the grid
+// exactly, so the turned shape holds the turned outline as the first holds
+// the first (rotated() turns the outline exactly too). A quarter of the
+// work of making it again: the offsets by Clipper and the poles were most
+// of the cost of a large job's shapes.
+Shape turnedShape(const Shape& from, int quarters, double rotation) {
+  const auto turn = [quarters](IntPoint p) {
+    for (int k = 0; k < quarters; ++k) p = {-p.Y, p.X};
+    return p;
+  };
+  const auto turnPath = [&](const Path& path) {
+    Path out;
+    out.reserve(path.size());
+    for (const IntPoint& p : path) out.push_back(turn(p));
+    return out;
+  };
+  const auto turnBox = [&](cInt minX, cInt minY, cInt maxX, cInt maxY) {
+    const IntPoint a = turn({minX, minY}), b = turn({maxX, maxY});
+    return Box{std::min(a.X, b.X), std::min(a.Y, b.Y), std::max(a.X, b.X), std::max(a.Y, b.Y)};
+  };
+  Shape shape;
+  shape.rotation = rotation;
+  shape.grown = turnPath(from.grown);
+  shape.negated = turnPath(from.negated);
+  for (const Path& piece : from.pieces) shape.pieces.push_back(turnPath(piece));
+  for (const Path& piece : from.negatedPieces) shape.negatedPieces.push_back(turnPath(piece));
+  for (const Path& piece : shape.pieces) shape.pieceBoxes.push_back(boxOf(piece));
+  for (const Path& piece : shape.negatedPieces) shape.negatedPieceBoxes.push_back(boxOf(piece));
+  for (const IntPoint& c : from.centres) shape.centres.push_back(turn(c));
+  shape.radius = from.radius;
+  for (const Shape::Pole& pole : from.poles) shape.poles.push_back({turn(pole.centre), pole.radius});
+  shape.diameter = from.diameter;
+  shape.size = from.size;
+  shape.core = turnPath(from.core);
+  shape.coreBox = boxOf(shape.core);
+  std::tie(shape.grownMinX, shape.grownMinY, shape.grownMaxX, shape.grownMaxY) =
+      std::tuple_cat(turnBox(from.grownMinX, from.grownMinY, from.grownMaxX, from.grownMaxY));
+  std::tie(shape.minX, shape.minY, shape.maxX, shape.maxY) =
+      std::tuple_cat(turnBox(from.minX, from.minY, from.maxX, from.maxY));
+  return shape;
+}
+
+}  // namespace
+
 Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
                 const Shape* turnedFrom) {
+  if (turnedFrom && quarterTurns(rotation) >= 0 && quarterTurns(turnedFrom->rotation) >= 0) {
+    return turnedShape(*turnedFrom, (quarterTurns(rotation) - quarterTurns(turnedFrom->rotation) + 4) % 4, rotation);
+  }
   Shape shape;
   shape.rotation = rotation;
   Path path = toPath(rotated(outline, rotation));
@@ -367,49 +425,32 @@ bool coresOverlap(const Shape& a, IntPoint atA, const Shape& b, IntPoint atB) {
 PartShapes::PartShapes(const std::vector<NestingPart>& parts, const NestingOptions& options,
                        const core::WorkContext& context)
     : parts_(parts), options_(options), roomScale_(roomScaleFor(toInt(options.height))) {
-  // The poles and discs of 3674 bunny panels in 4 rotations: 20 s on one core.
   shapes_.resize(parts.size());
-  context.parallelFor(parts.size(), [&](size_t i) {
-    shapes_[i].reserve(parts[i].rotations.size());  // the first stays where the others are turned from
-    for (double rotation : parts[i].rotations) {
-      shapes_[i].push_back(makeShape(parts[i].outline, rotation, options.spacing, roomScale_.radiusStep,
-                                     forNoFitPolygons(), shapes_[i].empty() ? nullptr : &shapes_[i].front()));
-    }
-  });
-  for (const auto& shapes : shapes_) area_.push_back(std::abs(ClipperLib::Area(shapes.front().grown)));
-  std::map<std::vector<cInt>, int> classes;
-  for (const auto& shapes : shapes_) {
-    classOf_.emplace_back();
-    for (const Shape& shape : shapes) {
-      std::vector<cInt> key;
-      for (const IntPoint& p : shape.grown) key.insert(key.end(), {p.X, p.Y});
-      const auto [it, added] = classes.emplace(std::move(key), static_cast<int>(classSize_.size()));
-      if (added) classSize_.push_back(0);
-      ++classSize_[it->second];
-      classOf_.back().push_back(it->second);
-    }
-  }
-  for (const auto& shapes : shapes_) {
+  area_.assign(parts.size(), 0);
+  built_.assign(parts.size(), 0);
+  // The true outline's box in each rotation (what makeShape() finds), to
+  // check the fit and size the strip before any shape is built.
+  std::vector<std::vector<Box>> boxes(parts.size());
+  for (size_t i = 0; i < parts.size(); ++i) {
     quarterOf_.emplace_back();
     shapeAtQuarter_.push_back({-1, -1, -1, -1});
-    for (size_t k = 0; k < shapes.size(); ++k) {
-      const double quarters = shapes[k].rotation / 90.0;
-      int quarter = -1;
-      if (std::abs(quarters - std::round(quarters)) < 1e-12) {
-        quarter = static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
-        if (shapeAtQuarter_.back()[quarter] < 0) shapeAtQuarter_.back()[quarter] = static_cast<int>(k);
-      }
+    for (size_t k = 0; k < parts[i].rotations.size(); ++k) {
+      const int quarter = quarterTurns(parts[i].rotations[k]);
+      if (quarter >= 0 && shapeAtQuarter_.back()[quarter] < 0) shapeAtQuarter_.back()[quarter] = static_cast<int>(k);
       quarterOf_.back().push_back(quarter);
+      boxes[i].push_back(boxOf(toPath(rotated(parts[i].outline, parts[i].rotations[k]))));
     }
     const auto& at = shapeAtQuarter_.back();
     firstQuarter_.push_back(
         static_cast<int>(std::find_if(at.begin(), at.end(), [](int k) { return k >= 0; }) - at.begin()));
   }
+  const auto widthOf = [](const Box& box) { return box[2] - box[0]; };
+  const auto heightOf = [](const Box& box) { return box[3] - box[1]; };
   if (options.strip) {
     // A strip long enough for every part side by side.
-    for (const auto& shapes : shapes_) {
+    for (const auto& partBoxes : boxes) {
       cInt longest = 0;
-      for (const Shape& s : shapes) longest = std::max({longest, s.maxX - s.minX, s.maxY - s.minY});
+      for (const Box& box : partBoxes) longest = std::max({longest, widthOf(box), heightOf(box)});
       width_ += longest + toInt(options_.spacing) + 1;
     }
   } else {
@@ -420,14 +461,94 @@ PartShapes::PartShapes(const std::vector<NestingPart>& parts, const NestingOptio
   // the simplification each, with mitres), in any unit.
   if (!options.strip) pitch_ = width_ + 2 * toInt(options.spacing) + toInt(1.0);
   for (size_t i = 0; i < parts.size(); ++i) {
-    const bool fits = std::any_of(shapes_[i].begin(), shapes_[i].end(), [&](const Shape& s) {
-      return s.maxX - s.minX <= width_ && s.maxY - s.minY <= height_;
-    });
+    const bool fits = std::any_of(boxes[i].begin(), boxes[i].end(),
+                                  [&](const Box& box) { return widthOf(box) <= width_ && heightOf(box) <= height_; });
     if (!fits) {
-      const Shape& s = shapes_[i].front();
+      const Box& box = boxes[i].front();
       throw std::invalid_argument(fmt::format(
           "{} ({:.4g} x {:.4g}) does not fit the usable area of {:.4g} x {:.4g} in any allowed rotation", parts[i].name,
-          (s.maxX - s.minX) / kScale, (s.maxY - s.minY) / kScale, options.strip ? 0.0 : options.width, options.height));
+          widthOf(box) / kScale, heightOf(box) / kScale, options.strip ? 0.0 : options.width, options.height));
+    }
+  }
+  // Grown with mitres (limit 2) by half the spacing and the
+  // simplification's tolerance, a shape's box is at most twice that wider
+  // each side than the true outline's.
+  const cInt overhang = 2 * toInt(options.spacing / 2 + kSimplifyTolerance) + 2;
+  std::vector<double> poleBounds;
+  for (const auto& partBoxes : boxes) {
+    const Box& box = partBoxes.front();
+    sizeBound_.push_back(std::max(widthOf(box), heightOf(box)) + 2 * overhang);
+    poleBounds.push_back(static_cast<double>(std::min(widthOf(box), heightOf(box))) / 2 + overhang);
+  }
+  // The largest pole: the parts whose bound is largest built, until the
+  // next bound is no more than the largest pole found (or a few dozen
+  // parts: copies have equal bounds), and that bound kept if larger.
+  std::vector<int> byBound(parts.size());
+  std::iota(byBound.begin(), byBound.end(), 0);
+  std::stable_sort(byBound.begin(), byBound.end(), [&](int a, int b) { return poleBounds[a] > poleBounds[b]; });
+  constexpr size_t kMostBuiltForTheBound = 32;
+  const size_t tried = std::min(byBound.size(), kMostBuiltForTheBound);
+  buildParts({byBound.begin(), byBound.begin() + static_cast<long>(tried)}, context);
+  double largest = 0;
+  for (size_t k = 0; k < byBound.size(); ++k) {
+    const int part = byBound[k];
+    if (poleBounds[part] <= largest) break;
+    if (!built(part)) {
+      largest = poleBounds[part];
+      break;
+    }
+    if (!shapes_[part].front().poles.empty()) largest = std::max(largest, shapes_[part].front().poles.front().radius);
+  }
+  largestPoleBound_ = largest;
+}
+
+void PartShapes::build(std::span<const int> which, const core::WorkContext& context) {
+  std::vector<int> parts;
+  for (int part : which) {
+    if (!built(part)) parts.push_back(part);
+  }
+  std::sort(parts.begin(), parts.end());
+  parts.erase(std::unique(parts.begin(), parts.end()), parts.end());
+  buildParts(parts, context);
+}
+
+void PartShapes::buildParts(const std::vector<int>& parts, const core::WorkContext& context) {
+  // The poles of 3674 bunny panels: 3 s on one core.
+  context.parallelFor(parts.size(), [&](size_t k) {
+    const size_t i = static_cast<size_t>(parts[k]);
+    if (built_[i]) return;
+    std::vector<Shape>& shapes = shapes_[i];
+    shapes.reserve(parts_[i].rotations.size());  // the first stays where the others are turned from
+    for (double rotation : parts_[i].rotations) {
+      shapes.push_back(makeShape(parts_[i].outline, rotation, options_.spacing, roomScale_.radiusStep,
+                                 forNoFitPolygons(), shapes.empty() ? nullptr : &shapes.front()));
+    }
+    area_[i] = std::abs(ClipperLib::Area(shapes.front().grown));
+  });
+  for (int part : parts) built_[static_cast<size_t>(part)] = 1;
+}
+
+void PartShapes::buildAll(const core::WorkContext& context) {
+  std::vector<int> all(parts_.size());
+  std::iota(all.begin(), all.end(), 0);
+  build(all, context);
+  largestPoleBound_ = 0;
+  for (const auto& shapes : shapes_) {
+    for (const Shape& shape : shapes) {
+      if (!shape.poles.empty()) largestPoleBound_ = std::max(largestPoleBound_, shape.poles.front().radius);
+    }
+  }
+  if (!classOf_.empty()) return;
+  std::map<std::vector<cInt>, int> classes;
+  for (const auto& shapes : shapes_) {
+    classOf_.emplace_back();
+    for (const Shape& shape : shapes) {
+      std::vector<cInt> key;
+      for (const IntPoint& p : shape.grown) key.insert(key.end(), {p.X, p.Y});
+      const auto [it, added] = classes.emplace(std::move(key), static_cast<int>(classSize_.size()));
+      if (added) classSize_.push_back(0);
+      ++classSize_[it->second];
+      classOf_.back().push_back(it->second);
     }
   }
 }

@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -152,21 +153,41 @@ bool mayGoOn(const PartShapes& shapes, OrderMode policy, const Sheets& sheets, i
 
 // The shapes of every part in every allowed rotation, which parts are
 // copies of one another, and the area they are laid out in, on the grid.
-// Built once for a nesting run, the parts shared out on the context's
-// executor; read-only after, shared by its searches. Throws
-// std::invalid_argument naming a part that fits the area in no allowed
-// rotation, core::Cancelled.
+// The shapes are built as they are needed, some parts at a time (build()),
+// the parts shared out on the context's executor: the first layout builds
+// them just ahead of the parts it places, so that a time budget that runs
+// out in it has not been spent on shapes it never reached (a 25,888-part
+// job's took 6 s). Once buildAll() has run, read-only, shared by the
+// searches.
 class PartShapes {
  public:
+  // Builds the few shapes that largestPoleBound() needs. Throws
+  // std::invalid_argument naming a part that fits the area in no allowed
+  // rotation, core::Cancelled.
   PartShapes(const std::vector<NestingPart>& parts, const NestingOptions& options, const core::WorkContext& context);
+
+  // Builds the shapes of `which` not built yet. Throws core::Cancelled.
+  void build(std::span<const int> which, const core::WorkContext& context);
+  // Builds every part's shapes and finds the copies (classOf()), which the
+  // searches need. Throws core::Cancelled.
+  void buildAll(const core::WorkContext& context);
+  [[nodiscard]] bool built(int part) const { return built_[part] != 0; }
+
+  // At least the radius of any part's largest pole (Shape::poles), in grid
+  // units: exact once every shape is built, else from the parts' boxes
+  // (a disc inside a grown shape is no wider than its box), made exact for
+  // the parts that could have the largest.
+  [[nodiscard]] double largestPoleBound() const { return largestPoleBound_; }
+  // The largest side of each part's box (its first rotation, grown), in grid units.
+  [[nodiscard]] cInt sizeBound(int part) const { return sizeBound_[part]; }
 
   [[nodiscard]] const std::vector<NestingPart>& parts() const { return parts_; }
   [[nodiscard]] const NestingOptions& options() const { return options_; }
   [[nodiscard]] const std::vector<Shape>& of(int part) const { return shapes_[part]; }
   [[nodiscard]] const Shape& at(int part, int shape) const { return shapes_[part][shape]; }
   [[nodiscard]] const Shape& of(const PlacedShape& p) const { return shapes_[p.part][p.shape]; }
-  [[nodiscard]] double area(int part) const { return area_[part]; }  // grown, square grid units
-  // Shapes that are exact copies share a class (one per part and rotation).
+  [[nodiscard]] double area(int part) const { return area_[part]; }  // grown, square grid units; once built
+  // Shapes that are exact copies share a class (one per part and rotation); after buildAll().
   [[nodiscard]] int classOf(int part, int shape) const { return classOf_[part][shape]; }
   [[nodiscard]] int classSize(int shapeClass) const { return classSize_[shapeClass]; }
   // Each shape's rotation in quarter turns (0-3; -1 when it is not one), and
@@ -209,7 +230,11 @@ class PartShapes {
   std::vector<std::array<int, 4>> shapeAtQuarter_;
   std::vector<int> firstQuarter_;
   std::vector<double> area_;
+  std::vector<char> built_;
+  std::vector<cInt> sizeBound_;
+  double largestPoleBound_ = 0;
   cInt width_ = 0, height_ = 0, pitch_ = 0;
+  void buildParts(const std::vector<int>& parts, const core::WorkContext& context);
 };
 
 template <typename Sheets>

@@ -4,6 +4,7 @@
 
 #include "jobs/nesting/CellCover.h"
 #include "jobs/nesting/ConvexPieces.h"
+#include "support/ClipperSupport.h"
 
 #include <gtest/gtest.h>
 
@@ -20,20 +21,8 @@ using ClipperLib::IntPoint;
 using ClipperLib::Path;
 using ClipperLib::Paths;
 
-double areaOf(const Paths& paths) {
-  double area = 0;
-  for (const Path& p : paths) area += ClipperLib::Area(p);
-  return area;
-}
-
-Paths boolean(ClipperLib::ClipType type, const Paths& a, const Paths& b) {
-  ClipperLib::Clipper clipper;
-  clipper.AddPaths(a, ClipperLib::ptSubject, true);
-  clipper.AddPaths(b, ClipperLib::ptClip, true);
-  Paths out;
-  clipper.Execute(type, out, ClipperLib::pftNonZero, ClipperLib::pftNonZero);
-  return out;
-}
+using test::areaOf;
+using test::boolean;
 
 // Concave polygons on the grid: stars, wavy strips, combs, and random
 // star-shaped polygons (every ray from the centre crosses the boundary once).

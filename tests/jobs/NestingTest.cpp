@@ -5,6 +5,7 @@
 #include "jobs/Nesting.h"
 #include "jobs/RowLayout.h"
 
+#include "support/NestingParts.h"
 #include "support/TestContext.h"
 
 #include <gtest/gtest.h>
@@ -22,58 +23,9 @@
 namespace rotafab::jobs {
 namespace {
 
-// A star-shaped vertex panel: `spikes` points between two radii.
-Polygon2 star(std::mt19937& random, int spikes, double outer) {
-  std::uniform_real_distribution<double> inner(0.3, 0.7), jitter(0.85, 1.0);
-  Polygon2 p;
-  const double ratio = inner(random);
-  for (int i = 0; i < 2 * spikes; ++i) {
-    const double angle = std::numbers::pi * i / spikes;
-    const double r = (i % 2 ? ratio : 1.0) * outer * jitter(random);
-    p.emplace_back(r * std::cos(angle), r * std::sin(angle));
-  }
-  return p;
-}
-
-// A long wavy strip, like an unfolded woven ribbon.
-Polygon2 wavyStrip(std::mt19937& random, double length, double width) {
-  std::uniform_real_distribution<double> amplitude(0.1, 0.6);
-  const double a = amplitude(random);
-  const int steps = 24;
-  Polygon2 p;
-  for (int i = 0; i <= steps; ++i) {
-    const double x = length * i / steps;
-    p.emplace_back(x, a * std::sin(2 * std::numbers::pi * x / length * 2));
-  }
-  for (int i = steps; i >= 0; --i) {
-    const double x = length * i / steps;
-    p.emplace_back(x, width + a * std::sin(2 * std::numbers::pi * x / length * 2));
-  }
-  return p;
-}
-
-std::vector<NestingPart> randomParts(unsigned seed, int count) {
-  std::mt19937 random(seed);
-  std::vector<NestingPart> parts;
-  for (int i = 0; i < count; ++i) {
-    NestingPart part;
-    part.name = "panel " + std::to_string(i + 1);
-    part.order = i;
-    switch (random() % 4) {
-      case 0:
-        part.outline = wavyStrip(random, 6.0 + random() % 10, 0.6);
-        break;
-      case 1:
-        part.outline = star(random, 3 + random() % 3, 0.2 + (random() % 10) / 20.0);
-        break;  // tiny
-      default:
-        part.outline = star(random, 4 + random() % 8, 1.0 + (random() % 30) / 10.0);
-        break;
-    }
-    parts.push_back(std::move(part));
-  }
-  return parts;
-}
+using test::randomParts;
+using test::star;
+using test::wavyStrip;
 
 void expectValid(const std::vector<NestingPart>& parts, const NestingResult& result, const NestingOptions& options) {
   EXPECT_EQ(layoutProblems(parts, result, options), std::vector<std::string>{});
@@ -218,12 +170,41 @@ TEST(Nesting, TheSearchStopsAtTheAreaBound) {
   expectValid(parts, result, options);
 }
 
-TEST(Nesting, SameSeedNoBudgetSameLayout) {
+// The budget holds for the first layout too: with none, the parts are
+// laid out in rows by their boxes, and said so.
+TEST(Nesting, NoBudgetLaysThePartsOutInRows) {
   const auto parts = randomParts(11, 12);
   NestingOptions options;
   options.seconds = 0;
-  const NestingResult a = nest(parts, options, test::context()), b = nest(parts, options, test::context());
-  expectSameLayout(a, b);
+  const NestingResult result = nest(parts, options, test::context());
+  expectValid(parts, result, options);
+  EXPECT_EQ(result.inRows, static_cast<int>(parts.size()));
+  expectSameLayout(result, rowLayout(parts, options));
+  EXPECT_EQ(inRowsNote(result).rfind("the time budget ran out before the first layout began: the 12 parts", 0), 0u)
+      << inRowsNote(result);
+}
+
+// When the budget runs out in the first layout, the parts it placed stay
+// where they are and the rest follow in rows, on sheets of their own.
+TEST(Nesting, ABudgetThatRunsOutInTheFirstLayoutKeepsItsPartsAndRowsTheRest) {
+  const auto parts = randomParts(23, 3000);
+  NestingOptions options;
+  options.seconds = 0.2;  // (3000 parts take over a second)
+  const NestingResult result = nest(parts, options, test::context());
+  expectValid(parts, result, options);
+  ASSERT_EQ(result.placements.size(), parts.size());
+  EXPECT_GT(result.inRows, 0);
+  const std::string note = inRowsNote(result);
+  EXPECT_NE(note.find(" of 3000 parts: the other " + std::to_string(result.inRows) + " are laid out in rows"),
+            std::string::npos)
+      << note;
+  std::vector<int> perSheet(static_cast<size_t>(result.sheets) + 1, 0);
+  for (const PartPlacement& p : result.placements) ++perSheet.at(static_cast<size_t>(p.sheet));
+  for (int s = 1; s <= result.sheets; ++s) EXPECT_GT(perSheet[static_cast<size_t>(s)], 0) << "sheet " << s;
+  // In cutting order: the first layout's sheets, then the rows'.
+  for (size_t i = 1; i < result.placements.size(); ++i) {
+    EXPECT_LE(result.placements[i - 1].sheet, result.placements[i].sheet);
+  }
 }
 
 TEST(Nesting, SameSeedAndEvaluationsSameLayoutWhateverTheClock) {
@@ -270,7 +251,7 @@ TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
   options.order = OrderMode::Strict;
   options.width = 15;
   options.height = 10;
-  options.seconds = 0;
+  options.evaluations = 1;  // the first layout only
   const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   // In cutting order the assembly order never goes down.
