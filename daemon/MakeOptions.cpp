@@ -26,6 +26,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.scoreFolds = options.scoreFolds;
   if (!options.kerf.empty()) request.kerf = lengthOption(options.kerf, "--kerf");
   request.seconds = options.seconds;
+  request.evaluations = options.evaluations;
   request.order = orderOption(options.order);
   request.freeOrderWhenItSavesSheets = !options.orderGiven;
   request.window = options.window;
@@ -81,6 +82,10 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
                   "by then is kept; parts the first layout has not reached by then go in rows (with a note)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
+  make.add_option("--evaluations", options.evaluations,
+                  "Stop the nesting's searches after this many layouts each, the first included: with a --time\n"
+                  "long enough, the same sheets on every machine of as many cores (1: the first layout only)")
+      ->check(CLI::Range(0, 1000000000));
   make.add_option("--order", options.order,
                   "Cutting order: strict, window or free (see `rotafab nest`); by default window, or free where\n"
                   "keeping to the window would cost a sheet")

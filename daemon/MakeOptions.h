@@ -19,7 +19,7 @@ struct MakeOptions {
   bool orderGiven = false;  // --order given: kept even where the free order would save a sheet
   std::optional<double> scale, tension, mergeCoplanar;
   std::optional<int> start, panels;
-  int samples = 8, window = 8;
+  int samples = 8, window = 8, evaluations = 0;
   double seconds = jobs::kDefaultNestingSeconds;
   bool json = false, scoreFolds = false;
 };

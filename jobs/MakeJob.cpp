@@ -406,6 +406,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   PlanOptions plan;
   plan.kerf = request.kerf.value_or(request.material.kerf);
   plan.seconds = request.seconds;
+  plan.evaluations = request.evaluations;
   plan.order = request.order;
   plan.window = request.window;
   plan.freeOrderWhenItSavesSheets = request.freeOrderWhenItSavesSheets;

@@ -53,6 +53,7 @@ struct MakeRequest {
   // The planner's (jobs/SheetPlanner.h).
   std::optional<double> kerf;  // default: the material's
   double seconds = kDefaultNestingSeconds;
+  int evaluations = 0;                  // as NestingOptions'
   std::optional<SheetFormats> formats;  // unset: defaultFormats(machine)
   OrderMode order = OrderMode::Window;
   int window = 8;

@@ -9,10 +9,11 @@
 // moves them apart again (OverlapCompaction.h): it shortens the strip, or on
 // beds the last sheet, whose parts move onto the earlier ones. Parts are
 // concave and interlock; bounding boxes and hulls are never used for
-// collisions. The first layout is deterministic; the searches (side by
-// side on the context's executor) each follow a course fixed by their seed,
-// and the time budget decides how far along they get, so with a budget the
-// result can differ between machines (a cap on layouts, `evaluations`,
+// collisions. The first layout is deterministic unless the budget runs
+// out in it (NestingOptions::seconds); the searches (side by side on the
+// context's executor, from that one first layout) each follow a course
+// fixed by their seed, and the time budget decides how far along they
+// get, so with a budget the result can differ between machines (a cap on layouts, `evaluations`,
 // makes it the same everywhere for the same `threads`).
 //
 // Coordinates in inches; a placement rotates the part's outline about its own
@@ -62,6 +63,10 @@ struct NestingOptions {
   // best layout it found. Not with a cap on layouts (`evaluations`), nor
   // in the strip: the first layout is then always finished.
   double seconds = kDefaultNestingSeconds;
+  // The first layout's own budget, from the call, when it is longer than
+  // `seconds` (0: `seconds`): `make` gives the window order half the
+  // budget to improve its layout, but its first layout the whole of it.
+  double firstLayoutSeconds = 0;
   int evaluations = 0;  // if positive, each search stops after this many layouts (and compaction moves)
   OrderMode order = OrderMode::Free;
   int window = 8;

@@ -16,6 +16,10 @@ NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOpti
   std::iota(sequence.begin(), sequence.end(), 0);
   std::stable_sort(sequence.begin(), sequence.end(), [&](int a, int b) { return parts[a].order < parts[b].order; });
 
+  // What the nester's grid may round away (1/10000 in): a part it takes
+  // for fitting the area fits here too (nest() lays the parts its budget
+  // had no time for out here).
+  const double width = options.width + 1e-4, height = options.height + 1e-4;
   NestingResult result;
   // The current row: from y = rowY, `rowHeight` high, filled up to x = rowX.
   double rowX = 0, rowY = 0, rowHeight = 0;
@@ -29,7 +33,7 @@ NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOpti
     for (double rotation : part.rotations) {
       const auto [min, max] = rotatedBox(part.outline, rotation);
       const Point2 size = max - min;
-      if (size.x() > options.width || size.y() > options.height) continue;
+      if (size.x() > width || size.y() > height) continue;
       const Point2 bestSize = high - low;
       if (!fits || size.y() < bestSize.y() || (size.y() == bestSize.y() && size.x() < bestSize.x())) {
         bestRotation = rotation, low = min, high = max, fits = true;
@@ -42,11 +46,11 @@ NestingResult rowLayout(const std::vector<NestingPart>& parts, const NestingOpti
     }
     const Point2 size = high - low;
     if (sheet == 0) sheet = 1;
-    if (rowX > 0 && rowX + size.x() > options.width) {  // the next row
+    if (rowX > 0 && rowX + size.x() > width) {  // the next row
       rowY += rowHeight + options.spacing;
       rowX = 0, rowHeight = 0;
     }
-    if (rowY + size.y() > options.height) {  // the next sheet
+    if (rowY + size.y() > height) {  // the next sheet
       ++sheet;
       rowX = 0, rowY = 0, rowHeight = 0;
     }

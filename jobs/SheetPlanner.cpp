@@ -57,9 +57,12 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.height = bed.height - 2 * bed.margin;
   nesting.spacing = options.spacing >= 0 ? options.spacing : 1.0 / 16 + options.kerf;
   // One budget for the whole nesting: with the free order as a fallback,
-  // the window order has half of it and the free order what is left.
+  // the window order has half of it to improve its first layout (which
+  // may take all of it) and the free order what is left.
   const bool fallback = !options.rows && options.freeOrderWhenItSavesSheets && options.order == OrderMode::Window;
   nesting.seconds = fallback ? options.seconds / 2 : options.seconds;
+  nesting.firstLayoutSeconds = options.seconds;
+  nesting.evaluations = options.evaluations;
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
@@ -71,8 +74,9 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   if (fallback && nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting) && took < options.seconds) {
     NestingOptions free = nesting;
     free.order = OrderMode::Free;
-    // What is left of the budget; a first layout is made whatever is left.
+    // What is left of the budget.
     free.seconds = std::max(0.0, options.seconds - took);
+    free.firstLayoutSeconds = 0;
     NestingResult loose = nest(nestingParts, free, context);
     if (loose.sheets < nested.sheets) windowSheets = nested.sheets, nested = std::move(loose);
   }

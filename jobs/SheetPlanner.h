@@ -21,12 +21,13 @@ struct PlanOptions {
   double kerf = 0.0;                        // from the material profile
   double spacing = -1.0;                    // between two cut paths; negative: 1/16 in of material plus the kerf
   double seconds = kDefaultNestingSeconds;  // the whole nesting's budget (NestingOptions::seconds)
+  int evaluations = 0;                      // NestingOptions::evaluations
   OrderMode order = OrderMode::Window;
   int window = 8;
   // With the window: when the free order fits the parts on fewer sheets,
-  // take it (SheetPlan::windowSheets says so). Tried only when the first
-  // layout came quickly (within twice the time budget, or 10 s): a large
-  // job would wait twice as long for it.
+  // take it (SheetPlan::windowSheets says so). The window order has half
+  // the budget to improve its layout (its first layout, all of it), the
+  // free order what is left, if any.
   bool freeOrderWhenItSavesSheets = false;
   unsigned seed = 1;
   bool rows = false;  // rowLayout() instead of nest(): seconds for any size, more sheets

@@ -111,13 +111,14 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
   size_t aheadTo = 0;  // beforeParts has been called for the sequence up to here
   for (size_t index = 0; index < sequence.size(); ++index) {
     if (cancellation_) cancellation_->check();
+    if (timed && std::chrono::steady_clock::now() >= deadline) break;
     if (beforeParts && index == aheadTo) {
       aheadTo = std::min(sequence.size(), index + kPartsAhead);
       beforeParts(std::span<const int>(sequence).subspan(index, aheadTo - index));
     }
-    if (timed && std::chrono::steady_clock::now() >= deadline) break;
-    if (onProgress) onProgress(index, sequence.size(), sheets.size());
     const int part = sequence[index];
+    if (!shapes_.built(part)) throw std::logic_error("internal: a part is placed before its shapes are built");
+    if (onProgress) onProgress(index, sequence.size(), sheets.size());
     bool done = false;
     // First fit over the sheets still open: the last kOpenSheets.
     const int openFrom = std::max(0, static_cast<int>(sheets.size()) - kOpenSheets);

@@ -9,7 +9,8 @@
 //
 // Which places are worth an exact test comes from a clearance raster per
 // sheet: for each cell, how far its centre is from the nearest placed
-// shape (capped at the largest pole of any part, and a cell). A pole of radius r can
+// shape (capped at a bound on any part's largest pole, and a cell:
+// PartShapes::largestPoleBound()). A pole of radius r can
 // only go where the clearance is at least r, less half a cell's diagonal,
 // so a part's largest poles rule out nearly every place on a filling sheet
 // by table lookups, and a sheet (or a column of it) with no room for the
@@ -22,8 +23,8 @@
 // and Huttenlocher 2012) of that window.
 //
 // Sheets fill first fit (a strict order: only the last one), with the
-// same order window as the bottom-left packer. One placer per search; not
-// for two threads at once.
+// same order window as the bottom-left packer. One placer per first
+// layout; not for two threads at once.
 
 #include <chrono>
 #include <cstddef>

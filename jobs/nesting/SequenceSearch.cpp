@@ -61,9 +61,9 @@ void SharedProgress::stillSearching(unsigned search) {
   report(progress);
 }
 
-std::chrono::steady_clock::time_point SharedProgress::deadline() const {
+std::chrono::steady_clock::time_point SharedProgress::deadlineAfter(double seconds) const {
   return started_ + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                        std::chrono::duration<double>(std::max(0.0, budget_)));
+                        std::chrono::duration<double>(std::max(0.0, seconds)));
 }
 
 FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core::WorkContext& context) {
@@ -91,7 +91,8 @@ FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core
   // parts could go nowhere else).
   const bool timed = options.evaluations <= 0 && !options.strip;
   first.result = placer.place(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order,
-                              timed ? progress.deadline() : std::chrono::steady_clock::time_point::max());
+                              timed ? progress.deadlineAfter(std::max(options.seconds, options.firstLayoutSeconds))
+                                    : std::chrono::steady_clock::time_point::max());
   first.layout = placer.layout();
   first.placed = first.result.placements.size();
   if (first.placed == parts.size()) {

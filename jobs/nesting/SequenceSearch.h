@@ -38,7 +38,9 @@ class SharedProgress {
   void remark(unsigned search, core::Progress progress);
   void improved(const std::pair<int, double>& cost, core::Progress progress);
   void stillSearching(unsigned search);
-  [[nodiscard]] std::chrono::steady_clock::time_point deadline() const;
+  [[nodiscard]] std::chrono::steady_clock::time_point deadline() const { return deadlineAfter(budget_); }
+  // `seconds` from the start of the nesting.
+  [[nodiscard]] std::chrono::steady_clock::time_point deadlineAfter(double seconds) const;
 
  private:
   void report(core::Progress& progress);

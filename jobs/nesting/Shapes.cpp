@@ -480,24 +480,34 @@ PartShapes::PartShapes(const std::vector<NestingPart>& parts, const NestingOptio
     sizeBound_.push_back(std::max(widthOf(box), heightOf(box)) + 2 * overhang);
     poleBounds.push_back(static_cast<double>(std::min(widthOf(box), heightOf(box))) / 2 + overhang);
   }
-  // The largest pole: the parts whose bound is largest built, until the
-  // next bound is no more than the largest pole found (or a few dozen
-  // parts: copies have equal bounds), and that bound kept if larger.
+  // The largest pole: the parts taken in decreasing order of their bound
+  // and built one at a time (a copy of one built counts as built), until
+  // the next bound is no more than the largest pole found; past a few
+  // dozen builds, that next bound is kept instead.
   std::vector<int> byBound(parts.size());
   std::iota(byBound.begin(), byBound.end(), 0);
   std::stable_sort(byBound.begin(), byBound.end(), [&](int a, int b) { return poleBounds[a] > poleBounds[b]; });
   constexpr size_t kMostBuiltForTheBound = 32;
-  const size_t tried = std::min(byBound.size(), kMostBuiltForTheBound);
-  buildParts({byBound.begin(), byBound.begin() + static_cast<long>(tried)}, context);
+  std::vector<int> builtForTheBound;
   double largest = 0;
-  for (size_t k = 0; k < byBound.size(); ++k) {
-    const int part = byBound[k];
+  for (int part : byBound) {
     if (poleBounds[part] <= largest) break;
-    if (!built(part)) {
-      largest = poleBounds[part];
-      break;
+    const auto copyOf = [&](int other) {
+      return poleBounds[other] == poleBounds[part] && parts[other].rotations == parts[part].rotations &&
+             parts[other].outline == parts[part].outline;
+    };
+    const auto built = std::find_if(builtForTheBound.begin(), builtForTheBound.end(), copyOf);
+    const int measured = built == builtForTheBound.end() ? part : *built;
+    if (built == builtForTheBound.end()) {
+      if (builtForTheBound.size() == kMostBuiltForTheBound) {
+        largest = poleBounds[part];
+        break;
+      }
+      buildParts({part}, context);
+      builtForTheBound.push_back(part);
     }
-    if (!shapes_[part].front().poles.empty()) largest = std::max(largest, shapes_[part].front().poles.front().radius);
+    const Shape& shape = shapes_[static_cast<size_t>(measured)].front();
+    if (!shape.poles.empty()) largest = std::max(largest, shape.poles.front().radius);
   }
   largestPoleBound_ = largest;
 }

@@ -110,8 +110,10 @@ struct Shape {
 
 // `forNoFitPolygons`: with the convex pieces and discs only the bottom-left
 // packer needs. `turnedFrom`, the same part's shape in another rotation:
-// its poles and discs are turned instead of searched again (their radii
-// less twice kSimplifyTolerance, what the two grown outlines may differ by).
+// for a quarter turn from a quarter turn, the whole shape is turned on the
+// grid, exactly; otherwise its poles and discs are turned instead of
+// searched again (their radii less twice kSimplifyTolerance, what the two
+// grown outlines may differ by).
 Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
                 const Shape* turnedFrom = nullptr);
 

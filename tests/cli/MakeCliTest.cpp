@@ -431,6 +431,31 @@ TEST(MakeCli, TheOrderDoesNotCostASheet) {
   EXPECT_EQ(window.err.find("free order"), std::string::npos);
 }
 
+// A cap on layouts gives the same sheets run after run; a budget spent
+// before the first layout begins lays the panels out in rows, and says so.
+TEST(MakeCli, ACapOnLayoutsGivesTheSameSheetsAndNoBudgetRows) {
+  TempDir dir;
+  const std::string ball = quoted(kSource / "examples/soccer-ball.obj");
+  for (const char* out : {"a", "b"}) {
+    const CommandResult made = run(kCli + " make " + ball + " --structure band --evaluations 8 --formats svg --out " +
+                                   quoted(dir.path() / out));
+    ASSERT_EQ(made.status, 0) << made.err;
+    EXPECT_EQ(made.err.find("in rows"), std::string::npos) << made.err;
+  }
+  EXPECT_EQ(readFile(dir.path() / "a/sheet-001.svg"), readFile(dir.path() / "b/sheet-001.svg"));
+  EXPECT_EQ(readFile(dir.path() / "a/manifest.json"), readFile(dir.path() / "b/manifest.json"));
+  const CommandResult rows =
+      run(kCli + " make " + ball + " --structure band --time 0 --json --out " + quoted(dir.path() / "c"));
+  ASSERT_EQ(rows.status, 0) << rows.err;
+  EXPECT_NE(rows.err.find("soccer-ball.obj: the time budget ran out before the first layout began: the 32 parts are "
+                          "laid out in rows by their boxes"),
+            std::string::npos)
+      << rows.err;
+  const CommandResult refused =
+      run(kCli + " make " + ball + " --structure band --evaluations -1 --out " + quoted(dir.path() / "d"));
+  EXPECT_EQ(refused.status, 2) << refused.err;
+}
+
 // A second make into the same folder replaces the first's files, stale sheets included;
 // an open mesh is built open (boundary edges get no band) or with its holes filled.
 TEST(MakeCli, ReusedFolderAndOpenMeshes) {

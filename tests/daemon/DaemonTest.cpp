@@ -30,7 +30,7 @@ const fs::path& threeSheets() {
   static const fs::path made = [] {
     const fs::path out = folder.path() / "soccer";
     const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
-                                " --structure band --machine grbl-diode-400 --time 1 --out " + quoted(out));
+                                " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
     EXPECT_EQ(r.status, 0) << r.err;
     return out;
   }();

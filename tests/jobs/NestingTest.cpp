@@ -187,15 +187,19 @@ TEST(Nesting, NoBudgetLaysThePartsOutInRows) {
 // When the budget runs out in the first layout, the parts it placed stay
 // where they are and the rest follow in rows, on sheets of their own.
 TEST(Nesting, ABudgetThatRunsOutInTheFirstLayoutKeepsItsPartsAndRowsTheRest) {
-  const auto parts = randomParts(23, 3000);
+  const auto parts = randomParts(23, 6000);
   NestingOptions options;
-  options.seconds = 0.2;  // (3000 parts take over a second)
+  options.seconds = 1;  // (6000 parts take several seconds; the first few hundred, well under one)
   const NestingResult result = nest(parts, options, test::context());
   expectValid(parts, result, options);
   ASSERT_EQ(result.placements.size(), parts.size());
+  std::vector<int> times(parts.size(), 0);
+  for (const PartPlacement& p : result.placements) ++times.at(static_cast<size_t>(p.part));
+  EXPECT_EQ(std::count(times.begin(), times.end(), 1), static_cast<long>(parts.size())) << "each part once";
   EXPECT_GT(result.inRows, 0);
+  EXPECT_LT(result.inRows, static_cast<int>(parts.size()));
   const std::string note = inRowsNote(result);
-  EXPECT_NE(note.find(" of 3000 parts: the other " + std::to_string(result.inRows) + " are laid out in rows"),
+  EXPECT_NE(note.find(" of 6000 parts: the other " + std::to_string(result.inRows) + " are laid out in rows"),
             std::string::npos)
       << note;
   std::vector<int> perSheet(static_cast<size_t>(result.sheets) + 1, 0);
