@@ -86,8 +86,9 @@ TEST(EdgeProjection, OnACubeTheNormalIsTheFacesNormalsMeanAndOnAFlatPairTheirs) 
   // their plane's normal and projecting moves nothing.
   const auto box = prepared(voxelSurface(2, 1, 1, [](int, int, int) { return true; }));
   int flat = 0;
+  const auto regions = edgeRegions(box.mesh, box.rs);
   for (int e = 0; e < box.rs.edgeCount(); ++e) {
-    const EdgeRegion& r = edgeRegions(box.mesh, box.rs)[static_cast<size_t>(e)];
+    const EdgeRegion& r = regions[static_cast<size_t>(e)];
     const Point3 leftCentre = faceCentroid(box.mesh, box.rs.face(2 * e));
     if ((leftCentre - r.leftCentre).norm() > 1e-12) continue;
     ++flat;
