@@ -8,6 +8,12 @@
 
 namespace rotafab::geometry {
 
+Point3 faceNormal(const PolygonMesh& mesh, int face) {
+  std::vector<Point3> corners;
+  for (int v : mesh.faces[static_cast<size_t>(face)]) corners.push_back(mesh.positions[static_cast<size_t>(v)]);
+  return newellNormal(corners);
+}
+
 Point3 newellNormal(const std::vector<Point3>& polygon) {
   Point3 normal = Point3::Zero();
   for (size_t i = 0; i < polygon.size(); ++i) normal += polygon[i].cross(polygon[(i + 1) % polygon.size()]);

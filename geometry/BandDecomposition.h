@@ -56,5 +56,7 @@ BandDecomposition bandDecomposition(const PolygonMesh& mesh, const RotationSyste
 // The unit normal of a polygon by Newell's method (the direction about which
 // it turns counter-clockwise); zero for a degenerate polygon.
 Point3 newellNormal(const std::vector<Point3>& polygon);
+// The Newell normal of a mesh face.
+Point3 faceNormal(const PolygonMesh& mesh, int face);
 
 }  // namespace rotafab::geometry

@@ -10,12 +10,9 @@ namespace rotafab::geometry {
 
 std::vector<EdgeRegion> edgeRegions(const PolygonMesh& mesh, const RotationSystem& rs) {
   std::vector<Point3> normals(mesh.faces.size()), centres(mesh.faces.size());
-  std::vector<Point3> corners;
-  for (size_t f = 0; f < mesh.faces.size(); ++f) {
-    corners.clear();
-    for (int v : mesh.faces[f]) corners.push_back(mesh.positions[static_cast<size_t>(v)]);
-    normals[f] = newellNormal(corners);
-    centres[f] = faceCentroid(mesh, static_cast<int>(f));
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    normals[static_cast<size_t>(f)] = faceNormal(mesh, f);
+    centres[static_cast<size_t>(f)] = faceCentroid(mesh, f);
   }
   std::vector<EdgeRegion> regions;
   regions.reserve(static_cast<size_t>(rs.edgeCount()));

@@ -20,13 +20,17 @@ namespace rotafab::jobs {
 
 using namespace nesting;
 
+int quarterTurns(double degrees) {
+  const double quarters = degrees / 90.0;
+  if (std::abs(quarters - std::round(quarters)) >= 1e-12) return -1;
+  return static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
+}
+
 Point2 rotatedPoint(const Point2& p, double degrees) {
   // Quarter turns exactly, so that 90-degree layouts stay on the grid.
   double c = std::cos(degrees * std::numbers::pi / 180.0), s = std::sin(degrees * std::numbers::pi / 180.0);
-  const double quarter = degrees / 90.0;
-  if (std::abs(quarter - std::round(quarter)) < 1e-12) {
+  if (const int k = quarterTurns(degrees); k >= 0) {
     static constexpr int kCos[] = {1, 0, -1, 0}, kSin[] = {0, 1, 0, -1};
-    const int k = ((static_cast<int>(std::lround(quarter)) % 4) + 4) % 4;
     c = kCos[k];
     s = kSin[k];
   }
@@ -85,7 +89,6 @@ NestingResult withTheRestInRows(const std::vector<NestingPart>& parts, const Nes
   result.sheets += inRows.sheets;
   result.evaluations = 1;
   result.inRows = static_cast<int>(rest.size());
-  for (const auto& part : parts) result.partArea += std::abs(polygonArea(part.outline));
   const auto cost = nesting::layoutCost(result, parts);
   progress.improved(cost, {"nesting", "first layout", parts.size(), parts.size(), cost.first, cost.second});
   return result;
@@ -108,20 +111,24 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
                             : options.threads > 0               ? static_cast<unsigned>(options.threads)
                                                                 : context.executor().concurrency();
   const FirstLayout first = firstLayout(shapes, progress, context);
-  if (first.placed < parts.size()) return withTheRestInRows(parts, options, first, progress);
-  shapes.buildAll(context);
-  std::vector<NestingResult> results(searches);
-  context.executor().parallelFor(searches, [&](size_t search) {
-    results[search] = searchLayout(shapes, first, static_cast<unsigned>(search), progress, context);
-  });
-  size_t winner = 0;
-  int evaluations = 0;
-  for (size_t i = 0; i < results.size(); ++i) {
-    evaluations += results[i].evaluations;
-    if (layoutCost(results[i], parts) < layoutCost(results[winner], parts)) winner = i;
+  NestingResult best;
+  if (first.placed < parts.size()) {
+    best = withTheRestInRows(parts, options, first, progress);
+  } else {
+    shapes.buildAll(context);
+    std::vector<NestingResult> results(searches);
+    context.executor().parallelFor(searches, [&](size_t search) {
+      results[search] = searchLayout(shapes, first, static_cast<unsigned>(search), progress, context);
+    });
+    size_t winner = 0;
+    int evaluations = 0;
+    for (size_t i = 0; i < results.size(); ++i) {
+      evaluations += results[i].evaluations;
+      if (layoutCost(results[i], parts) < layoutCost(results[winner], parts)) winner = i;
+    }
+    best = std::move(results[winner]);
+    best.evaluations = evaluations;
   }
-  NestingResult best = std::move(results[winner]);
-  best.evaluations = evaluations;
   for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));
   return best;
 }

@@ -128,6 +128,9 @@ double polygonArea(const Polygon2& polygon);
 // usable area's, rounded up): no layout on beds has fewer.
 int sheetsTheAreaNeeds(const std::vector<NestingPart>& parts, const NestingOptions& options);
 
+// How many quarter turns (0-3) `degrees` is, or -1 when it is no whole number of them.
+int quarterTurns(double degrees);
+
 // `p` turned counter-clockwise about the origin; quarter turns are exact.
 Point2 rotatedPoint(const Point2& p, double degrees);  // signed: positive counter-clockwise
 

@@ -207,14 +207,6 @@ Path translatedPath(const Path& path, IntPoint by) {
 
 namespace {
 
-// Quarter turns of a whole number of them (rotatedPoint() is exact for
-// those), else -1.
-int quarterTurns(double degrees) {
-  const double quarters = degrees / 90.0;
-  if (std::abs(quarters - std::round(quarters)) >= 1e-12) return -1;
-  return static_cast<int>(((std::llround(quarters) % 4) + 4) % 4);
-}
-
 // `shape` turned by `quarters` quarter turns about the origin: on the grid
 // exactly, so the turned shape holds the turned outline as the first holds
 // the first (rotated() turns the outline exactly too). A quarter of the

@@ -30,7 +30,7 @@ TEST(Decimal, UnitsAsDecimalsWithoutTrailingZeros) {
 
 TEST(Decimal, TheSameDigitsAsPrintf) {
   // printf rounds the binary value exactly; unitsOf rounds value * 10^d.
-  // The two can differ only within a rounding error of a tie (x.xxxx5):
+  // The two can differ only within a rounding error of a tie (a fifth decimal of 5):
   // none of a million random coordinates does.
   std::mt19937_64 random(7);
   std::uniform_real_distribution<double> coordinate(-40, 40);

@@ -23,12 +23,6 @@ struct Prepared {
   RotationSystem rs;
 };
 
-Point3 faceNormal(const PolygonMesh& mesh, int face) {
-  std::vector<Point3> corners;
-  for (int v : mesh.faces[static_cast<size_t>(face)]) corners.push_back(mesh.positions[static_cast<size_t>(v)]);
-  return newellNormal(corners);
-}
-
 Prepared prepared(PolygonMesh mesh) {
   requireUsable(analyzeMesh(mesh));
   RotationSystem rs = RotationSystem::fromMesh(mesh);
