@@ -71,9 +71,11 @@ WeaveThreads traceThreads(const RotationSystem& rs) {
     Thread thread;
     for (size_t i = 0; i < walk.darts.size(); ++i) {
       const bool twisted = (rs.twist(RotationSystem::edgeOf(walk.darts[i])) & 1) != 0;
-      thread.steps.push_back({walk.darts[i], !twisted                  ? Crossing::None
-                                             : walk.traceTypes[i] == 0 ? Crossing::Up
-                                                                       : Crossing::Down});
+      thread.steps.push_back({walk.darts[i],
+                              !twisted                  ? Crossing::None
+                              : walk.traceTypes[i] == 0 ? Crossing::Up
+                                                        : Crossing::Down,
+                              walk.traceTypes[i]});
     }
     const auto firstDown = std::find_if(thread.steps.begin(), thread.steps.end(),
                                         [](const ThreadStep& s) { return s.crossing == Crossing::Down; });

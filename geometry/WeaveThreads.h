@@ -38,6 +38,10 @@ enum class Crossing { Up, Down, None };
 struct ThreadStep {
   Dart dart;  // the edge crossed, in the direction the thread goes
   Crossing crossing;
+  // The trace type with which the walk reached the dart (0 for Up, 1 for
+  // Down): at an untwisted edge it says on which side the thread runs, in
+  // the face on the dart's left (0) or on its right (1).
+  int traceType = 0;
 };
 
 struct Thread {

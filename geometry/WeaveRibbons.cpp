@@ -1,0 +1,143 @@
+#include "geometry/WeaveRibbons.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+namespace rotafab::geometry {
+namespace {
+
+void requireShape(const RibbonShape& shape) {
+  const auto fraction = [](double value, const char* name) {
+    if (!(value > 0 && value <= 1)) {
+      throw std::invalid_argument(
+          fmt::format("{} {} is out of range: it must be more than 0 and at most 1", name, value));
+    }
+  };
+  fraction(shape.width, "width");
+  fraction(shape.curve, "curve");
+  if (!(shape.offset > 0) || !std::isfinite(shape.offset)) {
+    throw std::invalid_argument(fmt::format("offset {} is out of range: it must be more than 0", shape.offset));
+  }
+  if (shape.samples < 1) {
+    throw std::invalid_argument(fmt::format("samples {} is out of range: at least 1", shape.samples));
+  }
+}
+
+}  // namespace
+
+RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const ThreadStep& step,
+                      const RibbonShape& shape) {
+  const Dart d = step.dart;
+  const int e = RotationSystem::edgeOf(d);
+  const bool forward = d == 2 * e;  // the dart runs from the region's start to its end
+  RibbonPass pass;
+  pass.edge = e;
+  pass.crossing = step.crossing;
+  const int fromFace = step.traceType == 0 ? rs.face(d) : rs.face(RotationSystem::reverse(d));
+  const int otherFace = step.traceType == 0 ? rs.face(RotationSystem::reverse(d)) : rs.face(d);
+  pass.from = {fromFace, rs.origin(d)};
+  pass.to = {step.crossing == Crossing::None ? fromFace : otherFace, rs.target(d)};
+
+  // The pass's own coordinates: a along the thread (0 at its head), b across
+  // (0 on the vertex side at the head). The over strand runs along s of the
+  // region's map X(s, u), from the start's corner in the left face to the
+  // end's in the right; the under strand along u, from the start's corner in
+  // the right face to the end's in the left (docs/WEAVE.md, 1.1 item 5, 1.5).
+  // A dart against the region's direction runs them backwards, and its
+  // vertex side at the head is the region's end.
+  const Point3 lift = shape.offset * region.normal;
+  // Beside an untwisted edge the thread runs in the half of the region in
+  // its face: the triangle of the edge and that face's projected centre, a
+  // degenerate bilinear quad whose ends are the two half-segments vertex to
+  // centre, as a twisted pass's are (docs/WEAVE.md, section 4).
+  const Point3& centre = fromFace == rs.face(2 * e) ? region.leftCentre : region.rightCentre;
+  const Point3& origin = forward ? region.start : region.end;
+  const Point3& target = forward ? region.end : region.start;
+  const auto at = [&](double a, double b) -> Point3 {
+    switch (step.crossing) {
+      case Crossing::Up:
+        return (forward ? region.at(a, b) : region.at(1 - a, 1 - b)) + lift;
+      case Crossing::Down:
+        return (forward ? region.at(b, a) : region.at(1 - b, 1 - a)) - lift;
+      case Crossing::None:
+        break;
+    }
+    return (1 - b) * ((1 - a) * origin + a * target) + b * centre;
+  };
+  const double b0 = (1 - shape.width) / 2, b1 = (1 + shape.width) / 2;
+  const double a0 = (1 - shape.curve) / 2, a1 = (1 + shape.curve) / 2;
+  pass.head = {at(a0, b0), at(a0, b1)};
+  pass.middle = {at(0.5, b0), at(0.5, b1)};
+  pass.tail = {at(a1, b0), at(a1, b1)};
+  return pass;
+}
+
+Point3 bezierPoint(const std::array<Point3, 4>& control, double t) {
+  const double s = 1 - t;
+  return s * s * s * control[0] + 3 * s * s * t * control[1] + 3 * s * t * t * control[2] + t * t * t * control[3];
+}
+
+Point3 bezierDerivative(const std::array<Point3, 4>& control, double t) {
+  const double s = 1 - t;
+  return 3 * s * s * (control[1] - control[0]) + 6 * s * t * (control[2] - control[1]) +
+         3 * t * t * (control[3] - control[2]);
+}
+
+std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side) {
+  const auto count = ribbon.passes.size();
+  const RibbonPass& here = ribbon.passes[static_cast<size_t>(pass) % count];
+  const RibbonPass& next = ribbon.passes[(static_cast<size_t>(pass) + 1) % count];
+  const auto s = static_cast<size_t>(side);
+  return {here.middle[s], here.tail[s], next.head[s], next.middle[s]};
+}
+
+std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
+                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape) {
+  requireShape(shape);
+  std::vector<Ribbon> ribbons;
+  ribbons.reserve(weave.threads.size());
+  for (const Thread& thread : weave.threads) {
+    Ribbon ribbon;
+    ribbon.samples = shape.samples;
+    ribbon.passes.reserve(thread.steps.size());
+    // Rails: a connector joins the tail corner nearer the vertex the thread
+    // passes to the next head corner nearer it (A7). A pass's side 0 is the
+    // vertex side at its head; at its tail it is the vertex side beside an
+    // untwisted edge but the centre side across a twisted one, whose strand
+    // runs diagonally through the region. So rail P changes side after each
+    // crossing.
+    bool swapped = false;
+    for (const ThreadStep& step : thread.steps) {
+      RibbonPass pass = ribbonPass(rs, regions[static_cast<size_t>(RotationSystem::edgeOf(step.dart))], step, shape);
+      if (swapped) {
+        std::swap(pass.head[0], pass.head[1]);
+        std::swap(pass.middle[0], pass.middle[1]);
+        std::swap(pass.tail[0], pass.tail[1]);
+      }
+      if (step.crossing != Crossing::None) swapped = !swapped;
+      ribbon.passes.push_back(pass);
+    }
+    // An orientable surface brings the rails back to their own sides: an
+    // even number of crossings per thread (III.1.2: t flips at each).
+    if (swapped) throw std::logic_error("internal: a thread crosses an odd number of twisted edges");
+    const int n = shape.samples;
+    const int passes = static_cast<int>(ribbon.passes.size());
+    ribbon.railP.reserve(static_cast<size_t>(passes * n));
+    ribbon.railQ.reserve(static_cast<size_t>(passes * n));
+    for (int k = 0; k < passes; ++k) {
+      const auto p = segmentControls(ribbon, k, 0), q = segmentControls(ribbon, k, 1);
+      for (int i = 0; i < n; ++i) {
+        const double t = static_cast<double>(i) / n;
+        ribbon.railP.push_back(bezierPoint(p, t));
+        ribbon.railQ.push_back(bezierPoint(q, t));
+      }
+    }
+    ribbons.push_back(std::move(ribbon));
+  }
+  return ribbons;
+}
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,78 @@
+#pragma once
+// The ribbons of a plain-woven structure (dissertation IV.1-IV.2): per pass
+// of a thread across an edge, the fractional quadrilateral cut from the
+// edge's projected region (eq. 4.2-4.11) and lifted by +h where the thread
+// goes over, -h where it goes under; per thread, the two rails of C1 cubic
+// Bézier curves through consecutive quadrilaterals (eq. 4.17), sampled into
+// one closed strip of thin triangles (docs/WEAVE.md, 1.4-1.8).
+//
+// Readings (docs/WEAVE.md): the second pass of the bilinear interpolation
+// uses the width w, not c as printed in eq. 4.6-4.9 (A1); the under quad is
+// the over quad transposed, running along the other diagonal of the region
+// (A2); the over copy is the +h one, N_e pointing out (A3); a connector
+// joins the tail corner nearer the vertex the thread passes to the next
+// quad's head corner nearer that vertex (A7). An untwisted edge (a
+// single-cycle weave) is passed beside it, in one face's half of the region,
+// at height 0 (section 4).
+
+#include <array>
+#include <vector>
+
+#include "geometry/EdgeProjection.h"
+#include "geometry/WeaveThreads.h"
+
+namespace rotafab::geometry {
+
+struct RibbonShape {
+  double width = 0.8;    // w in (0, 1]: the ribbon's share of its region across it
+  double curve = 0.6;    // c in (0, 1]: the quad's share of its region along it (1: straight ribbons)
+  double offset = 0.05;  // h > 0, inches: how far over and under ribbons stand off the surface
+  int samples = 8;       // segments per Bézier curve
+};
+
+// A face corner: a face and one of its vertices.
+struct FaceCorner {
+  int face = -1, vertex = -1;
+  bool operator==(const FaceCorner&) const = default;
+};
+
+// A thread's pass across the region of one edge. The quad's rows run across
+// the thread at its head, middle and tail; side 0 and side 1 are its two
+// rails, numbered along the thread (the ribbon's rail P, rail Q).
+struct RibbonPass {
+  int edge = -1;
+  Crossing crossing = Crossing::None;
+  FaceCorner from, to;  // where the thread enters and leaves the region
+  std::array<Point3, 2> head, middle, tail;
+};
+
+struct Ribbon {
+  std::vector<RibbonPass> passes;  // the thread's steps, in its order
+  // The sampled rails, cyclic: row i joins railP[i] to railQ[i]; row
+  // k * samples is pass k's middle row (A1 B1), and rows go on along the
+  // thread. The strip's quad between rows i and i + 1 (mod size) is cut into
+  // the triangles (P_i, Q_i, P_i+1), (Q_i, Q_i+1, P_i+1).
+  std::vector<Point3> railP, railQ;
+  int samples = 0;
+};
+
+// The pass of `step` across the region of its edge, with sides as the
+// thread meets them (side 0 nearer the vertex at the head). `mesh` and `rs`
+// as the region was made from.
+RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const ThreadStep& step,
+                      const RibbonShape& shape);
+
+// One ribbon per thread. Throws std::invalid_argument for a shape out of
+// range (w, c in (0, 1], h > 0, at least one sample).
+std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
+                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape);
+
+// Point t in [0, 1] of eq. 4.17's cubic, and its derivative.
+Point3 bezierPoint(const std::array<Point3, 4>& control, double t);
+Point3 bezierDerivative(const std::array<Point3, 4>& control, double t);
+
+// The control points of the segment from pass k's middle to pass k + 1's
+// (mod the passes) on rail `side`: middle, tail, next head, next middle.
+std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side);
+
+}  // namespace rotafab::geometry
