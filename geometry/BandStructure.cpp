@@ -582,25 +582,8 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
 
 GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,
                                           const core::WorkContext& context) {
-  GrownStructure result;
-  std::vector<double> firstScales;  // of the size given
-  for (int attempt = 1;; ++attempt) {
-    try {
-      result.structure = buildBandStructure(mesh, options, context);
-      return result;
-    } catch (const NoRoomForHoleError& error) {
-      if (attempt == 1) firstScales = error.scales;
-      if (attempt == kGrowAttempts || !std::isfinite(error.scaleNeeded)) {
-        NoRoomForHoleError last = error;
-        last.scales = firstScales;
-        throw last;
-      }
-      if (attempt == 1) result.bandsWithoutRoom = error.bands, result.scalesNeeded = error.scales;
-      result.grown *= error.scaleNeeded;
-      for (Point3& p : mesh.positions) p *= error.scaleNeeded;
-      context.report({"geometry", "larger, for the fasteners", static_cast<size_t>(attempt), 0});
-    }
-  }
+  return growUntilRoom(
+      mesh, [&](const PolygonMesh& grown) { return buildBandStructure(grown, options, context); }, context);
 }
 
 }  // namespace rotafab::geometry

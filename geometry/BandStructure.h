@@ -41,19 +41,9 @@ Structure buildBandStructure(const PolygonMesh& mesh, const BandOptions& options
 // The structure at the smallest size, from the mesh's, at which every band
 // has room for its fastener (FastenerHoles.h, kLeastClearance): when some
 // band has none, the mesh is scaled by what the bands without room ask
-// (every length of the structure scales with it) and built again, at most
-// kGrowAttempts times (a hole may move to a tighter place on the larger
-// band). `mesh` is left at the size built; `grown` says how many times its
-// size it became (1: as given). Throws as buildBandStructure() does, the
-// NoRoomForHoleError of the last attempt.
-struct GrownStructure {
-  Structure structure;
-  double grown = 1;
-  int bandsWithoutRoom = 0;          // at the size given
-  std::vector<double> scalesNeeded;  // what each of them needed, times the size given
-};
-// (A NoRoomForHoleError it throws has `scales` of the size given, as the first try found them.)
-constexpr int kGrowAttempts = 3;
+// (every length of the structure scales with it) and built again
+// (growUntilRoom(), Structure.h; a hole may move to a tighter place on the
+// larger band).
 GrownStructure buildBandStructureWithRoom(PolygonMesh& mesh, const BandOptions& options,
                                           const core::WorkContext& context);
 

@@ -2,10 +2,12 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <map>
 #include <unordered_map>
 
 #include "core/Decimal.h"
+#include "geometry/FastenerHoles.h"
 
 namespace rotafab::geometry {
 
@@ -156,6 +158,29 @@ void writeStructureObj(std::ostream& out, const Structure& structure, std::strin
     }
   }
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+}
+
+GrownStructure growUntilRoom(PolygonMesh& mesh, const std::function<Structure(const PolygonMesh&)>& build,
+                             const core::WorkContext& context) {
+  GrownStructure result;
+  std::vector<double> firstScales;  // of the size given
+  for (int attempt = 1;; ++attempt) {
+    try {
+      result.structure = build(mesh);
+      return result;
+    } catch (const NoRoomForHoleError& error) {
+      if (attempt == 1) firstScales = error.scales;
+      if (attempt == kGrowAttempts || !std::isfinite(error.scaleNeeded)) {
+        NoRoomForHoleError last = error;
+        last.scales = firstScales;
+        throw last;
+      }
+      if (attempt == 1) result.bandsWithoutRoom = error.bands, result.scalesNeeded = error.scales;
+      result.grown *= error.scaleNeeded;
+      for (Point3& p : mesh.positions) p *= error.scaleNeeded;
+      context.report({"geometry", "larger, for the fasteners", static_cast<size_t>(attempt), 0});
+    }
+  }
 }
 
 }  // namespace rotafab::geometry

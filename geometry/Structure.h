@@ -6,12 +6,14 @@
 // joins; the assembly steps; the fasteners; warnings. Lengths in inches,
 // panel coordinates in the panel's own frame.
 
+#include <functional>
 #include <ostream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/Polygon2.h"
+#include "core/WorkContext.h"
 #include "geometry/PanelLabels.h"
 #include "geometry/PolygonMesh.h"
 
@@ -131,5 +133,24 @@ PolygonMesh surfaceMesh(const Structure& structure);
 // panel, coordinates to `decimals`, written a panel at a time (a 50,000-panel
 // structure's mesh is never held whole). `comment` is its first line.
 void writeStructureObj(std::ostream& out, const Structure& structure, std::string_view comment, int decimals);
+
+// A structure built at the smallest size, from the mesh's, at which every
+// fastener hole has room (FastenerHoles.h, kLeastClearance): when `build`
+// throws NoRoomForHoleError, the mesh is scaled by what the places without
+// room ask (every length of the structure scales with it) and built again,
+// at most kGrowAttempts times. `mesh` is left at the size built; `grown`
+// says how many times its size it became (1: as given). Throws what `build`
+// does, the NoRoomForHoleError of the last attempt with the `scales` of the
+// size given, as the first try found them. Progress: phase "geometry", step
+// "larger, for the fasteners" before each new attempt.
+struct GrownStructure {
+  Structure structure;
+  double grown = 1;
+  int bandsWithoutRoom = 0;          // at the size given (bands, or a weave's crossings)
+  std::vector<double> scalesNeeded;  // what each of them needed, times the size given
+};
+constexpr int kGrowAttempts = 3;
+GrownStructure growUntilRoom(PolygonMesh& mesh, const std::function<Structure(const PolygonMesh&)>& build,
+                             const core::WorkContext& context);
 
 }  // namespace rotafab::geometry

@@ -1,0 +1,428 @@
+#include "geometry/WeaveStructure.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numeric>
+#include <queue>
+#include <set>
+
+#include "core/Polygon2.h"
+#include "geometry/FastenerHoles.h"
+#include "geometry/FloodFill.h"
+#include "geometry/HersheyFont.h"
+#include "geometry/PanelLabels.h"
+#include "geometry/WovenPanels.h"
+
+namespace rotafab::geometry {
+namespace {
+
+std::string plural(size_t n) { return n == 1 ? "" : "s"; }
+
+// The three panels of a crossing: over it, and under it before and after
+// it along the thread under (indices into the woven panels), each with the
+// row of its strip through the crossing.
+struct CrossingPanels {
+  std::array<int, 3> panel{-1, -1, -1};
+  std::array<int, 3> row{};
+};
+
+// The order of the threads (docs/WEAVE.md, M11): the thread over the lowest
+// crossing first, then each time the thread crossing most of those placed
+// (the first on a tie), so that each thread is woven into the ones before.
+std::vector<int> threadOrder(const WeaveThreads& weave, const std::vector<EdgeRegion>& regions, int up) {
+  const int threads = static_cast<int>(weave.threads.size());
+  int lowest = -1;
+  for (size_t e = 0; e < regions.size(); ++e) {
+    if (weave.up[e].thread < 0) continue;
+    if (lowest < 0 || regions[e].midpoint[up] < regions[static_cast<size_t>(lowest)].midpoint[up]) {
+      lowest = static_cast<int>(e);
+    }
+  }
+  std::vector<int> order;
+  std::vector<char> placed(static_cast<size_t>(threads), 0);
+  std::vector<int> shared(static_cast<size_t>(threads), 0);
+  // Max-heap of (crossings shared with placed threads, -thread), stale entries skipped.
+  std::priority_queue<std::pair<int, int>> next;
+  const auto place = [&](int t) {
+    placed[static_cast<size_t>(t)] = 1;
+    order.push_back(t);
+    for (const ThreadStep& step : weave.threads[static_cast<size_t>(t)].steps) {
+      if (step.crossing == Crossing::None) continue;
+      const size_t e = static_cast<size_t>(RotationSystem::edgeOf(step.dart));
+      const int other = step.crossing == Crossing::Up ? weave.down[e].thread : weave.up[e].thread;
+      if (placed[static_cast<size_t>(other)]) continue;
+      next.emplace(++shared[static_cast<size_t>(other)], -other);
+    }
+  };
+  for (int start = lowest >= 0 ? weave.up[static_cast<size_t>(lowest)].thread : 0; start >= 0;) {
+    place(start);
+    while (!next.empty()) {
+      const auto [count, negative] = next.top();
+      next.pop();
+      const int t = -negative;
+      if (placed[static_cast<size_t>(t)] || count != shared[static_cast<size_t>(t)]) continue;
+      place(t);
+    }
+    // A surface of several pieces: go on with a thread not reached.
+    const auto missed = std::find(placed.begin(), placed.end(), 0);
+    start = missed == placed.end() ? -1 : static_cast<int>(missed - placed.begin());
+  }
+  return order;
+}
+
+Point2 centreOfRow(const WovenPanel& panel, int row) {
+  row = std::clamp(row, 0, panel.rows() - 1);
+  return (panel.flatP[static_cast<size_t>(row)] + panel.flatQ[static_cast<size_t>(row)]) / 2;
+}
+
+// The direction the thread runs at `row`, flat.
+double angleAtRow(const WovenPanel& panel, int row) {
+  const Point2 along = centreOfRow(panel, row + 1) - centreOfRow(panel, row - 1);
+  return std::atan2(along.y(), along.x());
+}
+
+// The flat hole positions of one crossing on its three panels, and the
+// clearance they keep, in diameters: from each panel's outline, and
+// between the two holes on a panel less one diameter (kClearance from the
+// outline and kClearance + 1 between centres keep the same 1.5 diameters
+// of material, FastenerHoles.h).
+struct CrossingHoles {
+  std::array<std::array<Point2, 2>, 3> flat;  // per panel of CrossingPanels, per hole
+  double clearance = -std::numeric_limits<double>::infinity();
+};
+
+CrossingHoles holesAt(const EdgeRegion& region, const CrossingPanels& at, const std::vector<WovenPanel>& panels,
+                      const std::vector<std::vector<Point2>>& outlines, double delta, int reach, double diameter) {
+  CrossingHoles holes;
+  double clearance = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < 3; ++k) {
+    const WovenPanel& panel = panels[static_cast<size_t>(at.panel[k])];
+    for (size_t h = 0; h < 2; ++h) {
+      // On the over strand's centre line, either side of the crossing's
+      // centre (docs/WEAVE.md, 1.11): along the over panel, across the
+      // panels under it.
+      const Point3 point = region.at(0.5 + (h == 0 ? -delta : delta), 0.5);
+      const StripPoint hit = stripPointOnLine(panel, at.row[k] - reach, at.row[k] + reach, point, region.normal);
+      holes.flat[k][h] = hit.onPanel(panel);
+      // A line that misses the strip: no hole through all three panels there.
+      if (hit.miss > 1e-6 * diameter) clearance = -std::numeric_limits<double>::infinity();
+      clearance = std::min(
+          clearance, core::distanceToOutline(outlines[static_cast<size_t>(at.panel[k])], holes.flat[k][h]) / diameter);
+    }
+    clearance = std::min(clearance, (holes.flat[k][0] - holes.flat[k][1]).norm() / diameter - 1);
+  }
+  holes.clearance = clearance;
+  return holes;
+}
+
+// The largest spread of a crossing's holes, from a quarter of the quad's
+// smaller side (in the region's parameters) down to where their centres are
+// kClearance + 1 diameters apart, that keeps kClearance diameters to every
+// outline; else the spread that keeps the most.
+CrossingHoles placeCrossingHoles(const EdgeRegion& region, const CrossingPanels& at,
+                                 const std::vector<WovenPanel>& panels,
+                                 const std::vector<std::vector<Point2>>& outlines, const RibbonShape& shape,
+                                 double diameter) {
+  const double largest = std::min(shape.curve, shape.width) / 4;
+  const double length = (region.at(1, 0.5) - region.at(0, 0.5)).norm();
+  const double smallest = std::min(largest, (kClearance + 1) * diameter / (2 * length));
+  const int reach = std::max(1, shape.samples / 2);
+  constexpr int kTries = 8;
+  CrossingHoles best;
+  for (int i = 0; i <= kTries; ++i) {
+    const double delta = largest + (smallest - largest) * i / kTries;
+    CrossingHoles holes = holesAt(region, at, panels, outlines, delta, reach, diameter);
+    if (holes.clearance >= kClearance) return holes;
+    if (holes.clearance > best.clearance) best = holes;
+  }
+  return best;
+}
+
+struct Labelled {
+  std::vector<PanelLabel> labels;
+  std::vector<std::string> unfitted;
+};
+
+// The candidate centres for a label: the strip's centre at `from`, then
+// rows stepping `step` away, as far as `to`.
+std::vector<Point2> rowCentres(const WovenPanel& panel, int from, int to) {
+  std::vector<Point2> centres;
+  const int step = to >= from ? 1 : -1;
+  for (int row = from;; row += step) {
+    if (row >= 0 && row < panel.rows()) centres.push_back(centreOfRow(panel, row));
+    if (row == to) break;
+  }
+  return centres;
+}
+
+}  // namespace
+
+std::vector<AssemblyStep> weaveSteps(const std::vector<Panel>& panels) {
+  // Panels (in id order) with holes of each edge number.
+  std::map<int, std::vector<int>> panelsOfEdge;
+  std::vector<AssemblyStep> steps;
+  for (const Panel& panel : panels) {
+    std::map<int, int> holesOfEdge;
+    for (const PanelHole& hole : panel.holes) ++holesOfEdge[hole.edge];
+    AssemblyStep step{panel.id, {}, {}, {}};
+    for (const auto& [edge, holes] : holesOfEdge) {
+      std::vector<int>& on = panelsOfEdge[edge];
+      on.push_back(panel.id);
+      if (on.size() != 3) continue;
+      // Complete: over it panel `edge`, and two under.
+      const int named = edge != panel.id ? edge : on[0];
+      step.joins.push_back({named, edge, holes, {}});
+    }
+    steps.push_back(std::move(step));
+  }
+  return steps;
+}
+
+Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context) {
+  if (!(options.fastener > 0)) {
+    throw ParameterError(Parameter::Fastener,
+                         fmt::format("{}: the hole diameter must be positive", options.names(Parameter::Fastener)));
+  }
+  context.report({"geometry", "weaving threads", 0, 0});
+  RotationSystem rs = RotationSystem::fromMesh(mesh);
+  twistForWeave(rs, options.cycles, lowestFace(mesh, options.up));
+  const WeaveThreads weave = traceThreads(rs);
+  const std::vector<EdgeRegion> regions = edgeRegions(mesh, rs);
+  context.check();
+  context.report({"geometry", "ribbons", 0, 0});
+  const std::vector<Ribbon> ribbons = weaveRibbons(rs, weave, regions, options.shape);
+  const int overlap = std::max(1, options.shape.samples / 2);
+  std::vector<WovenPanel> woven = wovenPanels(ribbons, regions, overlap);
+  context.check();
+
+  // Assembly order: thread by thread, each from its lowest crossing over.
+  const int up = options.up;
+  std::vector<std::vector<int>> panelsOfThread(ribbons.size());
+  for (size_t i = 0; i < woven.size(); ++i)
+    panelsOfThread[static_cast<size_t>(woven[i].thread)].push_back(static_cast<int>(i));
+  std::vector<int> order;  // panel id - 1 -> woven index
+  std::vector<int> cycleOf(ribbons.size(), 0);
+  int cycle = 0;
+  for (int t : threadOrder(weave, regions, up)) {
+    auto& mine = panelsOfThread[static_cast<size_t>(t)];
+    cycleOf[static_cast<size_t>(t)] = ++cycle;
+    if (mine.empty()) continue;
+    const auto lowest = std::min_element(mine.begin(), mine.end(), [&](int a, int b) {
+      return regions[static_cast<size_t>(woven[static_cast<size_t>(a)].upEdge)].midpoint[up] <
+             regions[static_cast<size_t>(woven[static_cast<size_t>(b)].upEdge)].midpoint[up];
+    });
+    std::rotate(mine.begin(), lowest, mine.end());
+    order.insert(order.end(), mine.begin(), mine.end());
+  }
+  std::vector<int> idOf(woven.size());
+  std::vector<int> edgeNumber(regions.size(), 0);
+  for (size_t k = 0; k < order.size(); ++k) {
+    idOf[static_cast<size_t>(order[k])] = static_cast<int>(k) + 1;
+    edgeNumber[static_cast<size_t>(woven[static_cast<size_t>(order[k])].upEdge)] = static_cast<int>(k) + 1;
+  }
+
+  // Each crossing's three panels.
+  std::vector<CrossingPanels> crossings(regions.size());
+  for (size_t i = 0; i < woven.size(); ++i) {
+    const WovenPanel& p = woven[i];
+    crossings[static_cast<size_t>(p.upEdge)].panel[0] = static_cast<int>(i);
+    crossings[static_cast<size_t>(p.upEdge)].row[0] = p.upRow;
+    // Under before the crossing (it ends there) and after it (it starts there).
+    crossings[static_cast<size_t>(p.downEdges[1])].panel[1] = static_cast<int>(i);
+    crossings[static_cast<size_t>(p.downEdges[1])].row[1] = p.downRows[1];
+    crossings[static_cast<size_t>(p.downEdges[0])].panel[2] = static_cast<int>(i);
+    crossings[static_cast<size_t>(p.downEdges[0])].row[2] = p.downRows[0];
+  }
+  std::vector<std::vector<Point2>> outlines(woven.size());
+  context.parallelFor(woven.size(), [&](size_t i) { outlines[i] = woven[i].outline(); });
+
+  Structure result;
+  result.kind = StructureKind::Weave;
+  result.edges = static_cast<int>(woven.size());
+  const double d = options.fastener;
+  const size_t crossingCount = regions.size();
+  context.report({"geometry", "fastener holes", 0, crossingCount});
+  std::vector<CrossingHoles> holes(crossingCount);
+  context.parallelFor(crossingCount, [&](size_t e) {
+    if (crossings[e].panel[0] < 0) return;  // untwisted: no crossing
+    holes[e] = placeCrossingHoles(regions[e], crossings[e], woven, outlines, options.shape, d);
+  });
+  {
+    int withoutRoom = 0, narrow = 0;
+    double scaleNeeded = 1, narrowest = kClearance;
+    int first = 0, narrowestEdge = 0;
+    std::vector<double> scales;
+    for (size_t e = 0; e < crossingCount; ++e) {
+      if (crossings[e].panel[0] < 0) continue;
+      const double c = holes[e].clearance;
+      if (c < kLeastClearance) {
+        ++withoutRoom;
+        // Every length but the diameter scales with the mesh.
+        const double scale = c > 0 ? kClearance / c : std::numeric_limits<double>::infinity();
+        scales.push_back(scale);
+        if (first == 0 || scale > scaleNeeded) first = edgeNumber[e];
+        scaleNeeded = std::max(scaleNeeded, scale);
+      } else if (c < kClearance) {
+        ++narrow;
+        if (c < narrowest) narrowest = c, narrowestEdge = edgeNumber[e];
+      }
+    }
+    if (withoutRoom > 0) {
+      NoRoomForHoleError error(
+          fmt::format("edge {}: its crossing has no room for two {:.3f} in holes {:g} diameter from the outlines of "
+                      "its three panels",
+                      first, d, kLeastClearance),
+          withoutRoom, scaleNeeded, d, options.names);
+      error.scales = scales;
+      throw error;
+    }
+    if (narrow > 0) {
+      result.warnings.push_back(fmt::format(
+          "{} crossing{} too narrow for {:.3f} in holes {} diameters from the panels' outlines, down to {:.2f} "
+          "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
+          narrow, narrow == 1 ? " is" : "s are", d, kClearance, narrowest, narrowestEdge,
+          options.names(Parameter::Size), options.names(Parameter::Fastener)));
+    }
+  }
+  context.check();
+
+  // Per panel, its holes: two at each of its three crossings.
+  std::vector<std::vector<PanelHole>> holesOf(woven.size());
+  for (size_t e = 0; e < crossingCount; ++e) {
+    if (crossings[e].panel[0] < 0) continue;
+    for (size_t k = 0; k < 3; ++k) {
+      for (const Point2& xy : holes[e].flat[k]) {
+        holesOf[static_cast<size_t>(crossings[e].panel[k])].push_back({edgeNumber[e], xy, d});
+      }
+    }
+  }
+
+  context.report({"geometry", "labels", 0, woven.size()});
+  const HersheyFont& font = HersheyFont::simplex();
+  result.panels.resize(woven.size());
+  std::vector<std::vector<std::string>> unfittedOf(woven.size());
+  const int reach = std::max(1, options.shape.samples / 2);
+  context.parallelFor(order.size(), [&](size_t k) {
+    const size_t i = static_cast<size_t>(order[k]);
+    const WovenPanel& w = woven[i];
+    Panel panel;
+    panel.id = static_cast<int>(k) + 1;
+    panel.source.edge = panel.id;
+    panel.source.cycle = cycleOf[static_cast<size_t>(w.thread)];
+    panel.outline = outlines[i];
+    panel.holes = holesOf[i];
+    panel.area = w.area;
+    for (int r = 0; r + 1 < w.rows(); ++r) {
+      panel.surface.push_back(
+          {w.railP[static_cast<size_t>(r)], w.railQ[static_cast<size_t>(r)], w.railP[static_cast<size_t>(r + 1)]});
+      panel.surface.push_back(
+          {w.railQ[static_cast<size_t>(r)], w.railQ[static_cast<size_t>(r + 1)], w.railP[static_cast<size_t>(r + 1)]});
+    }
+    // Joins: under it at its up crossing, and over it and on its own thread at each end.
+    const CrossingPanels& atUp = crossings[static_cast<size_t>(w.upEdge)];
+    for (size_t j : {1, 2}) panel.joins.push_back({idOf[static_cast<size_t>(atUp.panel[j])], panel.id});
+    for (int e : w.downEdges) {
+      const CrossingPanels& atDown = crossings[static_cast<size_t>(e)];
+      for (size_t j : {0, 1, 2}) {
+        const int other = idOf[static_cast<size_t>(atDown.panel[j])];
+        if (other != panel.id) panel.joins.push_back({other, edgeNumber[static_cast<size_t>(e)]});
+      }
+    }
+
+    // Labels (IV.4, fig. 39-43): the up edge's number in the middle, each
+    // down edge's at its end, all reading along the thread; the
+    // neighbouring edge's number underlined beside the middle one
+    // (docs/WEAVE.md, 1.12, A12).
+    std::vector<Circle> circles;
+    for (const PanelHole& hole : panel.holes) circles.push_back({hole.xy, hole.diameter / 2});
+    std::vector<TextBox> taken;
+    const auto place = [&](const std::string& label, int edge, LabelRole role, int row, int first, int last,
+                           const std::vector<Point2>& candidates) {
+      const std::vector<Point2> region = w.outlineOfRows(std::max(first, 0), std::min(last, w.rows() - 1));
+      const std::string text = labelText(label);
+      const auto box = fitText(font, text, angleAtRow(w, row), region, panel.outline, circles, taken, candidates);
+      if (!box) {
+        unfittedOf[i].push_back(fmt::format("{} {} on panel {}", roleName(role), label, panel.id));
+        return;
+      }
+      taken.push_back(*box);
+      PanelLabel placed{text, edge, role, *box, labelStrokes(font, label, box->origin, box->height, box->angle)};
+      if (role == LabelRole::Neighbor) {
+        // Underlined: a stroke below the box, within the gap fitText kept.
+        const Point2 below = Point2(box->along.y(), -box->along.x()) * (box->height * 0.15);
+        placed.strokes.push_back({box->origin + below, box->origin + box->along * box->width + below});
+      }
+      panel.labels.push_back(std::move(placed));
+    };
+    const int u = w.upRow;
+    place(std::to_string(panel.id), panel.id, LabelRole::Up, u, u - reach, u + reach, rowCentres(w, u, u - reach));
+    // The neighbouring edge: the panel under this one met first turning
+    // counter-clockwise about N_e from the direction this one runs.
+    {
+      const RibbonPass& over = ribbons[static_cast<size_t>(w.thread)].passes[static_cast<size_t>(w.upPass)];
+      const StepRef under = weave.down[static_cast<size_t>(w.upEdge)];
+      const RibbonPass& below = ribbons[static_cast<size_t>(under.thread)].passes[static_cast<size_t>(under.step)];
+      const Point3 overRuns = (over.tail[0] + over.tail[1]) - (over.head[0] + over.head[1]);
+      const Point3 underRuns = (below.tail[0] + below.tail[1]) - (below.head[0] + below.head[1]);
+      const bool after = overRuns.cross(underRuns).dot(regions[static_cast<size_t>(w.upEdge)].normal) > 0;
+      const int neighbour = idOf[static_cast<size_t>(atUp.panel[after ? 2 : 1])];
+      std::vector<Point2> beside = rowCentres(w, u + 2, u + reach);
+      const auto other = rowCentres(w, u - 2, u - reach);
+      beside.insert(beside.end(), other.begin(), other.end());
+      place(std::to_string(neighbour), neighbour, LabelRole::Neighbor, u, u - reach, u + reach, beside);
+    }
+    for (int end = 0; end < 2; ++end) {
+      const int row = w.downRows[static_cast<size_t>(end)];
+      const int number = edgeNumber[static_cast<size_t>(w.downEdges[static_cast<size_t>(end)])];
+      // Past the holes towards the panel's end first, then towards its middle.
+      const int outwards = end == 0 ? -1 : 1;
+      std::vector<Point2> candidates = rowCentres(w, row + outwards, row + outwards * reach);
+      const auto inwards = rowCentres(w, row - outwards, row - outwards * reach);
+      candidates.insert(candidates.end(), inwards.begin(), inwards.end());
+      place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach, candidates);
+    }
+    result.panels[k] = std::move(panel);
+  });
+  std::vector<std::string> unfitted;
+  for (auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
+  if (!unfitted.empty()) {
+    std::string some;
+    for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];
+    result.warnings.push_back(fmt::format("{} label{} not etched, too large for {} ribbon even at {} in: {}{}",
+                                          unfitted.size(), unfitted.size() == 1 ? " is" : "s are",
+                                          unfitted.size() == 1 ? "its" : "their", kSmallestLabel, some,
+                                          unfitted.size() > 3 ? ", ..." : ""));
+  }
+  {
+    std::vector<int> overlapping;
+    for (const Panel& panel : result.panels) {
+      if (core::crossesItself(panel.outline)) overlapping.push_back(panel.id);
+    }
+    if (!overlapping.empty()) {
+      std::string some;
+      for (size_t i = 0; i < overlapping.size() && i < 5; ++i)
+        some += fmt::format("{}{}", i ? ", " : "", overlapping[i]);
+      result.warnings.push_back(fmt::format(
+          "{} panel{} overlap{} {} when unfolded (panel{} {}{}): cut {} across where {} ribbon crosses itself",
+          overlapping.size(), plural(overlapping.size()), overlapping.size() == 1 ? "s" : "",
+          overlapping.size() == 1 ? "itself" : "themselves", plural(overlapping.size()), some,
+          overlapping.size() > 5 ? ", ..." : "", overlapping.size() == 1 ? "it" : "them",
+          overlapping.size() == 1 ? "its" : "each"));
+    }
+  }
+  result.fasteners = 2 * result.edges;
+  result.steps = weaveSteps(result.panels);
+  return result;
+}
+
+GrownStructure buildWeaveStructureWithRoom(PolygonMesh& mesh, const WeaveOptions& options,
+                                           const core::WorkContext& context) {
+  return growUntilRoom(
+      mesh, [&](const PolygonMesh& grown) { return buildWeaveStructure(grown, options, context); }, context);
+}
+
+}  // namespace rotafab::geometry

@@ -1,0 +1,53 @@
+#pragma once
+// A plain-woven structure, end to end in geometry (dissertation ch. IV): the
+// threads of face tracing with twisted edges (III.1.2, IV.1), the
+// projection method's ribbons (IV.1-IV.2), cut into down-up-down panels and
+// unfolded (IV.3-IV.4), with two fastener holes at each crossing through
+// its three panels, the edge numbers etched at both ends and the middle and
+// the neighbouring edge's underlined (IV.4, fig. 39-43). Panels come thread
+// by thread, each thread's in its order: the order to assemble them in
+// (docs/WEAVE.md).
+
+#include <vector>
+
+#include "core/WorkContext.h"
+#include "geometry/BandStructure.h"
+#include "geometry/Parameters.h"
+#include "geometry/PolygonMesh.h"
+#include "geometry/Structure.h"
+#include "geometry/WeaveRibbons.h"
+
+namespace rotafab::geometry {
+
+struct WeaveOptions {
+  WeaveCycles cycles = WeaveCycles::All;
+  RibbonShape shape;
+  double fastener = 0.125;  // hole diameter, inches
+  int up = 1;               // the vertical axis for "lowest": 0 x, 1 y, 2 z
+  ParameterNames names = parameterInWords;
+};
+
+// The mesh must be usable (analyzeMesh) and closed, already at construction
+// size (inches). Edge numbers are panel numbers: panel k goes over edge k.
+// The first thread is the one over the lowest crossing, then each time the
+// thread that crosses most of the threads placed; each from its lowest
+// crossing over onwards. Throws InvalidMeshError or std::invalid_argument
+// (NoRoomForHoleError when a crossing has no room for its two holes) with
+// one line, and core::Cancelled. Progress: phase "geometry", steps "weaving
+// threads", "ribbons", "fastener holes" (of the crossings), "labels" (of the
+// panels).
+Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context);
+
+// As buildBandStructureWithRoom(): the mesh grown until every crossing has
+// room for its holes, at most kGrowAttempts times.
+GrownStructure buildWeaveStructureWithRoom(PolygonMesh& mesh, const WeaveOptions& options,
+                                           const core::WorkContext& context);
+
+// The steps of building a woven structure panel by panel in id order: each
+// crossing (edge k: panel k over it, two panels under it, each with two
+// holes of edge k) is fastened, with its two fasteners through its three
+// panels, at the step of the last of them. The join names the panel that
+// goes over (or, at the over panel's own step, the first panel under).
+std::vector<AssemblyStep> weaveSteps(const std::vector<Panel>& panels);
+
+}  // namespace rotafab::geometry

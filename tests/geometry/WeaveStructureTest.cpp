@@ -1,0 +1,199 @@
+// A plain-woven structure end to end (dissertation ch. IV; docs/WEAVE.md,
+// M9-M11): one panel per edge, panel k over edge k; each edge number `up`
+// on one panel and `down` on two (SPEC's woven rule), with an underlined
+// neighbour number naming a panel under it; two holes per crossing on each
+// of its three panels, the three of each position on one line through the
+// stacked ribbons; every crossing fastened once, with two fasteners, at
+// the step of its last panel.
+#include "geometry/WeaveStructure.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+
+#include "core/Polygon2.h"
+#include "geometry/FastenerHoles.h"
+#include "geometry/MeshAnalysis.h"
+#include "geometry/MeshImport.h"
+#include "geometry/Primitives.h"
+#include "support/MeshSupport.h"
+#include "support/TestContext.h"
+
+namespace rotafab::geometry {
+namespace {
+
+// A flat point of a woven panel back in space: the panel's outline is one
+// rail forwards and the other backwards, row by row, and its surface the
+// strip's triangles in row order (P_r, Q_r, P_r+1), (Q_r, Q_r+1, P_r+1).
+std::optional<Point3> inSpace(const Panel& panel, const Point2& xy) {
+  const size_t rows = panel.outline.size() / 2;
+  std::vector<Point2> a(panel.outline.begin(), panel.outline.begin() + static_cast<long>(rows));
+  std::vector<Point2> b(panel.outline.rbegin(), panel.outline.rbegin() + static_cast<long>(rows));
+  // Which flat rail is P: the one whose first side is as long as P's in space.
+  const Point3 &p0 = panel.surface[0][0], &p1 = panel.surface[0][2];
+  if (std::abs((a[1] - a[0]).norm() - (p1 - p0).norm()) > std::abs((b[1] - b[0]).norm() - (p1 - p0).norm())) {
+    std::swap(a, b);
+  }
+  for (size_t r = 0; r + 1 < rows; ++r) {
+    const std::array<std::array<Point2, 3>, 2> flat{{{a[r], b[r], a[r + 1]}, {b[r], b[r + 1], a[r + 1]}}};
+    for (size_t t = 0; t < 2; ++t) {
+      const auto& f = flat[t];
+      const double area = core::cross(f[1] - f[0], f[2] - f[0]);
+      const double w1 = core::cross(xy - f[0], f[2] - f[0]) / area, w2 = core::cross(f[1] - f[0], xy - f[0]) / area;
+      if (w1 < -1e-9 || w2 < -1e-9 || w1 + w2 > 1 + 1e-9) continue;
+      const auto& s = panel.surface[2 * r + t];
+      return (1 - w1 - w2) * s[0] + w1 * s[1] + w2 * s[2];
+    }
+  }
+  return std::nullopt;
+}
+
+Structure wovenStructure(PolygonMesh mesh, WeaveOptions options = {}) {
+  mesh = test::atConstructionSize(std::move(mesh));
+  requireUsable(analyzeMesh(mesh));
+  return buildWeaveStructure(mesh, options, test::context());
+}
+
+TEST(WeaveStructure, TheSoccerBallIsNinetyPanelsEachOverItsEdgeAndUnderTwo) {
+  const WeaveOptions options;
+  const Structure s = wovenStructure(truncatedIcosahedron(), options);
+  ASSERT_EQ(s.panels.size(), 90U);
+  EXPECT_EQ(s.kind, StructureKind::Weave);
+  EXPECT_EQ(s.edges, 90);
+  EXPECT_EQ(s.fasteners, 180);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+  std::map<int, int> up, down;
+  std::set<int> cycles;
+  for (const Panel& panel : s.panels) {
+    SCOPED_TRACE(panel.id);
+    EXPECT_EQ(panel.source.edge, panel.id);
+    cycles.insert(panel.source.cycle);
+    std::map<LabelRole, int> roles;
+    for (const PanelLabel& label : panel.labels) {
+      ++roles[label.role];
+      if (label.role == LabelRole::Up) {
+        EXPECT_EQ(label.edge, panel.id);
+        ++up[label.edge];
+      }
+      if (label.role == LabelRole::Down) ++down[label.edge];
+    }
+    EXPECT_EQ(roles[LabelRole::Up], 1);
+    EXPECT_EQ(roles[LabelRole::Down], 2);
+    EXPECT_EQ(roles[LabelRole::Neighbor], 1);
+    EXPECT_GT(core::signedArea(panel.outline), 0);
+    EXPECT_FALSE(core::crossesItself(panel.outline));
+    // Its holes: two at each of its three crossings.
+    std::map<int, int> holes;
+    for (const PanelHole& hole : panel.holes) ++holes[hole.edge];
+    EXPECT_EQ(holes.size(), 3U);
+    for (const auto& [edge, count] : holes) EXPECT_EQ(count, 2) << "edge " << edge;
+    EXPECT_EQ(holes.count(panel.id), 1U);
+  }
+  // SPEC: each edge index `up` on one panel and `down` on two.
+  for (int e = 1; e <= 90; ++e) {
+    EXPECT_EQ(up[e], 1) << e;
+    EXPECT_EQ(down[e], 2) << e;
+  }
+  // Petrie walks of the truncated icosahedron: ten threads of 18.
+  EXPECT_EQ(cycles.size(), 10U);
+}
+
+TEST(WeaveStructure, TheNeighbourNumberNamesAPanelUnderTheCrossing) {
+  const Structure s = wovenStructure(truncatedIcosahedron());
+  std::map<int, std::set<int>> panelsAt;
+  for (const Panel& panel : s.panels) {
+    for (const PanelHole& hole : panel.holes) panelsAt[hole.edge].insert(panel.id);
+  }
+  for (const Panel& panel : s.panels) {
+    for (const PanelLabel& label : panel.labels) {
+      if (label.role != LabelRole::Neighbor) continue;
+      EXPECT_NE(label.edge, panel.id);
+      EXPECT_EQ(panelsAt[panel.id].count(label.edge), 1U) << "panel " << panel.id;
+      // Underlined: one stroke more than its digits.
+      EXPECT_FALSE(label.strokes.empty());
+    }
+  }
+}
+
+TEST(WeaveStructure, TheHolesOfACrossingLineUpThroughItsThreePanels) {
+  WeaveOptions options;
+  for (auto& [name, mesh] : std::vector<std::pair<const char*, PolygonMesh>>{
+           {"cube", cube()}, {"soccer ball", truncatedIcosahedron()}, {"torus", torus(9, 6)}}) {
+    SCOPED_TRACE(name);
+    const Structure s = wovenStructure(mesh, options);
+    // Per edge, the holes of each panel in space.
+    std::map<int, std::vector<std::vector<Point3>>> at;
+    for (const Panel& panel : s.panels) {
+      std::map<int, std::vector<Point3>> mine;
+      for (const PanelHole& hole : panel.holes) {
+        const auto p = inSpace(panel, hole.xy);
+        ASSERT_TRUE(p) << "a hole of panel " << panel.id << " is off it";
+        mine[hole.edge].push_back(*p);
+      }
+      // The panel over edge k is panel k: first.
+      for (auto& [edge, points] : mine) {
+        auto& list = at[edge];
+        list.insert(edge == panel.id ? list.begin() : list.end(), points);
+      }
+    }
+    for (const auto& [edge, panels] : at) {
+      ASSERT_EQ(panels.size(), 3U);
+      for (const auto& pair : panels) ASSERT_EQ(pair.size(), 2U);
+      // The panels under it share the strip there: their holes are the same
+      // points. The panel over it has each hole on the same line along N_e,
+      // above: 2h at the crossing's centre, and at the holes, either side of
+      // it, as far as the Bézier rails have bowed towards the next crossing.
+      for (const Point3& hole : panels[1]) {
+        const double same = std::min((panels[2][0] - hole).norm(), (panels[2][1] - hole).norm());
+        EXPECT_LT(same, 1e-9) << "edge " << edge;
+        const double over = std::min((panels[0][0] - hole).norm(), (panels[0][1] - hole).norm());
+        EXPECT_GT(over, options.shape.offset / 2) << "edge " << edge;
+        EXPECT_LE(over, 3 * options.shape.offset) << "edge " << edge;
+      }
+      // Each pair apart by the least clearance's spacing, at the least.
+      for (const auto& pair : panels) {
+        EXPECT_GE((pair[0] - pair[1]).norm(), (kLeastClearance + 1) * options.fastener * (1 - 1e-9));
+      }
+    }
+  }
+}
+
+TEST(WeaveStructure, EveryCrossingIsFastenedOnceWithTwoFastenersAtItsLastPanel) {
+  const Structure s = wovenStructure(truncatedIcosahedron());
+  std::map<int, int> fastened;
+  int total = 0;
+  for (const AssemblyStep& step : s.steps) {
+    for (const AssemblyJoin& join : step.joins) {
+      ++fastened[join.edge];
+      total += join.fasteners;
+      EXPECT_EQ(join.fasteners, 2);
+      EXPECT_LT(join.panel, step.panel + (join.edge == step.panel ? 0 : 1));
+    }
+  }
+  EXPECT_EQ(fastened.size(), 90U);
+  EXPECT_EQ(total, s.fasteners);
+  // The first thread's panels come first, each over the next crossing of it.
+  EXPECT_EQ(s.panels.front().source.cycle, 1);
+}
+
+TEST(WeaveStructure, ASingleCycleWeaveIsOneThreadOfFacesLessOnePanels) {
+  WeaveOptions options;
+  options.cycles = WeaveCycles::Single;
+  const Structure s = wovenStructure(cube(), options);
+  EXPECT_EQ(s.panels.size(), 5U);
+  for (const Panel& panel : s.panels) EXPECT_EQ(panel.source.cycle, 1);
+}
+
+TEST(WeaveStructure, AFastenerTooLargeForTheCrossingsGrowsTheMesh) {
+  PolygonMesh mesh = test::atConstructionSize(truncatedIcosahedron());
+  requireUsable(analyzeMesh(mesh));
+  WeaveOptions options;
+  options.fastener = 0.5;
+  const GrownStructure grown = buildWeaveStructureWithRoom(mesh, options, test::context());
+  EXPECT_GT(grown.grown, 1);
+  EXPECT_EQ(grown.structure.panels.size(), 90U);
+}
+
+}  // namespace
+}  // namespace rotafab::geometry
