@@ -107,7 +107,10 @@ void addMakeCommand(CLI::App& app, int& status) {
       "Examples:\n"
       "  rotafab make examples/bunny.obj --structure band\n"
       "  rotafab make examples/torus.obj --structure band --size 30in --fastener 3mm --out torus/");
-  make->callback([options, &status] { status = runMake(*options); });
+  make->callback([options, make, &status] {
+    checkStructureOptions(*make, *options);
+    status = runMake(*options);
+  });
 }
 
 }  // namespace rotafab::cli

@@ -1,5 +1,10 @@
 #include "daemon/MakeOptions.h"
 
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <vector>
+
 #include "daemon/CommandSupport.h"
 
 namespace rotafab::cli {
@@ -12,9 +17,13 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.material = profiles::findMaterial(catalogue, options.material);
   if (!options.size.empty()) request.size = lengthOption(options.size, "--size", true);
   request.scale = options.scale;
-  request.holes = options.holes == "fill"    ? jobs::HolesMode::Fill
-                  : options.holes == "error" ? jobs::HolesMode::Error
-                                             : jobs::HolesMode::Keep;
+  // SPEC: fill by default for weave (every edge is crossed), keep for band.
+  const std::string holes = !options.holes.empty()                                ? options.holes
+                            : request.structure == geometry::StructureKind::Weave ? "fill"
+                                                                                  : "keep";
+  request.holes = holes == "fill"    ? jobs::HolesMode::Fill
+                  : holes == "error" ? jobs::HolesMode::Error
+                                     : jobs::HolesMode::Keep;
   request.repair = options.repair == "auto";
   request.mergeCoplanar = options.mergeCoplanar;
   request.panels = options.panels;
@@ -24,6 +33,10 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.start = options.start;
   request.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
   request.scoreFolds = options.scoreFolds;
+  if (options.width) request.width = *options.width;
+  if (options.curve) request.curve = *options.curve;
+  if (!options.offset.empty()) request.offset = lengthOption(options.offset, "--offset", true);
+  request.cycles = options.cycles == "single" ? geometry::WeaveCycles::Single : geometry::WeaveCycles::All;
   if (!options.kerf.empty()) request.kerf = lengthOption(options.kerf, "--kerf");
   request.seconds = options.seconds;
   request.evaluations = options.evaluations;
@@ -34,6 +47,47 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   if (!options.formats.empty()) request.formats = jobs::formatsOf(options.formats);  // checked by --formats
   request.names = flagOf;
   return request;
+}
+
+namespace {
+
+const std::vector<std::string> kWeaveOnly{"--width", "--curve", "--offset", "--cycles"};
+const std::vector<std::string> kBandOnly{"--tension", "--start", "--score-folds"};
+
+// A fraction of an edge's region: more than 0, at most 1, with no unit.
+CLI::Validator fractionCheck() {
+  return CLI::Validator(
+      [](std::string& value) {
+        char* end = nullptr;
+        const double number = std::strtod(value.c_str(), &end);
+        if (end == value.c_str() || *end != '\0') {
+          return fmt::format(
+              "{}: expected a plain number more than 0 and at most 1 (a share of the edge's region, "
+              "no unit)",
+              value);
+        }
+        if (!(number > 0 && number <= 1)) return fmt::format("{}: expected more than 0 and at most 1", value);
+        return std::string();
+      },
+      "0<F<=1");
+}
+
+}  // namespace
+
+void checkStructureOptions(const CLI::App& make, const MakeOptions& options) {
+  const bool weave = options.structure == "weave";
+  for (const std::string& option : weave ? kBandOnly : kWeaveOnly) {
+    if (make.count(option) > 0) {
+      throw CLI::ValidationError(
+          weave ? fmt::format("{} is an option of the band decomposition (--structure band), not of weave", option)
+                : fmt::format("{} is an option of the plain-woven structure (--structure weave), not of band", option));
+    }
+  }
+  if (weave && options.holes == "keep") {
+    throw CLI::ValidationError(
+        "--holes keep: a plain weave crosses every edge, and a boundary edge has one side; fill (the default for "
+        "weave) caps each hole with a face, error refuses an open mesh");
+  }
 }
 
 void addMakeOptions(CLI::App& make, MakeOptions& options) {
@@ -49,8 +103,9 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
                 "Print one JSON object: panels, sheets, fasteners, utilization, seconds per phase");
   auto* size = make.add_option("--size", options.size, "Scale so that the largest bounding-box side is this long");
   make.add_option("--scale", options.scale, "Scale the mesh by this factor (inches per mesh unit)")->excludes(size);
-  make.add_option("--holes", options.holes, "Open meshes: keep the boundary open, fill each hole, or refuse")
-      ->capture_default_str()
+  make.add_option("--holes", options.holes,
+                  "Open meshes: keep the boundary open (the default for band), fill each hole with a face (the "
+                  "default for weave), or refuse")
       ->check(CLI::IsMember({"keep", "fill", "error"}));
   make.add_option("--repair", options.repair,
                   "auto: weld, drop duplicate faces, split non-manifold edges and bow-tie vertices, orient (each "
@@ -67,9 +122,26 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
       ->check(CLI::Range(4, 10000000));
   make.add_option("--tension", options.tension,
                   "Corner-cutting tension a of eq. 5.2, 0 < a < 1 (default: Doo-Sabin, a = 1/4 + 5/(4N))");
-  make.add_option("--samples", options.samples, "Segments along each edge band")
+  make.add_option("--samples", options.samples,
+                  "Segments along each edge band (band), or along each ribbon's Bézier curve between crossings "
+                  "(weave)")
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
+  make.add_option("--width", options.width,
+                  "Weave: the ribbons' share of their edge region across them, 0 < W <= 1 (default 0.8; eq. 4.6-4.9)")
+      ->check(fractionCheck());
+  make.add_option("--curve", options.curve,
+                  "Weave: each crossing's share of its edge region along the ribbon, 0 < C <= 1 (default 0.6;\n"
+                  "smaller curves the ribbons more between crossings; eq. 4.2-4.5)")
+      ->check(fractionCheck());
+  make.add_option("--offset", options.offset,
+                  "Weave: how far a ribbon stands over (or under) the surface at a crossing (default: half the\n"
+                  "material's thickness, at least 0.01in)");
+  make.add_option("--cycles", options.cycles,
+                  "Weave: all (every edge crossed: a thread per Petrie walk) or single (one thread weaves the\n"
+                  "whole object, crossing the edges of a spanning tree of the dual)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"all", "single"}));
   make.add_option("--fastener", options.fastener, "Fastener hole diameter (default: the material's, 1/8 in)");
   make.add_option("--kerf", options.kerf, "Kerf (default: the material's)");
   make.add_option("--start", options.start, "Flood-fill start face (index in the file; default: the lowest face)");

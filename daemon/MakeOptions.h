@@ -14,9 +14,11 @@ namespace rotafab::cli {
 
 struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
-  std::string size, fastener, kerf, holes = "keep", repair = "auto", up = "y", order = "window", layout = "nest";
-  std::string formats;      // empty: the machine profile's (jobs::defaultFormats())
-  bool orderGiven = false;  // --order given: kept even where the free order would save a sheet
+  std::string size, fastener, kerf, holes, repair = "auto", up = "y", order = "window", layout = "nest";
+  std::string offset, cycles = "all";  // the weave's
+  std::optional<double> width, curve;  // the weave's: fractions, no unit
+  std::string formats;                 // empty: the machine profile's (jobs::defaultFormats())
+  bool orderGiven = false;             // --order given: kept even where the free order would save a sheet
   std::optional<double> scale, tension, mergeCoplanar;
   std::optional<int> start, panels;
   int samples = 8, window = 8, evaluations = 0;
@@ -26,6 +28,11 @@ struct MakeOptions {
 
 // Declares every option of `make` on the verb, into `options`.
 void addMakeOptions(CLI::App& make, MakeOptions& options);
+
+// Options given that the structure chosen does not take (--width with band,
+// --tension with weave, ...), and --holes keep with weave: throws
+// CLI::ValidationError naming the option.
+void checkStructureOptions(const CLI::App& make, const MakeOptions& options);
 
 // The request the options make; throws core::UserError on a bad length or an
 // unknown profile.

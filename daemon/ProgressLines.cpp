@@ -29,12 +29,15 @@ void ProgressLines::operator()(const core::Progress& p) {
                                     : fmt::format("{} with a tab, {} cut across the middle", p.done, across));
     }
     if (p.step == "larger, for the fasteners") {
-      line = fmt::format("building again, larger, so that every band has room for its fastener (try {})", p.done);
+      line = fmt::format("building again, larger, so that every fastener hole has room (try {})", p.done);
     }
     if (p.step == "smaller, for the bed") {
       line = fmt::format("building again, smaller, so that every part fits the bed (try {})", p.done);
     }
     if (p.step == "fastener holes") line = fmt::format("fastener holes on {} bands", p.total);
+    if (p.step == "crossing holes") line = fmt::format("fastener holes at {} crossings", p.total);
+    if (p.step == "weaving threads") line = "weaving threads (face tracing with twisted edges)";
+    if (p.step == "ribbons") line = "ribbons, panels, unfolding";
     if (p.step == "labels") line = fmt::format("labels on {} panels", p.total);
   } else if (p.phase == "nesting") {
     std::string step;

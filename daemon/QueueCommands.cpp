@@ -351,6 +351,7 @@ void addQueueCommands(CLI::App& app, int& status) {
       if (make->structure.empty() && !fs::is_directory(make->mesh, isFolder)) {
         throw CLI::ValidationError("--structure is required to plan a mesh (band or weave)");
       }
+      checkStructureOptions(*submit, *make);
       status = talking([&]() -> int {
         if (!make->out.empty())
           throw UserError("--out: the daemon keeps a submitted job's files; `rotafab make` writes a folder");

@@ -24,8 +24,6 @@ namespace {
 
 // The commands of SPEC's command line that are not built yet: the workshop page's.
 constexpr std::string_view kDaemonVerbs[] = {"dashboard"};
-// Options of SPEC's `make` that only the woven structure takes.
-constexpr std::string_view kWeaveOptions[] = {"--width", "--curve", "--offset", "--cycles"};
 
 size_t editDistance(std::string_view a, std::string_view b) {
   std::vector<size_t> row(b.size() + 1);
@@ -93,19 +91,6 @@ int main(int argc, char** argv) {
               ? fmt::format("{} is not a rotafab command; did you mean `rotafab {}`?", word, nearest)
               : fmt::format("{} is not a rotafab command (the commands: {})", word, fmt::join(verbs, ", ")),
           "rotafab --help");
-    }
-  }
-  if (verb == "make") {
-    for (int i = 2; i < argc; ++i) {
-      const std::string_view arg = argv[i];
-      for (std::string_view option : kWeaveOptions) {
-        if (arg == option || (arg.starts_with(option) && arg.substr(option.size()).starts_with("="))) {
-          return usageError(fmt::format("{} is an option of the plain-woven structure (--structure weave, "
-                                        "dissertation ch. IV), which is not built yet",
-                                        option),
-                            "rotafab make --help");
-        }
-      }
     }
   }
   try {

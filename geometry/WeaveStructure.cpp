@@ -93,12 +93,22 @@ double angleAtRow(const WovenPanel& panel, int row) {
 struct CrossingHoles {
   std::array<std::array<Point2, 2>, 3> flat;  // per panel of CrossingPanels, per hole
   double clearance = -std::numeric_limits<double>::infinity();
+  double fromOutline = 0, apart = 0;  // the least distance to an outline, and between a panel's two holes, diameters
+  bool single = false;                // one hole at the crossing's centre: no room for two
+
+  // How many times larger the mesh must be (every length but the
+  // diameter grows with it) for these holes to keep kClearance.
+  [[nodiscard]] double scaleNeeded() const {
+    return std::max(fromOutline > 0 ? kClearance / fromOutline : std::numeric_limits<double>::infinity(),
+                    apart > 0 ? (kClearance + 1) / apart : std::numeric_limits<double>::infinity());
+  }
 };
 
 CrossingHoles holesAt(const EdgeRegion& region, const CrossingPanels& at, const std::vector<WovenPanel>& panels,
                       const std::vector<std::vector<Point2>>& outlines, double delta, int reach, double diameter) {
   CrossingHoles holes;
-  double clearance = std::numeric_limits<double>::infinity();
+  double fromOutline = std::numeric_limits<double>::infinity(), apart = fromOutline;
+  bool missed = false;
   for (size_t k = 0; k < 3; ++k) {
     const WovenPanel& panel = panels[static_cast<size_t>(at.panel[k])];
     for (size_t h = 0; h < 2; ++h) {
@@ -109,13 +119,16 @@ CrossingHoles holesAt(const EdgeRegion& region, const CrossingPanels& at, const 
       const StripPoint hit = stripPointOnLine(panel, at.row[k] - reach, at.row[k] + reach, point, region.normal);
       holes.flat[k][h] = hit.onPanel(panel);
       // A line that misses the strip: no hole through all three panels there.
-      if (hit.miss > 1e-6 * diameter) clearance = -std::numeric_limits<double>::infinity();
-      clearance = std::min(
-          clearance, core::distanceToOutline(outlines[static_cast<size_t>(at.panel[k])], holes.flat[k][h]) / diameter);
+      missed = missed || hit.miss > 1e-6 * diameter;
+      fromOutline =
+          std::min(fromOutline,
+                   core::distanceToOutline(outlines[static_cast<size_t>(at.panel[k])], holes.flat[k][h]) / diameter);
     }
-    clearance = std::min(clearance, (holes.flat[k][0] - holes.flat[k][1]).norm() / diameter - 1);
+    apart = std::min(apart, (holes.flat[k][0] - holes.flat[k][1]).norm() / diameter);
   }
-  holes.clearance = clearance;
+  holes.fromOutline = missed ? 0 : fromOutline;
+  holes.apart = apart;
+  holes.clearance = missed ? -std::numeric_limits<double>::infinity() : std::min(fromOutline, apart - 1);
   return holes;
 }
 
@@ -139,43 +152,64 @@ CrossingHoles placeCrossingHoles(const EdgeRegion& region, const CrossingPanels&
     if (holes.clearance >= kClearance) return holes;
     if (holes.clearance > best.clearance) best = holes;
   }
-  return best;
+  if (best.clearance >= kLeastClearance) return best;
+  // No room for two: one at the crossing's centre, as a band too small for
+  // two holes gets one (FastenerHoles.h), if that has room.
+  CrossingHoles one = holesAt(region, at, panels, outlines, 0, reach, diameter);
+  one.single = true;
+  one.apart = std::numeric_limits<double>::infinity();
+  one.clearance = one.fromOutline > 0 ? one.fromOutline : -std::numeric_limits<double>::infinity();
+  return one.clearance > best.clearance || one.clearance >= kLeastClearance ? one : best;
 }
 
-struct Labelled {
-  std::vector<PanelLabel> labels;
-  std::vector<std::string> unfitted;
-};
-
-// The candidate centres for a label: the strip's centre at `from`, then
-// rows stepping `step` away, as far as `to`.
-std::vector<Point2> rowCentres(const WovenPanel& panel, int from, int to) {
-  std::vector<Point2> centres;
+// The rows from `from` stepping towards `to`, both included, those on the panel.
+std::vector<int> rowsFrom(const WovenPanel& panel, int from, int to) {
+  std::vector<int> rows;
   const int step = to >= from ? 1 : -1;
   for (int row = from;; row += step) {
-    if (row >= 0 && row < panel.rows()) centres.push_back(centreOfRow(panel, row));
+    if (row >= 0 && row < panel.rows()) rows.push_back(row);
     if (row == to) break;
   }
-  return centres;
+  return rows;
+}
+
+// The candidate centres for a label, row by row in the order given: on
+// each row its middle, then nearer one side and the other (a label beside
+// a hole rather than between two).
+std::vector<Point2> labelCandidates(const WovenPanel& panel, const std::vector<int>& rows) {
+  std::vector<Point2> candidates;
+  for (int row : rows) {
+    const Point2 &p = panel.flatP[static_cast<size_t>(row)], &q = panel.flatQ[static_cast<size_t>(row)];
+    for (double t : {0.5, 0.32, 0.68, 0.18, 0.82}) candidates.push_back(p + t * (q - p));
+  }
+  return candidates;
 }
 
 }  // namespace
 
 std::vector<AssemblyStep> weaveSteps(const std::vector<Panel>& panels) {
-  // Panels (in id order) with holes of each edge number.
-  std::map<int, std::vector<int>> panelsOfEdge;
+  // Per edge number: its holes in all, and the last panel holding some. A
+  // crossing's three panels hold as many holes each, one per fastener; a
+  // panel may be two of them (a single thread round a leaf face of its tree
+  // goes under and then over one edge).
+  std::map<int, int> holesOfEdge, lastPanel, firstPanel;
+  for (const Panel& panel : panels) {
+    for (const PanelHole& hole : panel.holes) {
+      ++holesOfEdge[hole.edge];
+      lastPanel[hole.edge] = std::max(lastPanel[hole.edge], panel.id);
+      if (!firstPanel.count(hole.edge)) firstPanel[hole.edge] = panel.id;
+    }
+  }
   std::vector<AssemblyStep> steps;
   for (const Panel& panel : panels) {
-    std::map<int, int> holesOfEdge;
-    for (const PanelHole& hole : panel.holes) ++holesOfEdge[hole.edge];
     AssemblyStep step{panel.id, {}, {}, {}};
-    for (const auto& [edge, holes] : holesOfEdge) {
-      std::vector<int>& on = panelsOfEdge[edge];
-      on.push_back(panel.id);
-      if (on.size() != 3) continue;
-      // Complete: over it panel `edge`, and two under.
-      const int named = edge != panel.id ? edge : on[0];
-      step.joins.push_back({named, edge, holes, {}});
+    std::set<int> edges;
+    for (const PanelHole& hole : panel.holes) edges.insert(hole.edge);
+    for (int edge : edges) {
+      if (lastPanel[edge] != panel.id) continue;
+      // The join names the panel over it, or at the over panel's own step the first under it.
+      const int named = edge != panel.id ? edge : firstPanel[edge];
+      step.joins.push_back({named, edge, holesOfEdge[edge] / 3, {}});
     }
     steps.push_back(std::move(step));
   }
@@ -245,14 +279,15 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   result.edges = static_cast<int>(woven.size());
   const double d = options.fastener;
   const size_t crossingCount = regions.size();
-  context.report({"geometry", "fastener holes", 0, crossingCount});
+  context.report({"geometry", "crossing holes", 0, static_cast<size_t>(result.edges)});
   std::vector<CrossingHoles> holes(crossingCount);
+  std::vector<char> glued(crossingCount, 0);
   context.parallelFor(crossingCount, [&](size_t e) {
     if (crossings[e].panel[0] < 0) return;  // untwisted: no crossing
     holes[e] = placeCrossingHoles(regions[e], crossings[e], woven, outlines, options.shape, d);
   });
   {
-    int withoutRoom = 0, narrow = 0;
+    int withoutRoom = 0, narrow = 0, single = 0;
     double scaleNeeded = 1, narrowest = kClearance;
     int first = 0, narrowestEdge = 0;
     std::vector<double> scales;
@@ -261,24 +296,60 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       const double c = holes[e].clearance;
       if (c < kLeastClearance) {
         ++withoutRoom;
-        // Every length but the diameter scales with the mesh.
-        const double scale = c > 0 ? kClearance / c : std::numeric_limits<double>::infinity();
+        const double scale = holes[e].scaleNeeded();
         scales.push_back(scale);
         if (first == 0 || scale > scaleNeeded) first = edgeNumber[e];
         scaleNeeded = std::max(scaleNeeded, scale);
+      } else if (holes[e].single) {
+        ++single;
       } else if (c < kClearance) {
         ++narrow;
         if (c < narrowest) narrowest = c, narrowestEdge = edgeNumber[e];
       }
     }
+    // As a band decomposition may glue a few bands (MakeJob's sizing), one
+    // crossing in a hundred may go without a hole, glued, rather than the
+    // whole structure grow for a sliver: the mesh grows only as far as all
+    // but those need.
+    const size_t mayGlue = static_cast<size_t>(result.edges) / 100;
+    if (withoutRoom > 0 && static_cast<size_t>(withoutRoom) <= mayGlue) {
+      for (size_t e = 0; e < crossingCount; ++e) {
+        if (crossings[e].panel[0] >= 0 && holes[e].clearance < kLeastClearance) {
+          glued[e] = 1;
+          result.glued.push_back(edgeNumber[e]);
+        }
+      }
+      std::sort(result.glued.begin(), result.glued.end());
+      std::string some;
+      for (size_t i = 0; i < std::min<size_t>(result.glued.size(), 5); ++i) {
+        some += fmt::format("{}{}", i ? ", " : "", result.glued[i]);
+      }
+      result.warnings.push_back(fmt::format(
+          "{} crossing{} no room for a {:.3f} in fastener hole {:g} diameter from its panels' outlines, so no "
+          "hole: glue {} (edge{} {}{})",
+          withoutRoom, withoutRoom == 1 ? " has" : "s have", d, kLeastClearance, withoutRoom == 1 ? "it" : "them",
+          withoutRoom == 1 ? "" : "s", some, result.glued.size() > 5 ? ", ..." : ""));
+      withoutRoom = 0;
+    }
     if (withoutRoom > 0) {
+      std::sort(scales.begin(), scales.end(), std::greater<>());
+      scaleNeeded = scales[std::min(mayGlue, scales.size() - 1)];
       NoRoomForHoleError error(
           fmt::format("edge {}: its crossing has no room for two {:.3f} in holes {:g} diameter from the outlines of "
-                      "its three panels",
-                      first, d, kLeastClearance),
-          withoutRoom, scaleNeeded, d, options.names);
+                      "its three panels{}",
+                      first, d, kLeastClearance,
+                      withoutRoom > 1 ? fmt::format(" (nor have {} other crossings)", withoutRoom - 1) : ""),
+          1, scaleNeeded, d, options.names);
+      error.bands = withoutRoom;
       error.scales = scales;
       throw error;
+    }
+    if (single > 0) {
+      result.warnings.push_back(fmt::format(
+          "{} crossing{} too small for two {:.3f} in holes: one at {} centre, through its three panels; a larger {} "
+          "or a smaller {} gives {} two",
+          single, single == 1 ? " is" : "s are", d, single == 1 ? "its" : "each one's", options.names(Parameter::Size),
+          options.names(Parameter::Fastener), single == 1 ? "it" : "them"));
     }
     if (narrow > 0) {
       result.warnings.push_back(fmt::format(
@@ -290,13 +361,13 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   }
   context.check();
 
-  // Per panel, its holes: two at each of its three crossings.
+  // Per panel, its holes: two (or one) at each of its three crossings.
   std::vector<std::vector<PanelHole>> holesOf(woven.size());
   for (size_t e = 0; e < crossingCount; ++e) {
-    if (crossings[e].panel[0] < 0) continue;
+    if (crossings[e].panel[0] < 0 || glued[e]) continue;
     for (size_t k = 0; k < 3; ++k) {
-      for (const Point2& xy : holes[e].flat[k]) {
-        holesOf[static_cast<size_t>(crossings[e].panel[k])].push_back({edgeNumber[e], xy, d});
+      for (size_t h = 0; h < (holes[e].single ? 1U : 2U); ++h) {
+        holesOf[static_cast<size_t>(crossings[e].panel[k])].push_back({edgeNumber[e], holes[e].flat[k][h], d});
       }
     }
   }
@@ -359,7 +430,16 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       panel.labels.push_back(std::move(placed));
     };
     const int u = w.upRow;
-    place(std::to_string(panel.id), panel.id, LabelRole::Up, u, u - reach, u + reach, rowCentres(w, u, u - reach));
+    {
+      // From the middle row outwards, either way in turn.
+      std::vector<int> rows{u};
+      for (int k = 1; k <= reach; ++k) {
+        for (int row : {u - k, u + k}) {
+          if (row >= 0 && row < w.rows()) rows.push_back(row);
+        }
+      }
+      place(std::to_string(panel.id), panel.id, LabelRole::Up, u, u - reach, u + reach, labelCandidates(w, rows));
+    }
     // The neighbouring edge: the panel under this one met first turning
     // counter-clockwise about N_e from the direction this one runs.
     {
@@ -370,20 +450,21 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       const Point3 underRuns = (below.tail[0] + below.tail[1]) - (below.head[0] + below.head[1]);
       const bool after = overRuns.cross(underRuns).dot(regions[static_cast<size_t>(w.upEdge)].normal) > 0;
       const int neighbour = idOf[static_cast<size_t>(atUp.panel[after ? 2 : 1])];
-      std::vector<Point2> beside = rowCentres(w, u + 2, u + reach);
-      const auto other = rowCentres(w, u - 2, u - reach);
-      beside.insert(beside.end(), other.begin(), other.end());
-      place(std::to_string(neighbour), neighbour, LabelRole::Neighbor, u, u - reach, u + reach, beside);
+      std::vector<int> rows = rowsFrom(w, u + 1, u + reach);
+      const auto other = rowsFrom(w, u - 1, u - reach);
+      rows.insert(rows.end(), other.begin(), other.end());
+      place(std::to_string(neighbour), neighbour, LabelRole::Neighbor, u, u - reach, u + reach,
+            labelCandidates(w, rows));
     }
     for (int end = 0; end < 2; ++end) {
       const int row = w.downRows[static_cast<size_t>(end)];
       const int number = edgeNumber[static_cast<size_t>(w.downEdges[static_cast<size_t>(end)])];
       // Past the holes towards the panel's end first, then towards its middle.
       const int outwards = end == 0 ? -1 : 1;
-      std::vector<Point2> candidates = rowCentres(w, row + outwards, row + outwards * reach);
-      const auto inwards = rowCentres(w, row - outwards, row - outwards * reach);
-      candidates.insert(candidates.end(), inwards.begin(), inwards.end());
-      place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach, candidates);
+      std::vector<int> rows = rowsFrom(w, row + outwards, row + outwards * reach);
+      const auto inwards = rowsFrom(w, row - outwards, row - outwards * reach);
+      rows.insert(rows.end(), inwards.begin(), inwards.end());
+      place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach, labelCandidates(w, rows));
     }
     result.panels[k] = std::move(panel);
   });
@@ -414,7 +495,11 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
           overlapping.size() == 1 ? "its" : "each"));
     }
   }
-  result.fasteners = 2 * result.edges;
+  // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
+  result.fasteners = 0;
+  for (size_t e = 0; e < crossingCount; ++e) {
+    if (crossings[e].panel[0] >= 0 && !glued[e]) result.fasteners += holes[e].single ? 1 : 2;
+  }
   result.steps = weaveSteps(result.panels);
   return result;
 }

@@ -34,7 +34,7 @@ struct WeaveOptions {
 // crossing over onwards. Throws InvalidMeshError or std::invalid_argument
 // (NoRoomForHoleError when a crossing has no room for its two holes) with
 // one line, and core::Cancelled. Progress: phase "geometry", steps "weaving
-// threads", "ribbons", "fastener holes" (of the crossings), "labels" (of the
+// threads", "ribbons", "crossing holes" (of the crossings), "labels" (of the
 // panels).
 Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context);
 

@@ -19,6 +19,7 @@
 #include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
 #include "geometry/Simplification.h"
+#include "geometry/WeaveStructure.h"
 #include "jobs/AtomicFile.h"
 #include "jobs/OutputFolder.h"
 #include "jobs/Toolpath.h"
@@ -189,7 +190,7 @@ geometry::Point3 builtSize(const geometry::Structure& structure) {
 // (or the scale, if that is what was given), that gives every band room;
 // every length of the structure scales with the mesh.
 std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, double fastener,
-                       double scaleNeeded) {
+                       double scaleNeeded, std::string_view places = "band") {
   const auto& names = request.names;
   if (!std::isfinite(scaleNeeded)) {
     return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
@@ -200,9 +201,9 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
                                  ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
                                  : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(size * scaleNeeded));
   const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
-  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every band room",
-                                   names(Parameter::Fastener), smaller, larger)
-                     : fmt::format("{} or larger would give every band room", larger);
+  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every {} room",
+                                   names(Parameter::Fastener), smaller, larger, places)
+                     : fmt::format("{} or larger would give every {} room", larger, places);
 }
 
 // How the structure's size was chosen, when make chose it.
@@ -210,6 +211,49 @@ struct Sizing {
   double grown = 1;         // times the default size (1: as it was)
   bool bedLimited = false;  // limited by the bed or by the narrowest bands, which are glued
 };
+
+// A plain-woven structure (dissertation ch. IV) of the mesh as built. The
+// ribbons follow the surface within the offset, so --size scales the mesh;
+// with no size or scale given it grows until every crossing has room for
+// its two holes.
+geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
+                               const core::WorkContext& context) {
+  const std::string name = request.mesh.string();
+  geometry::WeaveOptions weave;
+  weave.cycles = request.cycles;
+  weave.shape.width = request.width;
+  weave.shape.curve = request.curve;
+  weave.shape.offset = request.offset.value_or(std::max(request.material.thickness / 2, kLeastOffset));
+  weave.shape.samples = request.samples;
+  weave.fastener = request.fastener.value_or(request.material.fastenerDiameter);
+  weave.up = request.up;
+  weave.names = request.names;
+  try {
+    if (request.size) {
+      const double side = geometry::boundingBoxSize(mesh).maxCoeff();
+      if (side > 0) {
+        for (geometry::Point3& p : mesh.positions) p *= *request.size / side;
+      }
+    }
+    if (request.size || request.scale) return geometry::buildWeaveStructure(mesh, weave, context);
+    geometry::GrownStructure built = geometry::buildWeaveStructureWithRoom(mesh, weave, context);
+    sizing.grown = built.grown;
+    if (built.grown > 1) {
+      context.note(fmt::format(
+          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the smallest size at which every crossing has room "
+          "for two {:.3f} in fastener holes ({} crossing{} had none); {} or {} sets the size",
+          name, geometry::kMeanEdgeInches * built.grown, geometry::kMeanEdgeInches, weave.fastener,
+          built.bandsWithoutRoom, plural(built.bandsWithoutRoom), request.names(Parameter::Size),
+          request.names(Parameter::Scale)));
+    }
+    return std::move(built.structure);
+  } catch (const geometry::NoRoomForHoleError& error) {
+    throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
+                                      roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing")));
+  } catch (const std::invalid_argument& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  }
+}
 
 // `start`: the flood fill's first face in the mesh as built.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
@@ -385,11 +429,6 @@ JobCost jobCost(const PlannedJob& job, const MakeRequest& request, const core::W
 PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context) {
   Lap lap;
   const std::string name = request.mesh.string();
-  if (request.structure == geometry::StructureKind::Weave) {
-    throw core::UserError(
-        fmt::format("{} weave: plain-woven structures (dissertation ch. IV) are not built yet; use band",
-                    request.names(Parameter::Structure)));
-  }
   PlannedJob job;
   job.title = fmt::format("{} ({})", request.mesh.stem().string(), geometry::structureName(request.structure));
   geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
@@ -397,7 +436,9 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   context.check();
 
   Sizing sizing;
-  job.structure = builtStructure(request, mesh, job.mesh.start, sizing, context);
+  job.structure = request.structure == geometry::StructureKind::Weave
+                      ? builtWeave(request, mesh, sizing, context)
+                      : builtStructure(request, mesh, job.mesh.start, sizing, context);
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.size = builtSize(job.structure);

@@ -16,6 +16,7 @@
 #include "geometry/Parameters.h"
 #include "geometry/Stability.h"
 #include "geometry/Structure.h"
+#include "geometry/WeaveThreads.h"
 #include "jobs/JobCost.h"
 #include "jobs/Manifest.h"
 #include "jobs/Nesting.h"
@@ -27,6 +28,9 @@ namespace rotafab::jobs {
 
 // SPEC's --holes: leave the boundary open, fill each hole, or refuse an open mesh.
 enum class HolesMode { Keep, Fill, Error };
+
+// A woven ribbon's least offset over or under the surface, inches: paper's thickness.
+constexpr double kLeastOffset = 0.01;
 
 struct MakeRequest {
   std::filesystem::path mesh;  // messages name it as given
@@ -50,6 +54,10 @@ struct MakeRequest {
   std::optional<int> start;
   int up = 1;
   bool scoreFolds = false;
+  // The plain weave's (geometry/WeaveStructure.h); `samples` too, per Bézier segment.
+  double width = 0.8, curve = 0.6;
+  std::optional<double> offset;  // inches; default: half the material's thickness, at least kLeastOffset
+  geometry::WeaveCycles cycles = geometry::WeaveCycles::All;
   // The planner's (jobs/SheetPlanner.h).
   std::optional<double> kerf;  // default: the material's
   double seconds = kDefaultNestingSeconds;

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -12,6 +13,7 @@
 #include <stdexcept>
 
 #include "core/UserError.h"
+#include "geometry/WeaveStructure.h"
 #include "jobs/JobCost.h"
 #include "jobs/JsonErrors.h"
 #include "jobs/SvgWriter.h"
@@ -349,6 +351,139 @@ std::string describeJoins(const Step& step) {
   return text;
 }
 
+// One assembly step as the builders read it, whatever the structure.
+struct StepLine {
+  int panel = 0, sheet = 0, fasteners = 0;
+  int thread = 0;  // a woven panel's (its source's cycle); 0 for a band panel
+  std::string joins;
+};
+
+// A woven structure's steps (dissertation IV.4): panel k goes over edge k,
+// between the two panels under it, which overlap end to end there; a
+// crossing is fastened, through both pairs of holes in its three panels,
+// once the last of them is placed (geometry::weaveSteps()).
+std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
+  std::map<int, const nlohmann::ordered_json*> byId;
+  for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
+  std::map<int, std::vector<int>> panelsAt;  // edge -> the panels with its holes, in id order
+  std::vector<geometry::Panel> panels;
+  for (const auto& [id, panel] : byId) {
+    geometry::Panel& read = panels.emplace_back();
+    read.id = id;
+    std::set<int> edges;
+    for (const auto& hole : panel->at("holes")) {
+      read.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
+      edges.insert(read.holes.back().edge);
+    }
+    for (int e : edges) panelsAt[e].push_back(id);
+  }
+  const auto others = [&](int edge, int except) {
+    std::vector<int> list;
+    for (int id : panelsAt[edge]) {
+      if (id != except) list.push_back(id);
+    }
+    return list;
+  };
+  const auto named = [](const std::vector<int>& ids) {
+    std::string text;
+    for (size_t i = 0; i < ids.size(); ++i)
+      text += fmt::format("{}{}", i == 0 ? "" : i + 1 == ids.size() ? " and " : ", ", ids[i]);
+    return text;
+  };
+  const std::vector<geometry::AssemblyStep> steps = geometry::weaveSteps(panels);
+  std::vector<StepLine> lines;
+  for (size_t i = 0; i < panels.size(); ++i) {
+    const geometry::Panel& panel = panels[i];
+    const auto& json = *byId.at(panel.id);
+    StepLine line;
+    line.panel = panel.id;
+    line.sheet = json.at("sheet").get<int>();
+    line.thread = json.at("source").value("cycle", 0);
+    std::set<int> ends;
+    for (const geometry::PanelHole& hole : panel.holes) {
+      if (hole.edge != panel.id) ends.insert(hole.edge);
+    }
+    const std::vector<int> under = others(panel.id, panel.id);
+    // Two panels at a crossing: this one goes under it too, at one end (a
+    // single thread round a leaf face), bent round over itself.
+    line.joins = under.size() == 2 ? fmt::format("over edge {}, above panels {}", panel.id, named(under))
+                 : under.size() == 1
+                     ? fmt::format("over edge {}, above panel {} and its own end (bend it round)", panel.id, under[0])
+                     : fmt::format("over edge {}", panel.id);
+    if (!ends.empty()) {
+      // Along the thread: first the end it shares with the panel before it on the thread, last the one it shares
+      // with the panel after it.
+      std::vector<int> inOrder(ends.begin(), ends.end());
+      const auto sharedWith = [&](size_t other) {
+        for (int e : inOrder) {
+          const auto& at = panelsAt[e];
+          if (std::find(at.begin(), at.end(), panels[other].id) != at.end() && e != panels[other].id) return e;
+        }
+        return 0;
+      };
+      const auto sameThread = [&](size_t other) {
+        return byId.at(panels[other].id)->at("source").value("cycle", 0) == line.thread;
+      };
+      int first = i > 0 && sameThread(i - 1) ? sharedWith(i - 1) : 0;
+      if (first == 0 && i + 1 < panels.size() && sameThread(i + 1) && inOrder.size() == 2) {
+        const int last = sharedWith(i + 1);
+        first = last == inOrder[0] ? inOrder[1] : inOrder[0];
+      }
+      std::stable_partition(inOrder.begin(), inOrder.end(), [&](int e) { return e == first; });
+      line.joins += fmt::format("; its ends under edge{} {}", inOrder.size() == 1 ? "" : "s", named(inOrder));
+    }
+    for (const geometry::AssemblyJoin& join : steps[i].joins) {
+      std::vector<int> three = panelsAt[join.edge];
+      // The one over it first.
+      std::stable_partition(three.begin(), three.end(), [&](int id) { return id == join.edge; });
+      line.joins += fmt::format("; fasten crossing {} through panels {} ({} fastener{})", join.edge, named(three),
+                                join.fasteners, join.fasteners == 1 ? "" : "s");
+      line.fasteners += join.fasteners;
+    }
+    lines.push_back(std::move(line));
+  }
+  return lines;
+}
+
+std::vector<StepLine> stepLines(const nlohmann::ordered_json& manifest) {
+  if (manifest.at("structure").get<std::string>() == geometry::structureName(geometry::StructureKind::Weave)) {
+    return wovenStepLines(manifest);
+  }
+  std::vector<StepLine> lines;
+  for (const Step& step : stepsOf(manifest)) {
+    lines.push_back({step.step.panel, step.sheet, fastenersOf(step), 0, describeJoins(step)});
+  }
+  return lines;
+}
+
+// What the steps mean, for the structure.
+std::string howToJoin(const nlohmann::ordered_json& manifest) {
+  if (manifest.at("structure").get<std::string>() == geometry::structureName(geometry::StructureKind::Weave)) {
+    return "Weave the panels in this order, thread by thread, each thread's panels one after the other along it. "
+           "Each panel goes over the edge whose number is etched in its middle and under the edges numbered at its "
+           "ends; the underlined number is the panel under it met first turning counter-clockwise. Where three "
+           "panels carry one number, lay the panel with that number in its middle over the other two (which overlap "
+           "end to end) and fasten the three through both pairs of holes.";
+  }
+  return "Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band with "
+         "the same number on the panel named; fasten them through their holes.";
+}
+
+// The text wrapped at `width` columns.
+std::string wrapped(const std::string& text, size_t width) {
+  std::string out, line;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find(' ', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string word = text.substr(start, end - start);
+    if (!line.empty() && line.size() + 1 + word.size() > width) out += line + "\n", line.clear();
+    line += (line.empty() ? "" : " ") + word;
+    start = end + 1;
+  }
+  return out + line + "\n";
+}
+
 std::string headline(const nlohmann::ordered_json& manifest) {
   const size_t sheets = manifest.at("sheets").size();
   const size_t panels = manifest.at("panels").size();
@@ -407,20 +542,18 @@ std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
 
 std::string manifestText(const nlohmann::ordered_json& manifest) {
   try {
-    std::string text = fmt::format(
-        "Assembly manifest: {}\n"
-        "Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band\n"
-        "with the same number on the panel named; fasten them through their holes.\n\n",
-        headline(manifest));
+    std::string text =
+        fmt::format("Assembly manifest: {}\n{}\n", headline(manifest), wrapped(howToJoin(manifest), 104));
     if (const auto notes = buildNotes(manifest); !notes.empty()) {
       for (const std::string& note : notes) text += note + "\n";
       text += "\n";
     }
-    int total = 0;
-    for (const Step& step : stepsOf(manifest)) {
-      total += fastenersOf(step);
-      text += fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.step.panel, step.step.panel, step.sheet,
-                          describeJoins(step));
+    int total = 0, thread = 0;
+    for (const StepLine& step : stepLines(manifest)) {
+      total += step.fasteners;
+      if (step.thread != thread) text += fmt::format("{}thread {}:\n", thread == 0 ? "" : "\n", step.thread);
+      thread = step.thread;
+      text += fmt::format("step {:>4}: panel {} (sheet {}): {}\n", step.panel, step.panel, step.sheet, step.joins);
     }
     text += fmt::format("\n{} fastener{} in all\n", total, total == 1 ? "" : "s");
     return text;
@@ -449,19 +582,17 @@ section.sheet .cutfile svg #etch path {{ stroke: #a0522d; }}
 </head>
 <body>
 <h1>Assembly manifest</h1>
-<p>{0}. Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band with
-the same number on the panel named; fasten them through their holes.</p>
+<p>{0}. {1}</p>
 <table>
 <tr><th>step</th><th>panel</th><th>sheet</th><th>joins</th><th>fasteners</th></tr>
 )",
-                                   xmlText(headline(manifest)));
+                                   xmlText(headline(manifest)), xmlText(howToJoin(manifest)));
     for (const std::string& note : buildNotes(manifest)) html += fmt::format("<p>{}</p>\n", xmlText(note));
     int total = 0;
-    for (const Step& step : stepsOf(manifest)) {
-      const int fasteners = fastenersOf(step);
-      total += fasteners;
-      html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.step.panel,
-                          step.step.panel, step.sheet, xmlText(describeJoins(step)), fasteners);
+    for (const StepLine& step : stepLines(manifest)) {
+      total += step.fasteners;
+      html += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n", step.panel, step.panel,
+                          step.sheet, xmlText(step.joins), step.fasteners);
     }
     html += fmt::format("</table>\n<p>{} fastener{} in all.</p>\n", total, total == 1 ? "" : "s");
     for (const auto& sheet : manifest.at("sheets")) {

@@ -109,19 +109,6 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
   }
 }
 
-// The distance from a point to a closed outline given as manifest.json's [[x, y], ...].
-double distanceToOutline(const nlohmann::json& outline, double x, double y) {
-  double nearest = 1e300;
-  for (size_t k = 0; k < outline.size(); ++k) {
-    const double ax = outline[k][0], ay = outline[k][1];
-    const double bx = outline[(k + 1) % outline.size()][0], by = outline[(k + 1) % outline.size()][1];
-    const double dx = bx - ax, dy = by - ay, length2 = dx * dx + dy * dy;
-    const double t = length2 > 0 ? std::clamp(((x - ax) * dx + (y - ay) * dy) / length2, 0.0, 1.0) : 0.0;
-    nearest = std::min(nearest, std::hypot(ax + t * dx - x, ay + t * dy - y));
-  }
-  return nearest;
-}
-
 // No hole's centre nearer than one diameter to the outline of the part it is cut in.
 void expectHolesADiameterIn(const nlohmann::json& part, const std::string& name) {
   for (const auto& hole : part.at("holes")) {
@@ -562,7 +549,6 @@ TEST(MakeCli, JsonSummaryAndErrors) {
     EXPECT_EQ(others, 0) << args << ": " << r.err;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "bad")) << args << " left files behind";
   };
-  fails(mesh + " --structure weave", 1, "--structure weave");
   fails(mesh + " --structure band --tension 1.5", 1, "tension");
   fails(mesh + " --structure band --start 32", 1, "--start 32");
   fails(mesh + " --structure band --size 20in --fastener 2in", 1, "no room for a 2.000 in fastener hole");

@@ -1,5 +1,5 @@
 // Usage errors as a new user meets them: a mistyped command, a command of
-// SPEC's that is not built yet, an option of the woven structure, and a bad
+// SPEC's that is not built yet, an option of the woven structure with band, and a bad
 // option of a command, each one line with exit status 2 and the `--help` to read.
 
 #include <gtest/gtest.h>
@@ -36,9 +36,8 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
               "rotafab --help");
   // A mesh is planned by the daemon with `make`'s options, --structure first.
   expectUsage("submit " + cube, "--structure is required to plan a mesh (band or weave)", "rotafab submit --help");
-  expectUsage("make " + cube + " --structure band --width 0.5in",
-              "--width is an option of the plain-woven structure (--structure weave, dissertation ch. IV), which is "
-              "not built yet",
+  expectUsage("make " + cube + " --structure band --width 0.5",
+              "--width is an option of the plain-woven structure (--structure weave), not of band",
               "rotafab make --help");
   // The parser's own errors point to the command's help, not the program's.
   const CommandResult noDevice = run(kCli + " run " + quoted(kSource));

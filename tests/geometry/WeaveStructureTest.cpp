@@ -185,14 +185,26 @@ TEST(WeaveStructure, ASingleCycleWeaveIsOneThreadOfFacesLessOnePanels) {
   for (const Panel& panel : s.panels) EXPECT_EQ(panel.source.cycle, 1);
 }
 
-TEST(WeaveStructure, AFastenerTooLargeForTheCrossingsGrowsTheMesh) {
-  PolygonMesh mesh = test::atConstructionSize(truncatedIcosahedron());
-  requireUsable(analyzeMesh(mesh));
+TEST(WeaveStructure, AFastenerTooLargeForTwoHolesGivesOneAndTooLargeForOneGrowsTheMesh) {
+  // The soccer ball's crossings at a 2 in mean edge: room for two 1/8 in
+  // holes; for one 1/2 in hole each, at the crossing's centre; for no
+  // 1 in hole, until the mesh is larger.
   WeaveOptions options;
   options.fastener = 0.5;
+  const Structure one = wovenStructure(truncatedIcosahedron(), options);
+  EXPECT_EQ(one.fasteners, 90);
+  ASSERT_FALSE(one.warnings.empty());
+  EXPECT_NE(one.warnings.front().find("90 crossings are too small for two 0.500 in holes"), std::string::npos)
+      << one.warnings.front();
+  for (const Panel& panel : one.panels) EXPECT_EQ(panel.holes.size(), 3U);
+
+  PolygonMesh mesh = test::atConstructionSize(truncatedIcosahedron());
+  requireUsable(analyzeMesh(mesh));
+  options.fastener = 1;
   const GrownStructure grown = buildWeaveStructureWithRoom(mesh, options, test::context());
   EXPECT_GT(grown.grown, 1);
   EXPECT_EQ(grown.structure.panels.size(), 90U);
+  EXPECT_TRUE(grown.structure.glued.empty());
 }
 
 }  // namespace

@@ -1,0 +1,163 @@
+// `rotafab make MESH --structure weave` through the built program
+// (dissertation ch. IV): the soccer ball's 90 panels with SPEC's woven
+// manifest (each edge index `up` on one panel and `down` on two, `source`
+// naming the edge and its cycle), sheets Ghostscript reads, the assembly
+// steps thread by thread; single-cycle weaves; open meshes filled by
+// default; the weave's options refused with band and band's with weave.
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "cli/CliSupport.h"
+#include "support/TestSupport.h"
+
+namespace rotafab::test {
+namespace {
+
+// SPEC's woven rule and what a builder needs of each panel: numbered 1..n
+// in order, panel k from edge k of cycle >= 1, on a sheet; `up` k on panel
+// k alone and each edge `down` on two panels; two holes (or one) of each of
+// its three crossings, the same count on the three panels of a crossing,
+// none nearer its outline than a diameter. Returns the cycles.
+std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
+  EXPECT_EQ(m.at("structure"), "weave");
+  EXPECT_EQ(m.at("panels").size(), panels);
+  std::map<int, int> up, down;
+  std::map<int, std::vector<int>> holesAt;  // edge -> count per panel
+  std::set<int> cycles, onSheets;
+  for (const auto& sheet : m.at("sheets")) {
+    for (const auto& id : sheet.at("panels")) onSheets.insert(id.get<int>());
+  }
+  EXPECT_EQ(onSheets.size(), panels);
+  int fasteners = 0;
+  for (size_t i = 0; i < m.at("panels").size(); ++i) {
+    const auto& p = m.at("panels")[i];
+    const int id = p.at("id");
+    EXPECT_EQ(id, static_cast<int>(i) + 1);
+    EXPECT_EQ(p.at("source").at("edge"), id);
+    cycles.insert(p.at("source").at("cycle").get<int>());
+    for (const auto& label : p.at("labels")) {
+      if (label.at("role") == "up") ++up[label.at("edge").get<int>()];
+      if (label.at("role") == "down") ++down[label.at("edge").get<int>()];
+    }
+    std::map<int, int> mine;
+    for (const auto& hole : p.at("holes")) ++mine[hole.at("edge").get<int>()];
+    // Its own edge and the two at its ends (one of them its own edge again
+    // where a single thread goes round a leaf face of its tree).
+    EXPECT_GE(mine.size(), 2U) << "panel " << id;
+    EXPECT_LE(mine.size(), 3U) << "panel " << id;
+    for (const auto& [edge, count] : mine) holesAt[edge].push_back(count);
+    // No hole's centre nearer than a diameter to the panel's outline.
+    const auto& outline = p.at("outline");
+    for (const auto& hole : p.at("holes")) {
+      const double nearest = distanceToOutline(outline, hole.at("xy")[0], hole.at("xy")[1]);
+      EXPECT_GE(nearest, hole.at("diameter").get<double>() - 1e-9) << "panel " << id;
+    }
+  }
+  for (int e = 1; e <= static_cast<int>(panels); ++e) {
+    EXPECT_EQ(up[e], 1) << "edge " << e;
+    EXPECT_EQ(down[e], 2) << "edge " << e;
+    // Three panels of as many holes each, two of them maybe one panel.
+    int holes = 0;
+    for (int count : holesAt[e]) holes += count;
+    EXPECT_TRUE(holes == 3 || holes == 6) << "edge " << e << ": " << holes << " holes";
+    EXPECT_TRUE(holesAt[e].size() == 3 || holesAt[e].size() == 2) << "edge " << e;
+    fasteners += holes / 3;
+  }
+  EXPECT_EQ(m.at("fasteners").get<int>(), fasteners);
+  return cycles;
+}
+
+TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
+  TempDir dir;
+  const auto out = dir.path() / "ball";
+  const CommandResult made = run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
+                                 " --structure weave --json --time 1 --out " + quoted(out));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto summary = nlohmann::json::parse(made.out);
+  EXPECT_EQ(summary.at("panels"), 90);
+  EXPECT_EQ(summary.at("fasteners"), 180);
+  const auto m = nlohmann::json::parse(readFile(out / "manifest.json"));
+  EXPECT_EQ(expectWovenManifest(m, 90).size(), 10U);  // the truncated icosahedron's Petrie walks
+  // Each sheet read by Ghostscript.
+  for (size_t s = 1; s <= m.at("sheets").size(); ++s) {
+    char name[32];
+    std::snprintf(name, sizeof name, "sheet-%03zu.eps", s);
+    const CommandResult gs = run("gs -q -dNOPAUSE -dBATCH -sDEVICE=bbox " + quoted(out / name));
+    EXPECT_EQ(gs.status, 0) << gs.err;
+  }
+  // The steps, thread by thread: each panel, its sheet, the crossing it goes over and the panels under it.
+  const CommandResult steps = run(kCli + " manifest " + quoted(out));
+  ASSERT_EQ(steps.status, 0) << steps.err;
+  EXPECT_NE(steps.out.find("thread 1:\nstep    1: panel 1 (sheet "), std::string::npos) << steps.out;
+  EXPECT_NE(steps.out.find("thread 10:\n"), std::string::npos);
+  EXPECT_NE(steps.out.find("): over edge 1, above panels "), std::string::npos);
+  EXPECT_NE(steps.out.find("\n180 fasteners in all\n"), std::string::npos) << steps.out;
+  EXPECT_EQ(readFile(out / "manifest.txt"), steps.out);
+  // structure.obj: a group per panel.
+  std::ifstream obj(out / "structure.obj");
+  int groups = 0;
+  for (std::string line; std::getline(obj, line);) groups += line.starts_with("g panel-");
+  EXPECT_EQ(groups, 90);
+}
+
+TEST(WeaveCli, ASingleCycleWeaveIsOneThread) {
+  TempDir dir;
+  for (const char* mesh : {"cube.obj", "torus.obj", "genus2.obj"}) {
+    SCOPED_TRACE(mesh);
+    const auto out = dir.path() / mesh;
+    const CommandResult made = run(kCli + " make " + quoted(kSource / "examples" / mesh) +
+                                   " --structure weave --cycles single --time 0.5 --out " + quoted(out));
+    ASSERT_EQ(made.status, 0) << made.err;
+    const auto m = nlohmann::json::parse(readFile(out / "manifest.json"));
+    const CommandResult inspected = run(kCli + " inspect --json " + quoted(kSource / "examples" / mesh));
+    const int faces = nlohmann::json::parse(inspected.out).at("faces");
+    // A spanning tree of the dual: one edge fewer than faces, each crossed over once.
+    EXPECT_EQ(expectWovenManifest(m, static_cast<size_t>(faces - 1)), std::set<int>{1});
+  }
+}
+
+TEST(WeaveCli, AnOpenMeshIsFilledByDefaultAndKeepingItsHolesIsRefused) {
+  TempDir dir;
+  // A cube without its top: one boundary loop.
+  const auto open = dir.path() / "open-box.obj";
+  std::ofstream(open) << "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+                         "f 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n";
+  const CommandResult filled =
+      run(kCli + " make " + quoted(open) + " --structure weave --time 0.5 --out " + quoted(dir.path() / "filled"));
+  ASSERT_EQ(filled.status, 0) << filled.err;
+  expectWovenManifest(nlohmann::json::parse(readFile(dir.path() / "filled/manifest.json")), 12);
+  const CommandResult kept = run(kCli + " make " + quoted(open) + " --structure weave --holes keep");
+  EXPECT_EQ(kept.status, 2);
+  EXPECT_NE(kept.err.find("--holes keep: a plain weave crosses every edge"), std::string::npos) << kept.err;
+  const CommandResult refused = run(kCli + " make " + quoted(open) + " --structure weave --holes error");
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("the surface is open (1 boundary loop)"), std::string::npos) << refused.err;
+}
+
+TEST(WeaveCli, EachStructuresOptionsAreRefusedWithTheOther) {
+  const std::string cube = quoted(kSource / "examples/cube.obj");
+  const auto usage = [](const std::string& args, const std::string& says) {
+    SCOPED_TRACE(args);
+    const CommandResult r = run(kCli + " make " + args);
+    EXPECT_EQ(r.status, 2) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("Run `rotafab make --help` for usage."), std::string::npos) << r.err;
+  };
+  usage(cube + " --structure band --width 0.5", "--width is an option of the plain-woven structure");
+  usage(cube + " --structure band --cycles single", "--cycles is an option of the plain-woven structure");
+  usage(cube + " --structure weave --tension 0.3", "--tension is an option of the band decomposition");
+  usage(cube + " --structure weave --width 0.5in", "0.5in: expected a plain number");
+  usage(cube + " --structure weave --curve 1.5", "1.5: expected more than 0 and at most 1");
+  usage(cube + " --structure weave --cycles some", "--cycles");
+  const CommandResult offset = run(kCli + " make " + cube + " --structure weave --offset -1mm");
+  EXPECT_EQ(offset.status, 1) << offset.err;
+  EXPECT_NE(offset.err.find("--offset -1mm"), std::string::npos) << offset.err;
+}
+
+}  // namespace
+}  // namespace rotafab::test
