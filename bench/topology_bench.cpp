@@ -29,6 +29,7 @@
 #include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
 #include "geometry/Simplification.h"
+#include "geometry/WeaveStructure.h"
 
 namespace geo = rotafab::geometry;
 
@@ -194,6 +195,37 @@ void BM_BandStructure(benchmark::State& state) {
   state.SetComplexityN(faces);
 }
 BENCHMARK(BM_BandStructure)
+    ->Arg(4000)
+    ->Arg(8000)
+    ->Arg(16000)
+    ->Arg(32000)
+    ->Arg(50000)
+    ->Unit(benchmark::kMillisecond)
+    ->Complexity(benchmark::oN);
+
+// `make --structure weave` up to the planner, import to labelled panels:
+// import, analysis, scale (mean edge 2 in), threads, edge regions,
+// ribbons, panels cut and unfolded, holes, labels, assembly order. One panel
+// per edge: 1.5 per face of these triangulated tori. Target as for band:
+// linear, under 5 s for 50k faces.
+void BM_WeaveStructure(benchmark::State& state) {
+  const auto& path = meshFile(state.range(0));
+  long faces = 0;
+  rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
+  const rotafab::core::Cancellation never;
+  const rotafab::core::WorkContext context(executor, never);
+  for (auto _ : state) {
+    geo::ImportedMesh imported = geo::importMesh(path);
+    geo::requireUsable(geo::analyzeMesh(imported.mesh));
+    const double scale = geo::constructionScale(imported.mesh, std::nullopt, std::nullopt);
+    for (geo::Point3& p : imported.mesh.positions) p *= scale;
+    const geo::Structure structure = geo::buildWeaveStructure(imported.mesh, geo::WeaveOptions{}, context);
+    benchmark::DoNotOptimize(structure.panels.data());
+    faces = imported.mesh.faceCount();
+  }
+  state.SetComplexityN(faces);
+}
+BENCHMARK(BM_WeaveStructure)
     ->Arg(4000)
     ->Arg(8000)
     ->Arg(16000)

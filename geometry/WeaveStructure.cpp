@@ -180,7 +180,7 @@ std::vector<Point2> labelCandidates(const WovenPanel& panel, const std::vector<i
   std::vector<Point2> candidates;
   for (int row : rows) {
     const Point2 &p = panel.flatP[static_cast<size_t>(row)], &q = panel.flatQ[static_cast<size_t>(row)];
-    for (double t : {0.5, 0.32, 0.68, 0.18, 0.82}) candidates.push_back(p + t * (q - p));
+    for (double t : {0.5, 0.25, 0.75}) candidates.push_back(p + t * (q - p));
   }
   return candidates;
 }

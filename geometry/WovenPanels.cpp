@@ -2,7 +2,6 @@
 
 #include <fmt/format.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -113,11 +112,13 @@ StripPoint stripPointOnLine(const WovenPanel& panel, int first, int last, const 
     for (const std::array<int, 3>& t :
          {std::array<int, 3>{i, rows + i, i + 1}, std::array<int, 3>{rows + i, rows + i + 1, i + 1}}) {
       const Point3 &a = panel.corner(t[0]), &b = panel.corner(t[1]), &c = panel.corner(t[2]);
-      Eigen::Matrix3d m;
-      m << b - a, c - a, -direction;
-      const double det = m.determinant();
+      // The line's parameter and the barycentric weights at once (Möller and
+      // Trumbore, "Fast, minimum storage ray-triangle intersection", 1997).
+      const Point3 e1 = b - a, e2 = c - a, p = direction.cross(e2);
+      const double det = e1.dot(p);
       if (!(std::abs(det) > 1e-18)) continue;
-      const Eigen::Vector3d solved = m.partialPivLu().solve(point - a);
+      const Point3 s = point - a, q = s.cross(e1);
+      const Eigen::Vector3d solved(s.dot(p) / det, direction.dot(q) / det, e2.dot(q) / det);
       const std::array<double, 3> w{1 - solved.x() - solved.y(), solved.x(), solved.y()};
       const double inside = std::min({w[0], w[1], w[2]});
       const double along = std::abs(solved.z());
