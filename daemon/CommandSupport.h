@@ -52,6 +52,10 @@ inline std::string flagOf(geometry::Parameter parameter) {
       return "--fastener";
     case geometry::Parameter::Start:
       return "--start";
+    case geometry::Parameter::Width:
+      return "--width";
+    case geometry::Parameter::Offset:
+      return "--offset";
   }
   return "--" + geometry::parameterInWords(parameter);
 }

@@ -22,6 +22,10 @@ std::string parameterInWords(Parameter parameter) {
       return "fastener diameter";
     case Parameter::Start:
       return "start face";
+    case Parameter::Width:
+      return "ribbon width";
+    case Parameter::Offset:
+      return "ribbon offset";
   }
   return "parameter";
 }

@@ -19,13 +19,15 @@ enum class Parameter {
   Scale,          // inches per mesh unit
   Fastener,       // the fastener hole's diameter
   Start,          // the flood fill's first face
+  Width,          // a woven ribbon's share of its edge region across it
+  Offset,         // how far a woven ribbon stands over or under the surface
 };
 
 // How messages name a parameter.
 using ParameterNames = std::function<std::string(Parameter)>;
 
 // In words: "structure", "holes", "repair", "coplanar merge angle", "panel count", "structure size", "scale", "fastener
-// diameter", "start face".
+// diameter", "start face", "ribbon width", "ribbon offset".
 std::string parameterInWords(Parameter parameter);
 
 // A parameter's value that cannot be built with; the message names it as

@@ -26,6 +26,18 @@ void requireShape(const RibbonShape& shape) {
   }
 }
 
+// The pass of `step` with its sides as rails P and Q.
+RibbonPass railPass(const RotationSystem& rs, const std::vector<EdgeRegion>& regions, const ThreadStep& step,
+                    const RibbonShape& shape, bool swapped) {
+  RibbonPass pass = ribbonPass(rs, regions[static_cast<size_t>(RotationSystem::edgeOf(step.dart))], step, shape);
+  if (swapped) {
+    std::swap(pass.head[0], pass.head[1]);
+    std::swap(pass.middle[0], pass.middle[1]);
+    std::swap(pass.tail[0], pass.tail[1]);
+  }
+  return pass;
+}
+
 }  // namespace
 
 RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const ThreadStep& step,
@@ -94,6 +106,24 @@ std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side) 
   return {here.middle[s], here.tail[s], next.head[s], next.middle[s]};
 }
 
+void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& regions, const Thread& thread,
+                 const Ribbon& ribbon, int k, const RibbonShape& shape, std::vector<Point3>& railP,
+                 std::vector<Point3>& railQ) {
+  const size_t n = thread.steps.size();
+  const size_t here = static_cast<size_t>(k) % n, next = (here + 1) % n;
+  const RibbonPass a = railPass(rs, regions, thread.steps[here], shape, ribbon.swapped[here] != 0);
+  const RibbonPass b = railPass(rs, regions, thread.steps[next], shape, ribbon.swapped[next] != 0);
+  const std::array<Point3, 4> p{a.middle[0], a.tail[0], b.head[0], b.middle[0]};
+  const std::array<Point3, 4> q{a.middle[1], a.tail[1], b.head[1], b.middle[1]};
+  railP.clear();
+  railQ.clear();
+  for (int i = 0; i <= shape.samples; ++i) {
+    const double t = static_cast<double>(i) / shape.samples;
+    railP.push_back(bezierPoint(p, t));
+    railQ.push_back(bezierPoint(q, t));
+  }
+}
+
 std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
                                  const std::vector<EdgeRegion>& regions, const RibbonShape& shape) {
   requireShape(shape);
@@ -111,14 +141,9 @@ std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& w
     // crossing.
     bool swapped = false;
     for (const ThreadStep& step : thread.steps) {
-      RibbonPass pass = ribbonPass(rs, regions[static_cast<size_t>(RotationSystem::edgeOf(step.dart))], step, shape);
-      if (swapped) {
-        std::swap(pass.head[0], pass.head[1]);
-        std::swap(pass.middle[0], pass.middle[1]);
-        std::swap(pass.tail[0], pass.tail[1]);
-      }
+      ribbon.passes.push_back(railPass(rs, regions, step, shape, swapped));
+      ribbon.swapped.push_back(swapped ? 1 : 0);
       if (step.crossing != Crossing::None) swapped = !swapped;
-      ribbon.passes.push_back(pass);
     }
     // An orientable surface brings the rails back to their own sides: an
     // even number of crossings per thread (III.1.2: t flips at each).

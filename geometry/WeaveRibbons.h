@@ -54,6 +54,7 @@ struct Ribbon {
   // the triangles (P_i, Q_i, P_i+1), (Q_i, Q_i+1, P_i+1).
   std::vector<Point3> railP, railQ;
   int samples = 0;
+  std::vector<char> swapped;  // per pass: rail P is its side 1 (its sides as ribbonPass() numbers them)
 };
 
 // The pass of `step` across the region of its edge, with sides as the
@@ -66,6 +67,13 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
 // range (w, c in (0, 1], h > 0, at least one sample).
 std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
                                  const std::vector<EdgeRegion>& regions, const RibbonShape& shape);
+
+// Segment k of `thread`'s ribbon (from pass k's middle row to pass k + 1's,
+// both included: samples + 1 rows) made again with `shape`, its rails as
+// `ribbon` has them: for trying another width or curve on a few segments.
+void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& regions, const Thread& thread,
+                 const Ribbon& ribbon, int k, const RibbonShape& shape, std::vector<Point3>& railP,
+                 std::vector<Point3>& railQ);
 
 // Point t in [0, 1] of eq. 4.17's cubic, and its derivative.
 Point3 bezierPoint(const std::array<Point3, 4>& control, double t);

@@ -15,6 +15,7 @@
 #include "geometry/FloodFill.h"
 #include "geometry/HersheyFont.h"
 #include "geometry/PanelLabels.h"
+#include "geometry/RibbonCollisions.h"
 #include "geometry/WovenPanels.h"
 
 namespace rotafab::geometry {
@@ -229,6 +230,10 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   context.check();
   context.report({"geometry", "ribbons", 0, 0});
   const std::vector<Ribbon> ribbons = weaveRibbons(rs, weave, regions, options.shape);
+  // Ribbons that pass through each other (ch. VII's open problem): warned
+  // of, with the width that clears them.
+  context.report({"geometry", "ribbons that meet", 0, 0});
+  const RibbonCollisions collisions = ribbonCollisions(rs, weave, regions, ribbons, options.shape, context);
   const int overlap = std::max(1, options.shape.samples / 2);
   std::vector<WovenPanel> woven = wovenPanels(ribbons, regions, overlap);
   context.check();
@@ -496,6 +501,24 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     }
   }
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
+  if (!collisions.pairs.empty()) {
+    std::string some;
+    for (size_t i = 0; i < collisions.pairs.size() && i < 3; ++i) {
+      some +=
+          fmt::format("{}edges {} and {}", i ? ", " : "", edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeA)],
+                      edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeB)]);
+    }
+    const size_t n = collisions.pairs.size();
+    const double width = std::floor(collisions.clearWidth * 100) / 100;
+    result.warnings.push_back(fmt::format(
+        "{} pair{} of ribbons pass through each other ({}{}): {}", n, n == 1 ? "" : "s", some, n > 3 ? ", ..." : "",
+        width > 0 ? fmt::format("{} {:.2f} or less clears {}", options.names(Parameter::Width), width,
+                                n == 1 ? "it" : "them all")
+                  : fmt::format("no {} tried clears {} (the faces meet at too sharp an angle); a larger {} or a "
+                                "smoother mesh may",
+                                options.names(Parameter::Width), n == 1 ? "it" : "them all",
+                                options.names(Parameter::Offset))));
+  }
   result.fasteners = 0;
   for (size_t e = 0; e < crossingCount; ++e) {
     if (crossings[e].panel[0] >= 0 && !glued[e]) result.fasteners += holes[e].single ? 1 : 2;
