@@ -53,6 +53,7 @@ namespace {
 
 const std::vector<std::string> kWeaveOnly{"--width", "--curve", "--offset", "--cycles"};
 const std::vector<std::string> kBandOnly{"--tension", "--start", "--score-folds"};
+constexpr int kLeastWeaveSamples = 4;
 
 // A fraction of an edge's region: more than 0, at most 1, with no unit.
 CLI::Validator fractionCheck() {
@@ -83,6 +84,12 @@ void checkStructureOptions(const CLI::App& make, const MakeOptions& options) {
                 : fmt::format("{} is an option of the plain-woven structure (--structure weave), not of band", option));
     }
   }
+  if (weave && options.samples < kLeastWeaveSamples) {
+    throw CLI::ValidationError(fmt::format(
+        "--samples {}: a weave needs at least {} (its panels run half a Bézier segment past each crossing under, to "
+        "hold its holes)",
+        options.samples, kLeastWeaveSamples));
+  }
   if (weave && options.holes == "keep") {
     throw CLI::ValidationError(
         "--holes keep: a plain weave crosses every edge, and a boundary edge has one side; fill (the default for "
@@ -95,7 +102,7 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
   make.add_option("--structure", options.structure, "band (dissertation ch. V) or weave (ch. IV)")
       ->required()
       ->check(CLI::IsMember({"band", "weave"}));
-  make.add_option("--out", options.out, "Output folder (default: MESHNAME-band)")->check(outputFolderCheck());
+  make.add_option("--out", options.out, "Output folder (default: MESHNAME-STRUCTURE, e.g. bunny-band)")->check(outputFolderCheck());
   make.add_option("--machine", options.machine, "Machine profile: the bed, margins and colours")->capture_default_str();
   make.add_option("--material", options.material, "Material profile: kerf and fastener diameter")
       ->capture_default_str();

@@ -93,6 +93,7 @@ double angleAtRow(const WovenPanel& panel, int row) {
 // of material, FastenerHoles.h).
 struct CrossingHoles {
   std::array<std::array<Point2, 2>, 3> flat;  // per panel of CrossingPanels, per hole
+  std::array<std::array<int, 2>, 3> rows{};   // the strip row each lies on
   double clearance = -std::numeric_limits<double>::infinity();
   double fromOutline = 0, apart = 0;  // the least distance to an outline, and between a panel's two holes, diameters
   bool single = false;                // one hole at the crossing's centre: no room for two
@@ -119,6 +120,8 @@ CrossingHoles holesAt(const EdgeRegion& region, const CrossingPanels& at, const 
       const Point3 point = region.at(0.5 + (h == 0 ? -delta : delta), 0.5);
       const StripPoint hit = stripPointOnLine(panel, at.row[k] - reach, at.row[k] + reach, point, region.normal);
       holes.flat[k][h] = hit.onPanel(panel);
+      holes.rows[k][h] =
+          std::min({hit.corners[0] % panel.rows(), hit.corners[1] % panel.rows(), hit.corners[2] % panel.rows()});
       // A line that misses the strip: no hole through all three panels there.
       missed = missed || hit.miss > 1e-6 * diameter;
       fromOutline =
@@ -186,19 +189,167 @@ std::vector<Point2> labelCandidates(const WovenPanel& panel, const std::vector<i
   return candidates;
 }
 
+// Rows first..last of a panel's strip.
+struct RowSpan {
+  int first = 0, last = 0;
+  [[nodiscard]] bool holds(int row) const { return row >= first && row <= last; }
+};
+
+double stripArea(const WovenPanel& w, const RowSpan& span) {
+  double area = 0;
+  for (int r = span.first; r < span.last; ++r) {
+    const auto at = [&](const std::vector<Point3>& rail, int k) -> const Point3& {
+      return rail[static_cast<size_t>(k)];
+    };
+    area += (at(w.railQ, r) - at(w.railP, r)).cross(at(w.railP, r + 1) - at(w.railP, r)).norm() / 2;
+    area += (at(w.railQ, r + 1) - at(w.railQ, r)).cross(at(w.railP, r + 1) - at(w.railQ, r)).norm() / 2;
+  }
+  return area;
+}
+
+// A panel whose unfolded outline crosses itself (its ribbon curls round, as
+// round a face at a leaf of a single thread's tree, or round a sharp vertex)
+// is cut across its strip, at most twice, into parts that do not; each cut
+// leaves the two parts overlapping over a few rows (a lap) with one hole
+// through both. The parts keep the panel's flat frame (an unfolding of
+// some of its rows is the same as theirs in the whole), so its holes and
+// labels stay where they are, each on the part whose rows hold it (a hole
+// in a lap on both). The part over the panel's edge stays the panel; the
+// others become its pieces, "17a", "17b". Leaves the panel as it was when no
+// cut gives parts that keep their holes' clearance and hold their labels.
+void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRows, const std::vector<int>& labelRows,
+              double diameter) {
+  constexpr int kLongestLap = 4, kCuts = 2;
+  std::vector<RowSpan> spans{{0, w.rows() - 1}};
+  std::vector<int> laps;  // the row of each cut's hole
+  const auto crosses = [&](const RowSpan& span) { return core::crossesItself(w.outlineOfRows(span.first, span.last)); };
+  // Whether the parts `a` and `b` of a cut with its hole at row `c` keep
+  // every hole clear and hold every label; how many of them still cross themselves.
+  const auto tryCut = [&](const RowSpan& a, const RowSpan& b, int c) -> int {
+    const std::vector<Point2> outlineA = w.outlineOfRows(a.first, a.last), outlineB = w.outlineOfRows(b.first, b.last);
+    const Point2 lap = centreOfRow(w, c);
+    for (const auto* outline : {&outlineA, &outlineB}) {
+      if (core::distanceToOutline(*outline, lap) < kClearance * diameter) return -1;
+    }
+    for (size_t h = 0; h < panel.holes.size(); ++h) {
+      // A crossing's hole on one part only: its three panels hold one each.
+      if (a.holds(holeRows[h]) && b.holds(holeRows[h])) return -1;
+      for (const auto& [span, outline] : {std::pair{a, &outlineA}, std::pair{b, &outlineB}}) {
+        if (!span.holds(holeRows[h])) continue;
+        if (core::distanceToOutline(*outline, panel.holes[h].xy) < kLeastClearance * diameter) return -1;
+        if ((panel.holes[h].xy - lap).norm() < (kLeastClearance + 1) * diameter) return -1;
+      }
+    }
+    for (size_t l = 0; l < panel.labels.size(); ++l) {
+      bool held = false;
+      for (const auto& [span, outline] : {std::pair{a, &outlineA}, std::pair{b, &outlineB}}) {
+        if (!span.holds(labelRows[l])) continue;
+        const auto corners = panel.labels[l].box.corners();
+        held = held || std::all_of(corners.begin(), corners.end(),
+                                   [&](const Point2& p) { return core::insidePolygon(*outline, p); });
+      }
+      if (!held) return -1;
+    }
+    return (core::crossesItself(outlineA) ? 1 : 0) + (core::crossesItself(outlineB) ? 1 : 0);
+  };
+  for (int cuts = 0; cuts < kCuts; ++cuts) {
+    const auto overlapping = std::find_if(spans.begin(), spans.end(), crosses);
+    if (overlapping == spans.end()) break;
+    const RowSpan span = *overlapping;
+    // Cuts from the middle of the span outwards, the shortest lap first that keeps the lap's hole clear.
+    std::vector<int> rows;
+    const int middle = (span.first + span.last) / 2;
+    for (int k = 0; k <= (span.last - span.first) / 2; ++k) {
+      for (int c : {middle - k, middle + k}) {
+        if (c > span.first + 1 && c < span.last - 1 && (rows.empty() || rows.back() != c)) rows.push_back(c);
+      }
+    }
+    int bestScore = 3, bestRow = -1, bestLap = 0;
+    for (int c : rows) {
+      for (int lap = 1; lap <= kLongestLap && bestScore > 0; ++lap) {
+        if (c - lap <= span.first || c + lap >= span.last) break;
+        const int score = tryCut({span.first, c + lap}, {c - lap, span.last}, c);
+        if (score >= 0 && score < bestScore) bestScore = score, bestRow = c, bestLap = lap;
+        if (score >= 0) break;  // a longer lap only spends material
+      }
+      if (bestScore == 0) break;
+    }
+    if (bestRow < 0) break;
+    *overlapping = {span.first, bestRow + bestLap};
+    spans.insert(overlapping + 1, RowSpan{bestRow - bestLap, span.last});
+    laps.push_back(bestRow);
+  }
+  if (laps.empty() || std::any_of(spans.begin(), spans.end(), crosses)) return;
+
+  // The part over the panel's edge stays the panel.
+  std::sort(laps.begin(), laps.end());
+  const auto main = std::find_if(spans.begin(), spans.end(), [&](const RowSpan& span) { return span.holds(w.upRow); });
+  const std::vector<PanelHole> holes = panel.holes;
+  std::vector<PanelLabel> labels = panel.labels;
+  const auto holesOf = [&](const RowSpan& span) {
+    std::vector<PanelHole> mine;
+    for (size_t h = 0; h < holes.size(); ++h) {
+      if (span.holds(holeRows[h])) mine.push_back(holes[h]);
+    }
+    for (int c : laps) {
+      if (span.holds(c)) mine.push_back({0, centreOfRow(w, c), diameter});  // a tab's fastener: no edge
+    }
+    return mine;
+  };
+  std::vector<char> labelTaken(labels.size(), 0);
+  const auto labelsOf = [&](const RowSpan& span) {
+    const std::vector<Point2> outline = w.outlineOfRows(span.first, span.last);
+    std::vector<PanelLabel> mine;
+    for (size_t l = 0; l < labels.size(); ++l) {
+      if (labelTaken[l] || !span.holds(labelRows[l])) continue;
+      const auto corners = labels[l].box.corners();
+      if (!std::all_of(corners.begin(), corners.end(),
+                       [&](const Point2& p) { return core::insidePolygon(outline, p); })) {
+        continue;
+      }
+      labelTaken[l] = 1;
+      mine.push_back(labels[l]);
+    }
+    return mine;
+  };
+  panel.outline = w.outlineOfRows(main->first, main->last);
+  panel.holes = holesOf(*main);
+  panel.labels = labelsOf(*main);
+  panel.area = stripArea(w, *main);
+  char letter = 'a';
+  for (auto span = spans.begin(); span != spans.end(); ++span) {
+    if (span == main) continue;
+    PanelPiece piece;
+    piece.name = fmt::format("{}{}", panel.id, letter++);
+    piece.edge = panel.id;
+    piece.outline = w.outlineOfRows(span->first, span->last);
+    piece.holes = holesOf(*span);
+    piece.labels = labelsOf(*span);
+    piece.area = stripArea(w, *span);
+    piece.fastening = PieceFastening::Tab;
+    panel.pieces.push_back(std::move(piece));
+  }
+}
+
 }  // namespace
 
 std::vector<AssemblyStep> weaveSteps(const std::vector<Panel>& panels) {
-  // Per edge number: its holes in all, and the last panel holding some. A
-  // crossing's three panels hold as many holes each, one per fastener; a
-  // panel may be two of them (a single thread round a leaf face of its tree
-  // goes under and then over one edge).
+  // Per edge number: its holes in all, and the last panel holding some
+  // (on itself or a piece of it). A crossing's three panels hold as many
+  // holes each, one per fastener; a panel may be two of them (a single
+  // thread round a leaf face of its tree goes under and then over one edge).
+  // Holes of edge 0 fasten a piece to its panel.
   std::map<int, int> holesOfEdge, lastPanel, firstPanel;
+  const auto count = [&](const PanelHole& hole, int id) {
+    if (hole.edge == 0) return;
+    ++holesOfEdge[hole.edge];
+    lastPanel[hole.edge] = std::max(lastPanel[hole.edge], id);
+    if (!firstPanel.count(hole.edge)) firstPanel[hole.edge] = id;
+  };
   for (const Panel& panel : panels) {
-    for (const PanelHole& hole : panel.holes) {
-      ++holesOfEdge[hole.edge];
-      lastPanel[hole.edge] = std::max(lastPanel[hole.edge], panel.id);
-      if (!firstPanel.count(hole.edge)) firstPanel[hole.edge] = panel.id;
+    for (const PanelHole& hole : panel.holes) count(hole, panel.id);
+    for (const PanelPiece& piece : panel.pieces) {
+      for (const PanelHole& hole : piece.holes) count(hole, panel.id);
     }
   }
   std::vector<AssemblyStep> steps;
@@ -206,6 +357,11 @@ std::vector<AssemblyStep> weaveSteps(const std::vector<Panel>& panels) {
     AssemblyStep step{panel.id, {}, {}, {}};
     std::set<int> edges;
     for (const PanelHole& hole : panel.holes) edges.insert(hole.edge);
+    for (const PanelPiece& piece : panel.pieces) {
+      for (const PanelHole& hole : piece.holes) edges.insert(hole.edge);
+      if (piece.fastening == PieceFastening::Tab) step.pieces.push_back(piece.name);
+    }
+    edges.erase(0);
     for (int edge : edges) {
       if (lastPanel[edge] != panel.id) continue;
       // The join names the panel over it, or at the over panel's own step the first under it.
@@ -368,11 +524,13 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
 
   // Per panel, its holes: two (or one) at each of its three crossings.
   std::vector<std::vector<PanelHole>> holesOf(woven.size());
+  std::vector<std::vector<int>> holeRowsOf(woven.size());
   for (size_t e = 0; e < crossingCount; ++e) {
     if (crossings[e].panel[0] < 0 || glued[e]) continue;
     for (size_t k = 0; k < 3; ++k) {
       for (size_t h = 0; h < (holes[e].single ? 1U : 2U); ++h) {
         holesOf[static_cast<size_t>(crossings[e].panel[k])].push_back({edgeNumber[e], holes[e].flat[k][h], d});
+        holeRowsOf[static_cast<size_t>(crossings[e].panel[k])].push_back(holes[e].rows[k][h]);
       }
     }
   }
@@ -416,6 +574,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     std::vector<Circle> circles;
     for (const PanelHole& hole : panel.holes) circles.push_back({hole.xy, hole.diameter / 2});
     std::vector<TextBox> taken;
+    std::vector<int> labelRows;
     const auto place = [&](const std::string& label, int edge, LabelRole role, int row, int first, int last,
                            const std::vector<Point2>& candidates) {
       const std::vector<Point2> region = w.outlineOfRows(std::max(first, 0), std::min(last, w.rows() - 1));
@@ -433,6 +592,14 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
         placed.strokes.push_back({box->origin + below, box->origin + box->along * box->width + below});
       }
       panel.labels.push_back(std::move(placed));
+      // Its row: the one whose centre is nearest the box's.
+      const Point2 centre =
+          box->origin + box->along * box->width / 2 + Point2(-box->along.y(), box->along.x()) * box->height / 2;
+      int nearest = std::clamp(first, 0, w.rows() - 1);
+      for (int r = std::max(first, 0); r <= std::min(last, w.rows() - 1); ++r) {
+        if ((centreOfRow(w, r) - centre).norm() < (centreOfRow(w, nearest) - centre).norm()) nearest = r;
+      }
+      labelRows.push_back(nearest);
     };
     const int u = w.upRow;
     {
@@ -471,6 +638,9 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       rows.insert(rows.end(), inwards.begin(), inwards.end());
       place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach, labelCandidates(w, rows));
     }
+    if (core::crossesItself(panel.outline)) {
+      cutApart(w, panel, holeRowsOf[i], labelRows, d);
+    }
     result.panels[k] = std::move(panel);
   });
   std::vector<std::string> unfitted;
@@ -492,12 +662,27 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       std::string some;
       for (size_t i = 0; i < overlapping.size() && i < 5; ++i)
         some += fmt::format("{}{}", i ? ", " : "", overlapping[i]);
+      // Not a panel anyone could cut and build: its ribbon folds over
+      // itself, mostly where it turns about a thin face's sharp corner
+      // more tightly than it is wide, and no cut across it unfolds it.
+      throw std::invalid_argument(fmt::format(
+          "panel{} {}{} would fold over {} when unfolded, even cut in three: {} ribbon turns about a face's corner "
+          "more sharply than it is wide (thin faces); simplifying the mesh to fewer, evener faces ({} N, fewer than "
+          "its {}) may weave it",
+          plural(overlapping.size()), some, overlapping.size() > 5 ? ", ..." : "",
+          overlapping.size() == 1 ? "itself" : "themselves", overlapping.size() == 1 ? "its" : "each",
+          options.names(Parameter::Panels), mesh.faceCount()));
+    }
+    size_t pieces = 0, cut = 0;
+    for (const Panel& panel : result.panels) {
+      pieces += panel.pieces.size();
+      cut += panel.pieces.empty() ? 0 : 1;
+    }
+    if (cut > 0) {
       result.warnings.push_back(fmt::format(
-          "{} panel{} overlap{} {} when unfolded (panel{} {}{}): cut {} across where {} ribbon crosses itself",
-          overlapping.size(), plural(overlapping.size()), overlapping.size() == 1 ? "s" : "",
-          overlapping.size() == 1 ? "itself" : "themselves", plural(overlapping.size()), some,
-          overlapping.size() > 5 ? ", ..." : "", overlapping.size() == 1 ? "it" : "them",
-          overlapping.size() == 1 ? "its" : "each"));
+          "{} panel{} would overlap {} when unfolded: cut into {} more piece{}, each fastened to the next where "
+          "they overlap (the steps say which)",
+          cut, plural(cut), cut == 1 ? "itself" : "themselves", pieces, plural(pieces)));
     }
   }
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
@@ -523,6 +708,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   for (size_t e = 0; e < crossingCount; ++e) {
     if (crossings[e].panel[0] >= 0 && !glued[e]) result.fasteners += holes[e].single ? 1 : 2;
   }
+  for (const Panel& panel : result.panels) result.fasteners += static_cast<int>(panel.pieces.size());
   result.steps = weaveSteps(result.panels);
   return result;
 }

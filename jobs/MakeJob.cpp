@@ -145,8 +145,10 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   }
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {
-      throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} keep or fill builds it", name,
-                                        loops, plural(loops), request.names(Parameter::Holes)));
+      // (A weave crosses every edge: a boundary edge has no second side to cross to.)
+      throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} {} builds it", name, loops,
+                                        plural(loops), request.names(Parameter::Holes),
+                                        request.structure == geometry::StructureKind::Weave ? "fill" : "keep or fill"));
     }
     if (request.holes == HolesMode::Fill) {
       geometry::fillHoles(mesh);
@@ -240,8 +242,9 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
     sizing.grown = built.grown;
     if (built.grown > 1) {
       context.note(fmt::format(
-          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the smallest size at which every crossing has room "
-          "for two {:.3f} in fastener holes ({} crossing{} had none); {} or {} sets the size",
+          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the smallest size at which its crossings have room "
+          "for {:.3f} in fastener holes, all but one in a hundred ({} crossing{} had none at the default size); {} or "
+          "{} sets the size",
           name, geometry::kMeanEdgeInches * built.grown, geometry::kMeanEdgeInches, weave.fastener,
           built.bandsWithoutRoom, plural(built.bandsWithoutRoom), request.names(Parameter::Size),
           request.names(Parameter::Scale)));
@@ -461,9 +464,12 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
     throw core::UserError(fmt::format(
         "{}: {}{}", name, error.what(),
         sizing.grown > 1 && !sizing.bedLimited
-            ? fmt::format(" at {:.2f} times the default size, the smallest at which every band has room for "
-                          "its fastener; a smaller {}, or fewer and evener faces ({} N), needs less",
-                          sizing.grown, request.names(Parameter::Fastener), request.names(Parameter::Panels))
+            ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
+                          "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
+                          sizing.grown,
+                          request.structure == geometry::StructureKind::Weave ? "crossing" : "band",
+                          request.structure == geometry::StructureKind::Weave ? " holes" : "",
+                          request.names(Parameter::Fastener), request.names(Parameter::Panels))
             : ""));
   }
   job.meshFile = request.mesh;

@@ -191,14 +191,18 @@ nlohmann::ordered_json panelEntry(const geometry::Structure& structure, size_t i
   };
   entry["holes"] = nlohmann::ordered_json::array();
   for (const auto& hole : panel.holes) entry["holes"].push_back(holeEntry(hole));
-  entry["labels"] = nlohmann::ordered_json::array();
-  for (const auto& label : panel.labels) {
-    // The number the label shows (without the mark of 6 and 9): an edge's, or the panel's own.
-    nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
-    if (label.edge > 0) l["edge"] = label.edge;
-    l["role"] = geometry::roleName(label.role);
-    entry["labels"].push_back(l);
-  }
+  // The number each label shows (without the mark of 6 and 9): an edge's, or the panel's own.
+  const auto labelsJson = [&](const std::vector<geometry::PanelLabel>& labels) {
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const auto& label : labels) {
+      nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
+      if (label.edge > 0) l["edge"] = label.edge;
+      l["role"] = geometry::roleName(label.role);
+      list.push_back(l);
+    }
+    return list;
+  };
+  entry["labels"] = labelsJson(panel.labels);
   std::vector<int> neighbors, edges;
   for (const geometry::PanelJoin& join : panel.joins) neighbors.push_back(join.panel), edges.push_back(join.edge);
   entry["neighbors"] = neighbors;
@@ -228,7 +232,8 @@ nlohmann::ordered_json panelEntry(const geometry::Structure& structure, size_t i
       p["holes"] = nlohmann::ordered_json::array();
       for (const auto& hole : piece.holes) p["holes"].push_back(holeEntry(hole));
       p["area"] = piece.area;
-      p["fastened"] = geometry::fasteningName(piece.fastening);  // extension: by a tab, or by its band
+      p["fastened"] = geometry::fasteningName(piece.fastening);           // extension: by a tab, or by its band
+      if (!piece.labels.empty()) p["labels"] = labelsJson(piece.labels);  // extension: what is etched on it
       entry["pieces"].push_back(p);
     }
   }
@@ -365,7 +370,9 @@ struct StepLine {
 std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
   std::map<int, const nlohmann::ordered_json*> byId;
   for (const auto& panel : manifest.at("panels")) byId[panel.at("id").get<int>()] = &panel;
-  std::map<int, std::vector<int>> panelsAt;  // edge -> the panels with its holes, in id order
+  std::map<int, std::vector<int>> panelsAt;  // edge -> the panels at its crossing, in id order
+  std::map<std::string, int> sheetOfPiece;
+  std::set<int> withHoles;  // crossings with holes; the others are glued
   std::vector<geometry::Panel> panels;
   for (const auto& [id, panel] : byId) {
     geometry::Panel& read = panels.emplace_back();
@@ -375,7 +382,32 @@ std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
       read.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
       edges.insert(read.holes.back().edge);
     }
-    for (int e : edges) panelsAt[e].push_back(id);
+    // Extension: the pieces cut off a panel that would overlap itself.
+    if (panel->contains("pieces")) {
+      for (const auto& piece : panel->at("pieces")) {
+        geometry::PanelPiece& p = read.pieces.emplace_back();
+        p.name = piece.at("name").get<std::string>();
+        sheetOfPiece[p.name] = piece.at("sheet").get<int>();
+        for (const auto& hole : piece.at("holes")) {
+          p.holes.push_back({hole.at("edge").get<int>(), Point2::Zero(), 0});
+          edges.insert(p.holes.back().edge);
+        }
+      }
+    }
+    edges.erase(0);  // a piece's own fastener
+    for (int e : edges) withHoles.insert(e);
+    // The panels at each crossing, from the joins (our extension "edges"
+    // names each neighbour's edge): holes or none (a glued crossing).
+    const auto& neighbors = panel->at("neighbors");
+    const auto& joinEdges = panel->at("edges");
+    for (size_t j = 0; j < neighbors.size() && j < joinEdges.size(); ++j) {
+      const int e = joinEdges[j].get<int>();
+      for (int at : {id, neighbors[j].get<int>()}) {
+        auto& list = panelsAt[e];
+        if (std::find(list.begin(), list.end(), at) == list.end())
+          list.insert(std::upper_bound(list.begin(), list.end(), at), at);
+      }
+    }
   }
   const auto others = [&](int edge, int except) {
     std::vector<int> list;
@@ -399,9 +431,10 @@ std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
     line.panel = panel.id;
     line.sheet = json.at("sheet").get<int>();
     line.thread = json.at("source").value("cycle", 0);
+    // Its ends: the crossings it is at, but its own.
     std::set<int> ends;
-    for (const geometry::PanelHole& hole : panel.holes) {
-      if (hole.edge != panel.id) ends.insert(hole.edge);
+    for (const auto& [edge, at] : panelsAt) {
+      if (edge != panel.id && std::find(at.begin(), at.end(), panel.id) != at.end()) ends.insert(edge);
     }
     const std::vector<int> under = others(panel.id, panel.id);
     // Two panels at a crossing: this one goes under it too, at one end (a
@@ -431,6 +464,30 @@ std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
       }
       std::stable_partition(inOrder.begin(), inOrder.end(), [&](int e) { return e == first; });
       line.joins += fmt::format("; its ends under edge{} {}", inOrder.size() == 1 ? "" : "s", named(inOrder));
+    }
+    if (!steps[i].pieces.empty()) {
+      std::string names;
+      for (size_t k = 0; k < steps[i].pieces.size(); ++k) {
+        names +=
+            fmt::format("{}{} (sheet {})", k ? " and " : "", steps[i].pieces[k], sheetOfPiece.at(steps[i].pieces[k]));
+      }
+      line.joins = fmt::format("first fasten piece{} {} to it where {} overlap ({} fastener{}); ",
+                               steps[i].pieces.size() == 1 ? "" : "s", names, "they", steps[i].pieces.size(),
+                               steps[i].pieces.size() == 1 ? "" : "s") +
+                   line.joins;
+      line.fasteners += static_cast<int>(steps[i].pieces.size());
+    }
+    // A glued crossing (no room for a hole), at the step of its last panel.
+    for (int e : ends) {
+      const auto& at = panelsAt[e];
+      if (!withHoles.count(e) && !at.empty() && at.back() == panel.id) {
+        line.joins += fmt::format("; glue crossing {} where panels {} overlap (no room for a fastener)", e,
+                                  named(std::vector<int>(at.begin(), at.end())));
+      }
+    }
+    if (!withHoles.count(panel.id) && !panelsAt[panel.id].empty() && panelsAt[panel.id].back() == panel.id) {
+      line.joins += fmt::format("; glue crossing {} where panels {} overlap (no room for a fastener)", panel.id,
+                                named(panelsAt[panel.id]));
     }
     for (const geometry::AssemblyJoin& join : steps[i].joins) {
       std::vector<int> three = panelsAt[join.edge];

@@ -185,6 +185,36 @@ TEST(WeaveStructure, ASingleCycleWeaveIsOneThreadOfFacesLessOnePanels) {
   for (const Panel& panel : s.panels) EXPECT_EQ(panel.source.cycle, 1);
 }
 
+TEST(WeaveStructure, APanelThatWouldOverlapItselfIsCutIntoLappedPiecesThatDoNot) {
+  // One thread round the torus: at the leaves of its tree it curls round a
+  // face, and two of its panels would overlap themselves.
+  WeaveOptions options;
+  options.cycles = WeaveCycles::Single;
+  const Structure s = wovenStructure(importMesh(std::string(ROTAFAB_SOURCE_DIR) + "/examples/torus.obj").mesh, options);
+  int pieces = 0, laps = 0;
+  for (const Panel& panel : s.panels) {
+    SCOPED_TRACE(panel.id);
+    EXPECT_FALSE(core::crossesItself(panel.outline));
+    for (const PanelHole& hole : panel.holes) laps += hole.edge == 0 ? 1 : 0;
+    for (const PanelPiece& piece : panel.pieces) {
+      ++pieces;
+      EXPECT_EQ(piece.name.substr(0, std::to_string(panel.id).size()), std::to_string(panel.id));
+      EXPECT_FALSE(core::crossesItself(piece.outline));
+      EXPECT_GT(core::signedArea(piece.outline), 0);
+      EXPECT_EQ(piece.fastening, PieceFastening::Tab);
+      for (const PanelHole& hole : piece.holes) laps += hole.edge == 0 ? 1 : 0;
+    }
+  }
+  EXPECT_GT(pieces, 0);
+  EXPECT_EQ(laps, 2 * pieces);  // a lap's hole on both parts it joins
+  // Each piece's fastener counted once, with the crossings' two each.
+  int crossingFasteners = 0;
+  for (const AssemblyStep& step : s.steps) {
+    for (const AssemblyJoin& join : step.joins) crossingFasteners += join.fasteners;
+  }
+  EXPECT_EQ(s.fasteners, crossingFasteners + pieces);
+}
+
 TEST(WeaveStructure, AFastenerTooLargeForTwoHolesGivesOneAndTooLargeForOneGrowsTheMesh) {
   // The soccer ball's crossings at a 2 in mean edge: room for two 1/8 in
   // holes; for one 1/2 in hole each, at the crossing's centre; for no
