@@ -99,9 +99,9 @@ Point3 bezierDerivative(const std::array<Point3, 4>& control, double t) {
 }
 
 std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side) {
-  const auto count = ribbon.passes.size();
-  const RibbonPass& here = ribbon.passes[static_cast<size_t>(pass) % count];
-  const RibbonPass& next = ribbon.passes[(static_cast<size_t>(pass) + 1) % count];
+  const int count = static_cast<int>(ribbon.passes.size());
+  const RibbonPass& here = ribbon.passes[static_cast<size_t>(((pass % count) + count) % count)];
+  const RibbonPass& next = ribbon.passes[static_cast<size_t>((((pass + 1) % count) + count) % count)];
   const auto s = static_cast<size_t>(side);
   return {here.middle[s], here.tail[s], next.head[s], next.middle[s]};
 }

@@ -56,10 +56,10 @@ void twistForWeave(RotationSystem& rs, WeaveCycles cycles, int root) {
   // reached is on another component, which one thread cannot reach.
   const auto missed = std::find(reached.begin(), reached.end(), 0);
   if (missed != reached.end()) {
-    throw std::invalid_argument(
-        fmt::format("face {} is on another piece of the surface than face {}: one thread cannot weave two pieces (all cycles, a "
-                    "thread per Petrie walk, weaves each)",
-                    missed - reached.begin() + 1, root + 1));
+    throw std::invalid_argument(fmt::format(
+        "face {} is on another piece of the surface than face {}: one thread cannot weave two pieces (all cycles, a "
+        "thread per Petrie walk, weaves each)",
+        missed - reached.begin() + 1, root + 1));
   }
 }
 

@@ -132,6 +132,12 @@ StripPoint stripPointOnLine(const WovenPanel& panel, int first, int last, const 
       }
     }
   }
+  if (!std::isfinite(bestInside)) {
+    // No triangle there to meet (all of zero area): no point of the strip.
+    best.weights = {1, 0, 0};
+    best.miss = std::numeric_limits<double>::infinity();
+    return best;
+  }
   if (bestInside < -1e-12) {
     double sum = 0;
     for (double& w : best.weights) sum += (w = std::max(w, 0.0));
@@ -162,8 +168,8 @@ std::vector<WovenPanel> wovenPanels(const std::vector<Ribbon>& ribbons, const st
                          ribbon.passes[static_cast<size_t>(wrapped(after, passes))].edge};
       const int firstRow = before * n - overlap, lastRow = after * n + overlap;
       if (before == k || lastRow - firstRow >= total) {
-        throw std::invalid_argument(fmt::format(
-            "thread {} crosses under only once: its panel over edge {} would go all round it", r + 1, pass.edge + 1));
+        throw std::invalid_argument(
+            fmt::format("thread {} crosses under only once, so its one panel would go all round it", r + 1));
       }
       panel.firstRow = wrapped(firstRow, total);
       panel.upRow = k * n - firstRow;

@@ -192,7 +192,7 @@ geometry::Point3 builtSize(const geometry::Structure& structure) {
 // (or the scale, if that is what was given), that gives every band room;
 // every length of the structure scales with the mesh.
 std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, double fastener,
-                       double scaleNeeded, std::string_view places = "band") {
+                       double scaleNeeded, std::string_view places = "band", bool estimate = false) {
   const auto& names = request.names;
   if (!std::isfinite(scaleNeeded)) {
     return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
@@ -203,9 +203,10 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
                                  ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
                                  : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(size * scaleNeeded));
   const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
-  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, would give every {} room",
-                                   names(Parameter::Fastener), smaller, larger, places)
-                     : fmt::format("{} or larger would give every {} room", larger, places);
+  const char* verb = estimate ? "may" : "would";
+  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, {} give every {} room",
+                                   names(Parameter::Fastener), smaller, larger, verb, places)
+                     : fmt::format("{} or larger {} give every {} room", larger, verb, places);
 }
 
 // How the structure's size was chosen, when make chose it.
@@ -251,8 +252,9 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
     }
     return std::move(built.structure);
   } catch (const geometry::NoRoomForHoleError& error) {
+    // (An estimate: the ribbons' offset does not grow with the mesh.)
     throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
-                                      roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing")));
+                                      roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing", true)));
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   }
@@ -466,8 +468,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
         sizing.grown > 1 && !sizing.bedLimited
             ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
                           "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
-                          sizing.grown,
-                          request.structure == geometry::StructureKind::Weave ? "crossing" : "band",
+                          sizing.grown, request.structure == geometry::StructureKind::Weave ? "crossing" : "band",
                           request.structure == geometry::StructureKind::Weave ? " holes" : "",
                           request.names(Parameter::Fastener), request.names(Parameter::Panels))
             : ""));

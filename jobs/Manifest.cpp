@@ -422,6 +422,11 @@ std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
       text += fmt::format("{}{}", i == 0 ? "" : i + 1 == ids.size() ? " and " : ", ", ids[i]);
     return text;
   };
+  // Per panel, the crossings it is at.
+  std::map<int, std::set<int>> crossingsOf;
+  for (const auto& [edge, at] : panelsAt) {
+    for (int id : at) crossingsOf[id].insert(edge);
+  }
   const std::vector<geometry::AssemblyStep> steps = geometry::weaveSteps(panels);
   std::vector<StepLine> lines;
   for (size_t i = 0; i < panels.size(); ++i) {
@@ -432,10 +437,8 @@ std::vector<StepLine> wovenStepLines(const nlohmann::ordered_json& manifest) {
     line.sheet = json.at("sheet").get<int>();
     line.thread = json.at("source").value("cycle", 0);
     // Its ends: the crossings it is at, but its own.
-    std::set<int> ends;
-    for (const auto& [edge, at] : panelsAt) {
-      if (edge != panel.id && std::find(at.begin(), at.end(), panel.id) != at.end()) ends.insert(edge);
-    }
+    std::set<int> ends(crossingsOf[panel.id].begin(), crossingsOf[panel.id].end());
+    ends.erase(panel.id);
     const std::vector<int> under = others(panel.id, panel.id);
     // Two panels at a crossing: this one goes under it too, at one end (a
     // single thread round a leaf face), bent round over itself.

@@ -64,6 +64,7 @@ cli::MakeOptions parseMakeOptions(const std::string& mesh, const std::vector<std
   arguments.push_back(mesh);
   try {
     make.parse(arguments);
+    cli::checkStructureOptions(make, options);
   } catch (const CLI::ParseError& error) {
     throw ApiError(400, fmt::format("make options: {}", error.what()));
   }

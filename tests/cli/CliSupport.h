@@ -27,4 +27,14 @@ inline double distanceToOutline(const nlohmann::json& outline, double x, double 
   return nearest;
 }
 
+// Whether a point lies inside a closed outline given as manifest.json's [[x, y], ...] (even-odd rule).
+inline bool insideOutline(const nlohmann::json& outline, double x, double y) {
+  bool inside = false;
+  for (size_t k = 0, j = outline.size() - 1; k < outline.size(); j = k++) {
+    const double ax = outline[k][0], ay = outline[k][1], bx = outline[j][0], by = outline[j][1];
+    if ((ay > y) != (by > y) && x < (bx - ax) * (y - ay) / (by - ay) + ax) inside = !inside;
+  }
+  return inside;
+}
+
 }  // namespace rotafab::test

@@ -71,6 +71,7 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
       const auto& outline = part->at("outline");
       for (const auto& hole : part->at("holes")) {
         const double nearest = distanceToOutline(outline, hole.at("xy")[0], hole.at("xy")[1]);
+        EXPECT_TRUE(insideOutline(outline, hole.at("xy")[0], hole.at("xy")[1])) << "panel " << id;
         EXPECT_GE(nearest, hole.at("diameter").get<double>() - 1e-9) << "panel " << id;
       }
     }
@@ -83,6 +84,9 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
     for (int count : holesAt[e]) holes += count;
     EXPECT_TRUE(holes == 3 || holes == 6) << "edge " << e << ": " << holes << " holes";
     EXPECT_TRUE(holesAt[e].size() == 3 || holesAt[e].size() == 2) << "edge " << e;
+    // As many on each of the three (two of them one panel: twice as many on it).
+    const auto [fewest, most] = std::minmax_element(holesAt[e].begin(), holesAt[e].end());
+    EXPECT_EQ(holesAt[e].size() == 3 ? *fewest : 2 * *fewest, *most) << "edge " << e;
     fasteners += holes / 3;
   }
   // Each lap's hole is on both parts it joins: one fastener.
