@@ -523,7 +523,9 @@ std::string howToJoin(const nlohmann::ordered_json& manifest) {
            "Each panel goes over the edge whose number is etched in its middle and under the edges numbered at its "
            "ends; the underlined number is the panel under it met first turning counter-clockwise. Where three "
            "panels carry one number, lay the panel with that number in its middle over the other two (which overlap "
-           "end to end) and fasten the three through both pairs of holes.";
+           "end to end) and fasten the three through both pairs of holes. Lay each panel loosely where the steps "
+           "name panels not yet placed; its crossing is fastened at the step of its last panel. The etched side "
+           "faces out.";
   }
   return "Join the panels in this order (flood fill from panel 1, the base). Each edge band overlaps the band with "
          "the same number on the panel named; fasten them through their holes.";
