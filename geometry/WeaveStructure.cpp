@@ -254,7 +254,10 @@ void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRow
     for (size_t l = 0; l < panel.labels.size(); ++l) {
       if (!a.holds(labelRows[l]) && !b.holds(labelRows[l])) continue;
       bool held = false;
-      for (const auto& [span, outline] : {std::pair{a, &outlineA}, std::pair{b, &outlineB}}) {
+      for (const auto& part : {std::pair{a, &outlineA}, std::pair{b, &outlineB}}) {
+        // (Not a structured binding: a lambda below uses the outline, which clang 14 refuses to capture.)
+        const RowSpan& span = part.first;
+        const std::vector<Point2>* outline = part.second;
         if (!span.holds(labelRows[l])) continue;
         const auto corners = panel.labels[l].box.corners();
         held = held || std::all_of(corners.begin(), corners.end(),
