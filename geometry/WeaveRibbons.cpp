@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -79,6 +80,7 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
     }
     return (1 - b) * ((1 - a) * origin + a * target) + b * centre;
   };
+  pass.lift = step.crossing == Crossing::Up ? lift : step.crossing == Crossing::Down ? Point3(-lift) : Point3::Zero();
   const double b0 = (1 - shape.width) / 2, b1 = (1 + shape.width) / 2;
   const double a0 = (1 - shape.curve) / 2, a1 = (1 + shape.curve) / 2;
   pass.head = {at(a0, b0), at(a0, b1)};
@@ -98,6 +100,15 @@ Point3 bezierDerivative(const std::array<Point3, 4>& control, double t) {
          3 * t * t * (control[3] - control[2]);
 }
 
+Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, int side, double t) {
+  const auto s = static_cast<size_t>(side);
+  const std::array<Point3, 4> projected{here.middle[s] - here.lift, here.tail[s] - here.lift, next.head[s] - next.lift,
+                                        next.middle[s] - next.lift};
+  // Smoothstep over the middle third: no slope at either end of it.
+  const double x = std::clamp(3 * t - 1, 0.0, 1.0), rise = x * x * (3 - 2 * x);
+  return bezierPoint(projected, t) + (1 - rise) * here.lift + rise * next.lift;
+}
+
 std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side) {
   const int count = static_cast<int>(ribbon.passes.size());
   const RibbonPass& here = ribbon.passes[static_cast<size_t>(((pass % count) + count) % count)];
@@ -113,14 +124,12 @@ void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& region
   const size_t here = static_cast<size_t>(k) % n, next = (here + 1) % n;
   const RibbonPass a = railPass(rs, regions, thread.steps[here], shape, ribbon.swapped[here] != 0);
   const RibbonPass b = railPass(rs, regions, thread.steps[next], shape, ribbon.swapped[next] != 0);
-  const std::array<Point3, 4> p{a.middle[0], a.tail[0], b.head[0], b.middle[0]};
-  const std::array<Point3, 4> q{a.middle[1], a.tail[1], b.head[1], b.middle[1]};
   railP.clear();
   railQ.clear();
   for (int i = 0; i <= shape.samples; ++i) {
     const double t = static_cast<double>(i) / shape.samples;
-    railP.push_back(bezierPoint(p, t));
-    railQ.push_back(bezierPoint(q, t));
+    railP.push_back(segmentPoint(a, b, 0, t));
+    railQ.push_back(segmentPoint(a, b, 1, t));
   }
 }
 
@@ -153,11 +162,12 @@ std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& w
     ribbon.railP.reserve(static_cast<size_t>(passes * n));
     ribbon.railQ.reserve(static_cast<size_t>(passes * n));
     for (int k = 0; k < passes; ++k) {
-      const auto p = segmentControls(ribbon, k, 0), q = segmentControls(ribbon, k, 1);
+      const RibbonPass& here = ribbon.passes[static_cast<size_t>(k)];
+      const RibbonPass& next = ribbon.passes[static_cast<size_t>((k + 1) % passes)];
       for (int i = 0; i < n; ++i) {
         const double t = static_cast<double>(i) / n;
-        ribbon.railP.push_back(bezierPoint(p, t));
-        ribbon.railQ.push_back(bezierPoint(q, t));
+        ribbon.railP.push_back(segmentPoint(here, next, 0, t));
+        ribbon.railQ.push_back(segmentPoint(here, next, 1, t));
       }
     }
     ribbons.push_back(std::move(ribbon));

@@ -44,6 +44,7 @@ struct RibbonPass {
   Crossing crossing = Crossing::None;
   FaceCorner from, to;  // where the thread enters and leaves the region
   std::array<Point3, 2> head, middle, tail;
+  Point3 lift = Point3::Zero();  // +h N_e over, -h N_e under, 0 beside an untwisted edge: in the points above
 };
 
 struct Ribbon {
@@ -74,6 +75,16 @@ std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& w
 void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& regions, const Thread& thread,
                  const Ribbon& ribbon, int k, const RibbonShape& shape, std::vector<Point3>& railP,
                  std::vector<Point3>& railQ);
+
+// Point t of the segment from pass `here`'s middle to pass `next`'s on rail
+// `side`: eq. 4.17's cubic through the passes' quads as projected, lifted by
+// a height that stays at `here`'s for the first third of the segment and at
+// `next`'s for the last, changing smoothly in the middle third, where the
+// ribbon passes the face corner that only its thread passes. (The cubic of
+// the lifted points would start sinking at once, and near the crossing
+// the ribbon over would meet the one under it where both bend away.) Its
+// derivative is the cubic's at both ends: C1 at every middle.
+Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, int side, double t);
 
 // Point t in [0, 1] of eq. 4.17's cubic, and its derivative.
 Point3 bezierPoint(const std::array<Point3, 4>& control, double t);

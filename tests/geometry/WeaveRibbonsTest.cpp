@@ -145,14 +145,48 @@ TEST(WeaveRibbons, TheBezierRailsAreC1AtEveryQuadsMiddleAndPassThroughIt) {
         const double tolerance = 1e-12 * (1 + pass.middle[0].norm());
         EXPECT_TRUE(near(ribbon.railP[static_cast<size_t>(k * shape.samples)], pass.middle[0], tolerance));
         EXPECT_TRUE(near(ribbon.railQ[static_cast<size_t>(k * shape.samples)], pass.middle[1], tolerance));
+        // The sampled curves themselves, lift included: one point and one
+        // derivative either side of each middle (central differences).
+        const RibbonPass& previous = ribbon.passes[static_cast<size_t>((k + n - 1) % n)];
+        const RibbonPass& next = ribbon.passes[static_cast<size_t>((k + 1) % n)];
+        constexpr double kStep = 1e-5;
         for (int side = 0; side < 2; ++side) {
-          const auto before = segmentControls(ribbon, (k + n - 1) % n, side), after = segmentControls(ribbon, k, side);
-          EXPECT_TRUE(near(bezierPoint(before, 1), bezierPoint(after, 0), tolerance));
-          const Point3 in = bezierDerivative(before, 1), out = bezierDerivative(after, 0);
-          EXPECT_TRUE(near(in, out, 1e-12 * (1 + in.norm() + pass.middle[0].norm()))) << "pass " << k;
+          EXPECT_TRUE(near(segmentPoint(previous, pass, side, 1), segmentPoint(pass, next, side, 0), tolerance));
+          const Point3 in =
+              (segmentPoint(previous, pass, side, 1) - segmentPoint(previous, pass, side, 1 - kStep)) / kStep;
+          const Point3 out = (segmentPoint(pass, next, side, kStep) - segmentPoint(pass, next, side, 0)) / kStep;
+          EXPECT_TRUE(near(in, out, 1e-3 * (1 + in.norm()))) << "pass " << k;
           EXPECT_GT(in.norm(), 0);
+          // The control polygon of eq. 4.17: A1 the midpoint of A0 A2, so equal tangents at A1.
+          const auto before = segmentControls(ribbon, (k + n - 1) % n, side), after = segmentControls(ribbon, k, side);
+          EXPECT_TRUE(near(bezierDerivative(before, 1), bezierDerivative(after, 0),
+                           1e-12 * (1 + in.norm() + pass.middle[0].norm())));
         }
       }
+    }
+  }
+}
+
+TEST(WeaveRibbons, NearACrossingTheRibbonsKeepTheirHeightsAndChangeThemPastTheCorner) {
+  // For the first and last third of each segment the ribbon stands at its
+  // crossing's height, ±h along N_e, so the ribbon over and the ribbon
+  // under stay 2h apart as far as they overlap; between, it rises or sinks.
+  const RibbonShape shape{.width = 0.8, .curve = 0.6, .offset = 0.05, .samples = 6};
+  const WovenMesh w = woven(truncatedIcosahedron());
+  for (const Ribbon& ribbon : weaveRibbons(w.rs, w.threads, w.regions, shape)) {
+    const size_t n = ribbon.passes.size();
+    for (size_t k = 0; k < n; ++k) {
+      const RibbonPass &here = ribbon.passes[k], &next = ribbon.passes[(k + 1) % n];
+      const Point3 normal = here.lift.normalized();
+      const Point3 atCrossing = segmentPoint(here, next, 0, 0);
+      // The height above the crossing's plane at a third of the way: the cubic of the projected points lies in
+      // that plane only while it is in the quad, so compare with the same point without the lift.
+      const double t = 0.3;
+      const Point3 lifted = segmentPoint(here, next, 0, t);
+      const std::array<Point3, 4> projected{here.middle[0] - here.lift, here.tail[0] - here.lift,
+                                            next.head[0] - next.lift, next.middle[0] - next.lift};
+      EXPECT_TRUE(near(lifted - bezierPoint(projected, t), here.lift, 1e-12)) << "pass " << k;
+      EXPECT_NEAR((atCrossing - w.regions[static_cast<size_t>(here.edge)].midpoint).dot(normal), shape.offset, 1e-9);
     }
   }
 }
