@@ -173,11 +173,10 @@ void BM_RotationSystemAndTrace(benchmark::State& state) {
 }
 BENCHMARK(BM_RotationSystemAndTrace)->Apply(sizes)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
 
-// `make --structure band` up to the planner, import to
-// labelled panels: import, analysis, scale (mean edge 2 in), vertex bands,
-// developable bands, unfolding, holes, labels, flood fill. Target: linear,
-// under 5 s for 50k faces. (Nesting is measured by rotafab_nest_bench.)
-void BM_BandStructure(benchmark::State& state) {
+// Import to labelled panels of one structure: import, analysis, scale (mean
+// edge 2 in), then `build`.
+template <class Build>
+void structureFromFile(benchmark::State& state, const Build& build) {
   const auto& path = meshFile(state.range(0));
   long faces = 0;
   rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
@@ -188,11 +187,21 @@ void BM_BandStructure(benchmark::State& state) {
     geo::requireUsable(geo::analyzeMesh(imported.mesh));
     const double scale = geo::constructionScale(imported.mesh, std::nullopt, std::nullopt);
     for (geo::Point3& p : imported.mesh.positions) p *= scale;
-    const geo::Structure structure = geo::buildBandStructure(imported.mesh, geo::BandOptions{}, context);
+    const geo::Structure structure = build(imported.mesh, context);
     benchmark::DoNotOptimize(structure.panels.data());
     faces = imported.mesh.faceCount();
   }
   state.SetComplexityN(faces);
+}
+
+// `make --structure band` up to the planner, import to
+// labelled panels: import, analysis, scale (mean edge 2 in), vertex bands,
+// developable bands, unfolding, holes, labels, flood fill. Target: linear,
+// under 5 s for 50k faces. (Nesting is measured by rotafab_nest_bench.)
+void BM_BandStructure(benchmark::State& state) {
+  structureFromFile(state, [](const geo::PolygonMesh& mesh, const rotafab::core::WorkContext& context) {
+    return geo::buildBandStructure(mesh, geo::BandOptions{}, context);
+  });
 }
 BENCHMARK(BM_BandStructure)
     ->Arg(4000)
@@ -209,21 +218,9 @@ BENCHMARK(BM_BandStructure)
 // per edge: 1.5 per face of these triangulated tori. Target as for band:
 // linear, under 5 s for 50k faces.
 void BM_WeaveStructure(benchmark::State& state) {
-  const auto& path = meshFile(state.range(0));
-  long faces = 0;
-  rotafab::core::Executor executor(std::max(1u, std::thread::hardware_concurrency()));
-  const rotafab::core::Cancellation never;
-  const rotafab::core::WorkContext context(executor, never);
-  for (auto _ : state) {
-    geo::ImportedMesh imported = geo::importMesh(path);
-    geo::requireUsable(geo::analyzeMesh(imported.mesh));
-    const double scale = geo::constructionScale(imported.mesh, std::nullopt, std::nullopt);
-    for (geo::Point3& p : imported.mesh.positions) p *= scale;
-    const geo::Structure structure = geo::buildWeaveStructure(imported.mesh, geo::WeaveOptions{}, context);
-    benchmark::DoNotOptimize(structure.panels.data());
-    faces = imported.mesh.faceCount();
-  }
-  state.SetComplexityN(faces);
+  structureFromFile(state, [](const geo::PolygonMesh& mesh, const rotafab::core::WorkContext& context) {
+    return geo::buildWeaveStructure(mesh, geo::WeaveOptions{}, context);
+  });
 }
 BENCHMARK(BM_WeaveStructure)
     ->Arg(4000)

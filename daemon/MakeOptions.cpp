@@ -102,7 +102,8 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
   make.add_option("--structure", options.structure, "band (dissertation ch. V) or weave (ch. IV)")
       ->required()
       ->check(CLI::IsMember({"band", "weave"}));
-  make.add_option("--out", options.out, "Output folder (default: MESHNAME-STRUCTURE, e.g. bunny-band)")->check(outputFolderCheck());
+  make.add_option("--out", options.out, "Output folder (default: MESHNAME-STRUCTURE, e.g. bunny-band)")
+      ->check(outputFolderCheck());
   make.add_option("--machine", options.machine, "Machine profile: the bed, margins and colours")->capture_default_str();
   make.add_option("--material", options.material, "Material profile: kerf and fastener diameter")
       ->capture_default_str();

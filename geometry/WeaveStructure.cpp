@@ -197,18 +197,6 @@ struct RowSpan {
   [[nodiscard]] bool holds(int row) const { return row >= first && row <= last; }
 };
 
-double stripArea(const WovenPanel& w, const RowSpan& span) {
-  double area = 0;
-  for (int r = span.first; r < span.last; ++r) {
-    const auto at = [&](const std::vector<Point3>& rail, int k) -> const Point3& {
-      return rail[static_cast<size_t>(k)];
-    };
-    area += (at(w.railQ, r) - at(w.railP, r)).cross(at(w.railP, r + 1) - at(w.railP, r)).norm() / 2;
-    area += (at(w.railQ, r + 1) - at(w.railQ, r)).cross(at(w.railP, r + 1) - at(w.railQ, r)).norm() / 2;
-  }
-  return area;
-}
-
 // A panel whose unfolded outline crosses itself (its ribbon curls round, as
 // round a face at a leaf of a single thread's tree, or round a sharp vertex)
 // is cut across its strip, at most twice, into parts that do not; each cut
@@ -330,7 +318,7 @@ void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRow
   panel.outline = w.outlineOfRows(main->first, main->last);
   panel.holes = holesOf(*main);
   panel.labels = labelsOf(*main);
-  panel.area = stripArea(w, *main);
+  panel.area = w.areaOfRows(main->first, main->last);
   char letter = 'a';
   for (auto span = spans.begin(); span != spans.end(); ++span) {
     if (span == main) continue;
@@ -340,7 +328,7 @@ void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRow
     piece.outline = w.outlineOfRows(span->first, span->last);
     piece.holes = holesOf(*span);
     piece.labels = labelsOf(*span);
-    piece.area = stripArea(w, *span);
+    piece.area = w.areaOfRows(span->first, span->last);
     piece.fastening = PieceFastening::Tab;
     panel.pieces.push_back(std::move(piece));
   }

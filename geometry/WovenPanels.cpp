@@ -56,20 +56,6 @@ void unfold(WovenPanel& panel, const Point3& normal) {
   panel.flatQ.assign(flat.begin() + rows, flat.end());
 }
 
-double stripArea(const WovenPanel& panel) {
-  double area = 0;
-  for (int i = 0; i + 1 < panel.rows(); ++i) {
-    const auto& p = panel.railP;
-    const auto& q = panel.railQ;
-    const auto at = [](const std::vector<Point3>& rail, int k) -> const Point3& {
-      return rail[static_cast<size_t>(k)];
-    };
-    area += (at(q, i) - at(p, i)).cross(at(p, i + 1) - at(p, i)).norm() / 2;
-    area += (at(q, i + 1) - at(q, i)).cross(at(p, i + 1) - at(q, i)).norm() / 2;
-  }
-  return area;
-}
-
 }  // namespace
 
 std::vector<Point2> WovenPanel::outlineOfRows(int first, int last) const {
@@ -77,6 +63,16 @@ std::vector<Point2> WovenPanel::outlineOfRows(int first, int last) const {
   for (int i = last; i >= first; --i) outline.push_back(flatQ[static_cast<size_t>(i)]);
   if (core::signedArea(outline) < 0) std::reverse(outline.begin(), outline.end());
   return outline;
+}
+
+double WovenPanel::areaOfRows(int first, int last) const {
+  double area = 0;
+  for (int i = first; i < last; ++i) {
+    const Point3 &p0 = railP[static_cast<size_t>(i)], &p1 = railP[static_cast<size_t>(i + 1)];
+    const Point3 &q0 = railQ[static_cast<size_t>(i)], &q1 = railQ[static_cast<size_t>(i + 1)];
+    area += (q0 - p0).cross(p1 - p0).norm() / 2 + (q1 - q0).cross(p1 - q0).norm() / 2;
+  }
+  return area;
 }
 
 std::vector<Point2> WovenPanel::outline() const { return outlineOfRows(0, rows() - 1); }
@@ -179,7 +175,7 @@ std::vector<WovenPanel> wovenPanels(const std::vector<Ribbon>& ribbons, const st
         panel.railQ.push_back(ribbon.railQ[static_cast<size_t>(wrapped(row, total))]);
       }
       unfold(panel, regions[static_cast<size_t>(pass.edge)].normal);
-      panel.area = stripArea(panel);
+      panel.area = panel.areaOfRows(0, panel.rows() - 1);
       panels.push_back(std::move(panel));
     }
   }

@@ -38,6 +38,8 @@ struct WovenPanel {
   [[nodiscard]] std::vector<Point2> outline() const;
   // The outline of its rows first..last only.
   [[nodiscard]] std::vector<Point2> outlineOfRows(int first, int last) const;
+  // The area in space of its strip's triangles between rows first and last.
+  [[nodiscard]] double areaOfRows(int first, int last) const;
   // The strip's triangles as (row, rail) corners: quad i (rows i, i + 1) is
   // (P_i, Q_i, P_i+1), (Q_i, Q_i+1, P_i+1); index r is P_r, rows() + r is Q_r.
   [[nodiscard]] const Point3& corner(int index) const;
