@@ -33,7 +33,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
   request.start = options.start;
   request.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
   request.scoreFolds = options.scoreFolds;
-  if (options.width) request.width = *options.width;
+  request.width = options.width;
   if (options.curve) request.curve = *options.curve;
   if (!options.offset.empty()) request.offset = lengthOption(options.offset, "--offset", true);
   request.cycles = options.cycles == "single" ? geometry::WeaveCycles::Single : geometry::WeaveCycles::All;
@@ -136,7 +136,8 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
       ->capture_default_str()
       ->check(CLI::Range(1, 64));
   make.add_option("--width", options.width,
-                  "Weave: the ribbons' share of their edge region across them, 0 < W <= 1 (default 0.8; eq. 4.6-4.9)")
+                  "Weave: the ribbons' share of their edge region across them, 0 < W <= 1 (eq. 4.6-4.9; default\n"
+                  "0.8, narrowed edge by edge where ribbons would pass through each other; a W given is kept)")
       ->check(fractionCheck());
   make.add_option("--curve", options.curve,
                   "Weave: each crossing's share of its edge region along the ribbon, 0 < C <= 1 (default 0.6;\n"

@@ -4,7 +4,7 @@
 // sharply or the ribbons are wide). Every triangle of every ribbon's strip
 // is put in a uniform grid by its box, and the triangles that share a cell
 // are tested against each other (an edge of one through the other), but
-// for a strip's own triangles a few rows apart, which touch. Then, per pair
+// for a strip's own triangles within three rows, which touch or nearly. Then, per pair
 // of ribbon segments that meet, the widest --width (by bisection, the two
 // segments made again at each try) at which they no longer do, and a width
 // at which no two ribbons meet, checked on the whole weave.
@@ -36,5 +36,21 @@ struct RibbonCollisions {
 RibbonCollisions ribbonCollisions(const RotationSystem& rs, const WeaveThreads& weave,
                                   const std::vector<EdgeRegion>& regions, const std::vector<Ribbon>& ribbons,
                                   const RibbonShape& shape, const core::WorkContext& context);
+
+// The ribbons at `shape`'s width but narrower at the edges where they would
+// meet: per pair of segments that meet, the passes of both take the pair's
+// own clearing width (or a tenth less than they had, when that is not
+// less), and the weave is made again and looked at again, a few rounds at
+// most. A dense weave (fig. 15) where the surface allows it, and no two
+// ribbons through each other where it does not.
+struct ClearedRibbons {
+  std::vector<Ribbon> ribbons;
+  std::vector<double> edgeWidths;  // w per edge, as the ribbons were made with
+  int narrowed = 0;                // edges narrower than the shape's width
+  RibbonCollisions left;           // what still meets after the last round (nothing, as a rule)
+};
+ClearedRibbons narrowUntilClear(const RotationSystem& rs, const WeaveThreads& weave,
+                                const std::vector<EdgeRegion>& regions, const RibbonShape& shape,
+                                const core::WorkContext& context);
 
 }  // namespace rotafab::geometry

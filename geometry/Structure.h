@@ -117,6 +117,7 @@ struct Structure {
   int fasteners = 0;                  // one per pair of holes that meet, one per piece's tab
   std::vector<int> glued;             // edge numbers of the bands with no room for a hole, to be glued
   std::vector<std::string> warnings;  // one line each (labels that did not fit, ...)
+  std::vector<std::string> notes;     // one line each: what was chosen for the user (ribbons narrowed, ...)
 };
 
 // The steps of building panel by panel in id order (the flood fill's, V.5,

@@ -27,10 +27,13 @@ void requireShape(const RibbonShape& shape) {
   }
 }
 
-// The pass of `step` with its sides as rails P and Q.
+// The pass of `step` with its sides as rails P and Q, at its edge's width
+// when `edgeWidths` gives one.
 RibbonPass railPass(const RotationSystem& rs, const std::vector<EdgeRegion>& regions, const ThreadStep& step,
-                    const RibbonShape& shape, bool swapped) {
-  RibbonPass pass = ribbonPass(rs, regions[static_cast<size_t>(RotationSystem::edgeOf(step.dart))], step, shape);
+                    RibbonShape shape, bool swapped, const std::vector<double>& edgeWidths = {}) {
+  const auto edge = static_cast<size_t>(RotationSystem::edgeOf(step.dart));
+  if (!edgeWidths.empty()) shape.width = edgeWidths[edge];
+  RibbonPass pass = ribbonPass(rs, regions[edge], step, shape);
   if (swapped) {
     std::swap(pass.head[0], pass.head[1]);
     std::swap(pass.middle[0], pass.middle[1]);
@@ -69,12 +72,12 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
   const Point3& centre = fromFace == rs.face(2 * e) ? region.leftCentre : region.rightCentre;
   const Point3& origin = forward ? region.start : region.end;
   const Point3& target = forward ? region.end : region.start;
-  const auto at = [&](double a, double b) -> Point3 {
+  const auto plain = [&](double a, double b) -> Point3 {
     switch (step.crossing) {
       case Crossing::Up:
-        return (forward ? region.at(a, b) : region.at(1 - a, 1 - b)) + lift;
+        return forward ? region.at(a, b) : region.at(1 - a, 1 - b);
       case Crossing::Down:
-        return (forward ? region.at(b, a) : region.at(1 - b, 1 - a)) - lift;
+        return forward ? region.at(b, a) : region.at(1 - b, 1 - a);
       case Crossing::None:
         break;
     }
@@ -83,9 +86,23 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
   pass.lift = step.crossing == Crossing::Up ? lift : step.crossing == Crossing::Down ? Point3(-lift) : Point3::Zero();
   const double b0 = (1 - shape.width) / 2, b1 = (1 + shape.width) / 2;
   const double a0 = (1 - shape.curve) / 2, a1 = (1 + shape.curve) / 2;
-  pass.head = {at(a0, b0), at(a0, b1)};
-  pass.middle = {at(0.5, b0), at(0.5, b1)};
-  pass.tail = {at(a1, b0), at(a1, b1)};
+  pass.head = {plain(a0, b0) + pass.lift, plain(a0, b1) + pass.lift};
+  pass.middle = {plain(0.5, b0) + pass.lift, plain(0.5, b1) + pass.lift};
+  pass.tail = {plain(a1, b0) + pass.lift, plain(a1, b1) + pass.lift};
+  if (step.crossing != Crossing::None) {
+    // The other strand runs across this one between a = b0 and a = b1 (the
+    // region's map transposed): its rails, as lines in the plane.
+    pass.planePoint = region.midpoint;
+    pass.planeNormal = region.normal;
+    const auto awayFrom = [&](double a, double outside, Point3& point, Point3& normal) {
+      point = plain(a, 0);
+      normal = region.normal.cross(plain(a, 1) - point);
+      if ((plain(outside, 0.5) - point).dot(normal) < 0) normal = -normal;
+      normal.normalize();
+    };
+    awayFrom(b0, 0, pass.entryPoint, pass.entryNormal);
+    awayFrom(b1, 1, pass.exitPoint, pass.exitNormal);
+  }
   return pass;
 }
 
@@ -100,13 +117,64 @@ Point3 bezierDerivative(const std::array<Point3, 4>& control, double t) {
          3 * t * t * (control[3] - control[2]);
 }
 
-Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, int side, double t) {
-  const auto s = static_cast<size_t>(side);
-  const std::array<Point3, 4> projected{here.middle[s] - here.lift, here.tail[s] - here.lift, next.head[s] - next.lift,
-                                        next.middle[s] - next.lift};
-  // Smoothstep over the middle third: no slope at either end of it.
-  const double x = std::clamp(3 * t - 1, 0.0, 1.0), rise = x * x * (3 - 2 * x);
-  return bezierPoint(projected, t) + (1 - rise) * here.lift + rise * next.lift;
+namespace {
+
+std::array<Point3, 4> projectedControls(const RibbonPass& here, const RibbonPass& next, size_t side) {
+  return {here.middle[side] - here.lift, here.tail[side] - here.lift, next.head[side] - next.lift,
+          next.middle[side] - next.lift};
+}
+
+// Whether both rails at t, as projected, lie on the outer side of a half-plane.
+bool bothOutside(const std::array<std::array<Point3, 4>, 2>& rails, const Point3& point, const Point3& normal,
+                 double t) {
+  return (bezierPoint(rails[0], t) - point).dot(normal) >= 0 && (bezierPoint(rails[1], t) - point).dot(normal) >= 0;
+}
+
+// The t from which `outside` holds all the way to `to`, on a grid from
+// `from` to `to`, refined by bisection; `from` when it holds everywhere.
+template <typename Outside>
+double firstOutside(double from, double to, const Outside& outside) {
+  constexpr int kScan = 16, kBisections = 10;
+  int last = kScan;
+  while (last >= 0 && outside(from + (to - from) * last / kScan)) --last;
+  if (last < 0) return from;
+  if (last == kScan) return to;
+  double inside = from + (to - from) * last / kScan, out = from + (to - from) * (last + 1) / kScan;
+  for (int k = 0; k < kBisections; ++k) {
+    const double t = (inside + out) / 2;
+    (outside(t) ? out : inside) = t;
+  }
+  return out;
+}
+
+}  // namespace
+
+SegmentTurn segmentTurn(const RibbonPass& here, const RibbonPass& next) {
+  const std::array<std::array<Point3, 4>, 2> rails{projectedControls(here, next, 0), projectedControls(here, next, 1)};
+  SegmentTurn turn;
+  if (here.crossing != Crossing::None) {
+    turn.leave = firstOutside(0, 1, [&](double t) { return bothOutside(rails, here.exitPoint, here.exitNormal, t); });
+  }
+  if (next.crossing != Crossing::None) {
+    turn.arrive =
+        firstOutside(1, 0, [&](double t) { return bothOutside(rails, next.entryPoint, next.entryNormal, t); });
+  }
+  if (turn.arrive - turn.leave < kLeastTurn) {
+    const double middle = std::clamp((turn.leave + turn.arrive) / 2, kLeastTurn / 2, 1 - kLeastTurn / 2);
+    turn = {middle - kLeastTurn / 2, middle + kLeastTurn / 2};
+  }
+  return turn;
+}
+
+Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, const SegmentTurn& turn, int side, double t) {
+  const Point3 base = bezierPoint(projectedControls(here, next, static_cast<size_t>(side)), t);
+  // Each end's plane and height, blended by a smoothstep over the turn (no
+  // slope at either end of it).
+  const double x = std::clamp((t - turn.leave) / (turn.arrive - turn.leave), 0.0, 1.0), rise = x * x * (3 - 2 * x);
+  const auto onPlane = [&base](const RibbonPass& pass) {
+    return pass.lift - (base - pass.planePoint).dot(pass.planeNormal) * pass.planeNormal;
+  };
+  return base + (1 - rise) * onPlane(here) + rise * onPlane(next);
 }
 
 std::array<Point3, 4> segmentControls(const Ribbon& ribbon, int pass, int side) {
@@ -126,16 +194,21 @@ void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& region
   const RibbonPass b = railPass(rs, regions, thread.steps[next], shape, ribbon.swapped[next] != 0);
   railP.clear();
   railQ.clear();
+  const SegmentTurn turn = segmentTurn(a, b);
   for (int i = 0; i <= shape.samples; ++i) {
     const double t = static_cast<double>(i) / shape.samples;
-    railP.push_back(segmentPoint(a, b, 0, t));
-    railQ.push_back(segmentPoint(a, b, 1, t));
+    railP.push_back(segmentPoint(a, b, turn, 0, t));
+    railQ.push_back(segmentPoint(a, b, turn, 1, t));
   }
 }
 
 std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
-                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape) {
+                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape,
+                                 const std::vector<double>& edgeWidths) {
   requireShape(shape);
+  if (!edgeWidths.empty() && edgeWidths.size() != regions.size()) {
+    throw std::logic_error("internal: a width per edge expected");
+  }
   std::vector<Ribbon> ribbons;
   ribbons.reserve(weave.threads.size());
   for (const Thread& thread : weave.threads) {
@@ -150,7 +223,7 @@ std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& w
     // crossing.
     bool swapped = false;
     for (const ThreadStep& step : thread.steps) {
-      ribbon.passes.push_back(railPass(rs, regions, step, shape, swapped));
+      ribbon.passes.push_back(railPass(rs, regions, step, shape, swapped, edgeWidths));
       ribbon.swapped.push_back(swapped ? 1 : 0);
       if (step.crossing != Crossing::None) swapped = !swapped;
     }
@@ -164,10 +237,11 @@ std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& w
     for (int k = 0; k < passes; ++k) {
       const RibbonPass& here = ribbon.passes[static_cast<size_t>(k)];
       const RibbonPass& next = ribbon.passes[static_cast<size_t>((k + 1) % passes)];
+      const SegmentTurn turn = segmentTurn(here, next);
       for (int i = 0; i < n; ++i) {
         const double t = static_cast<double>(i) / n;
-        ribbon.railP.push_back(segmentPoint(here, next, 0, t));
-        ribbon.railQ.push_back(segmentPoint(here, next, 1, t));
+        ribbon.railP.push_back(segmentPoint(here, next, turn, 0, t));
+        ribbon.railQ.push_back(segmentPoint(here, next, turn, 1, t));
       }
     }
     ribbons.push_back(std::move(ribbon));

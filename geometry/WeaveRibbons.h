@@ -45,6 +45,14 @@ struct RibbonPass {
   FaceCorner from, to;  // where the thread enters and leaves the region
   std::array<Point3, 2> head, middle, tail;
   Point3 lift = Point3::Zero();  // +h N_e over, -h N_e under, 0 beside an untwisted edge: in the points above
+  // The crossing's plane (IV.1.2: through P_m, normal N_e; a zero normal
+  // beside an untwisted edge), and the two rails of the other thread's
+  // strand across it as half-planes, each a point and a unit normal
+  // pointing away from that strand: the thread is over (or under) the other
+  // strand until it is outside both.
+  Point3 planePoint = Point3::Zero(), planeNormal = Point3::Zero();
+  Point3 entryPoint = Point3::Zero(), entryNormal = Point3::Zero();
+  Point3 exitPoint = Point3::Zero(), exitNormal = Point3::Zero();
 };
 
 struct Ribbon {
@@ -65,9 +73,12 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
                       const RibbonShape& shape);
 
 // One ribbon per thread. Throws std::invalid_argument for a shape out of
-// range (w, c in (0, 1], h > 0, at least one sample).
+// range (w, c in (0, 1], h > 0, at least one sample). `edgeWidths`, when
+// given, is w per edge in place of the shape's (narrowUntilClear()); both
+// strands of a crossing take its edge's.
 std::vector<Ribbon> weaveRibbons(const RotationSystem& rs, const WeaveThreads& weave,
-                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape);
+                                 const std::vector<EdgeRegion>& regions, const RibbonShape& shape,
+                                 const std::vector<double>& edgeWidths = {});
 
 // Segment k of `thread`'s ribbon (from pass k's middle row to pass k + 1's,
 // both included: samples + 1 rows) made again with `shape`, its rails as
@@ -76,15 +87,29 @@ void segmentRows(const RotationSystem& rs, const std::vector<EdgeRegion>& region
                  const Ribbon& ribbon, int k, const RibbonShape& shape, std::vector<Point3>& railP,
                  std::vector<Point3>& railQ);
 
+// Where along the segment from pass `here`'s middle to pass `next`'s
+// (parameter t of eq. 4.17) the ribbon has left the strand it crosses at
+// `here` and where it reaches the one it crosses at `next`: both rails of
+// the ribbon, as projected, outside that strand's rails. 0 and 1 beside an
+// untwisted edge. When the two leave less than kLeastTurn between them (a
+// ribbon wide for its curve), both move apart about their middle.
+struct SegmentTurn {
+  double leave = 0, arrive = 1;
+};
+inline constexpr double kLeastTurn = 0.1;
+SegmentTurn segmentTurn(const RibbonPass& here, const RibbonPass& next);
+
 // Point t of the segment from pass `here`'s middle to pass `next`'s on rail
-// `side`: eq. 4.17's cubic through the passes' quads as projected, lifted by
-// a height that stays at `here`'s for the first third of the segment and at
-// `next`'s for the last, changing smoothly in the middle third, where the
-// ribbon passes the face corner that only its thread passes. (The cubic of
-// the lifted points would start sinking at once, and near the crossing
-// the ribbon over would meet the one under it where both bend away.) Its
-// derivative is the cubic's at both ends: C1 at every middle.
-Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, int side, double t);
+// `side`: eq. 4.17's cubic through the passes' quads as projected, then,
+// while the ribbon lies over or under the other strand of its crossing
+// (t up to turn.leave, from turn.arrive), moved along N_e into that
+// crossing's plane and lifted by its ±h; between, the two smoothly blended.
+// The strands of a crossing are straight across (rows), so a ribbon that
+// followed the cubic's sag over its partner would pass through the
+// partner's rows: flat there, the two stay 2h apart wherever one lies over
+// the other. Its derivative is the cubic's at both ends (the quad's middle
+// and tail lie in the crossing's plane): C1 at every middle.
+Point3 segmentPoint(const RibbonPass& here, const RibbonPass& next, const SegmentTurn& turn, int side, double t);
 
 // Point t in [0, 1] of eq. 4.17's cubic, and its derivative.
 Point3 bezierPoint(const std::array<Point3, 4>& control, double t);

@@ -388,11 +388,26 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   const std::vector<EdgeRegion> regions = edgeRegions(mesh, rs);
   context.check();
   context.report({"geometry", "ribbons", 0, 0});
-  const std::vector<Ribbon> ribbons = weaveRibbons(rs, weave, regions, options.shape);
-  // Ribbons that pass through each other (ch. VII's open problem): warned
-  // of, with the width that clears them.
-  context.report({"geometry", "ribbons that meet", 0, 0});
-  const RibbonCollisions collisions = ribbonCollisions(rs, weave, regions, ribbons, options.shape, context);
+  // Ribbons that pass through each other (ch. VII's open problem):
+  // narrowed where they would, or, at a width asked for, warned of with the
+  // width that clears them.
+  std::vector<Ribbon> ribbons;
+  std::vector<double> edgeWidths;
+  RibbonCollisions collisions;
+  int narrowed = 0;
+  if (options.narrowWhereRibbonsMeet) {
+    context.report({"geometry", "ribbons that meet", 0, 0});
+    ClearedRibbons cleared = narrowUntilClear(rs, weave, regions, options.shape, context);
+    ribbons = std::move(cleared.ribbons);
+    edgeWidths = std::move(cleared.edgeWidths);
+    collisions = std::move(cleared.left);
+    narrowed = cleared.narrowed;
+  } else {
+    ribbons = weaveRibbons(rs, weave, regions, options.shape);
+    edgeWidths.assign(regions.size(), options.shape.width);
+    context.report({"geometry", "ribbons that meet", 0, 0});
+    collisions = ribbonCollisions(rs, weave, regions, ribbons, options.shape, context);
+  }
   const int overlap = std::max(1, options.shape.samples / 2);
   std::vector<WovenPanel> woven = wovenPanels(ribbons, regions, overlap);
   context.check();
@@ -448,7 +463,9 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   std::vector<char> glued(crossingCount, 0);
   context.parallelFor(crossingCount, [&](size_t e) {
     if (crossings[e].panel[0] < 0) return;  // untwisted: no crossing
-    holes[e] = placeCrossingHoles(regions[e], crossings[e], woven, outlines, options.shape, d);
+    RibbonShape shape = options.shape;
+    shape.width = edgeWidths[e];
+    holes[e] = placeCrossingHoles(regions[e], crossings[e], woven, outlines, shape, d);
   });
   {
     int withoutRoom = 0, narrow = 0, single = 0;
@@ -688,13 +705,21 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
           cut, plural(cut), cut == 1 ? "itself" : "themselves", pieces, plural(pieces)));
     }
   }
+  if (narrowed > 0) {
+    const double narrowest = *std::min_element(edgeWidths.begin(), edgeWidths.end());
+    result.notes.push_back(fmt::format(
+        "ribbons narrowed at {} of {} edges (to {:.2f} at the narrowest) where at {} {:g} they would pass through "
+        "each other",
+        narrowed, edgeWidths.size(), narrowest, options.names(Parameter::Width), options.shape.width));
+  }
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   if (!collisions.pairs.empty()) {
     std::string some;
     for (size_t i = 0; i < collisions.pairs.size() && i < 3; ++i) {
-      some +=
-          fmt::format("{}edges {} and {}", i ? ", " : "", edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeA)],
-                      edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeB)]);
+      const int a = edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeA)];
+      const int b = edgeNumber[static_cast<size_t>(collisions.pairs[i].edgeB)];
+      some += fmt::format("{}{}", i ? ", " : "",
+                          a == b ? fmt::format("both at edge {}", a) : fmt::format("edges {} and {}", a, b));
     }
     const size_t n = collisions.pairs.size();
     // Floored to what the option is written with (to the thousandth below 0.01, never up).

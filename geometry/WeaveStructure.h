@@ -22,6 +22,10 @@ namespace rotafab::geometry {
 struct WeaveOptions {
   WeaveCycles cycles = WeaveCycles::All;
   RibbonShape shape;
+  // Narrow the ribbons edge by edge where at the shape's width they would
+  // pass through each other (narrowUntilClear()); else keep the width and
+  // warn of them.
+  bool narrowWhereRibbonsMeet = true;
   double fastener = 0.125;  // hole diameter, inches
   int up = 1;               // the vertical axis for "lowest": 0 x, 1 y, 2 z
   ParameterNames names = parameterInWords;

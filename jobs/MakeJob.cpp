@@ -224,7 +224,10 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
   const std::string name = request.mesh.string();
   geometry::WeaveOptions weave;
   weave.cycles = request.cycles;
-  weave.shape.width = request.width;
+  // A width asked for is kept (and ribbons that meet at it are warned of);
+  // the default is the widest, narrowed where ribbons would meet.
+  weave.shape.width = request.width.value_or(weave.shape.width);
+  weave.narrowWhereRibbonsMeet = !request.width;
   weave.shape.curve = request.curve;
   weave.shape.offset = request.offset.value_or(std::max(request.material.thickness / 2, kLeastOffset));
   weave.shape.samples = request.samples;
@@ -444,6 +447,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.structure = request.structure == geometry::StructureKind::Weave
                       ? builtWeave(request, mesh, sizing, context)
                       : builtStructure(request, mesh, job.mesh.start, sizing, context);
+  for (const auto& note : job.structure.notes) context.note(fmt::format("{}: {}", name, note));
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.size = builtSize(job.structure);

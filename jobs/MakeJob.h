@@ -55,7 +55,8 @@ struct MakeRequest {
   int up = 1;
   bool scoreFolds = false;
   // The plain weave's (geometry/WeaveStructure.h); `samples` too, per Bézier segment.
-  double width = 0.8, curve = 0.6;
+  std::optional<double> width;  // default: geometry::RibbonShape's, narrowed where ribbons would meet
+  double curve = 0.6;
   std::optional<double> offset;  // inches; default: half the material's thickness, at least kLeastOffset
   geometry::WeaveCycles cycles = geometry::WeaveCycles::All;
   // The planner's (jobs/SheetPlanner.h).
