@@ -1,8 +1,10 @@
 #include "core/Polygon2.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <utility>
+#include <vector>
 
 namespace rotafab::core {
 
@@ -16,18 +18,30 @@ double signedArea(const Polygon2& polygon) {
   return twice / 2;
 }
 
-double distanceToSegment(const Point2& p, const Point2& a, const Point2& b) {
+namespace {
+
+double squaredDistanceToSegment(const Point2& p, const Point2& a, const Point2& b) {
   const Point2 ab = b - a;
-  const double t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
+  const double length = ab.squaredNorm();
+  const double t = length > 0 ? std::clamp((p - a).dot(ab) / length, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).squaredNorm();
+}
+
+}  // namespace
+
+double distanceToSegment(const Point2& p, const Point2& a, const Point2& b) {
+  return std::sqrt(squaredDistanceToSegment(p, a, b));
 }
 
 double distanceToOutline(const Polygon2& polygon, const Point2& p) {
+  // One square root for the nearest side, not one per side.
+  const size_t n = polygon.size();
+  if (n == 0) return std::numeric_limits<double>::max();
   double nearest = std::numeric_limits<double>::max();
-  for (size_t i = 0; i < polygon.size(); ++i) {
-    nearest = std::min(nearest, distanceToSegment(p, polygon[i], polygon[(i + 1) % polygon.size()]));
+  for (size_t i = 0; i < n; ++i) {
+    nearest = std::min(nearest, squaredDistanceToSegment(p, polygon[i], polygon[i + 1 < n ? i + 1 : 0]));
   }
-  return nearest;
+  return std::sqrt(nearest);
 }
 
 bool insidePolygon(const Polygon2& polygon, const Point2& p) {
@@ -51,10 +65,19 @@ bool properlyCross(const Point2& a, const Point2& b, const Point2& c, const Poin
 }
 
 bool crossesItself(const Polygon2& o) {
-  for (size_t a = 0; a < o.size(); ++a) {
-    for (size_t b = a + 2; b < o.size(); ++b) {
-      if (a == 0 && b + 1 == o.size()) continue;
-      if (properlyCross(o[a], o[a + 1], o[b], o[(b + 1) % o.size()])) return true;
+  // Each side's extent along x first: most pairs of sides lie apart there,
+  // and comparing two numbers is cheaper than four cross products.
+  const size_t n = o.size();
+  std::vector<std::pair<double, double>> spans(n);
+  for (size_t i = 0; i < n; ++i) {
+    const double x0 = o[i].x(), x1 = o[(i + 1) % n].x();
+    spans[i] = {std::min(x0, x1), std::max(x0, x1)};
+  }
+  for (size_t a = 0; a < n; ++a) {
+    for (size_t b = a + 2; b < n; ++b) {
+      if (a == 0 && b + 1 == n) continue;
+      if (spans[a].second < spans[b].first || spans[b].second < spans[a].first) continue;
+      if (properlyCross(o[a], o[(a + 1) % n], o[b], o[(b + 1) % n])) return true;
     }
   }
   return false;

@@ -23,18 +23,6 @@ double TextBox::distanceTo(const Point2& p) const {
 
 namespace {
 
-// Points along the box's sides, every `step` or closer.
-std::vector<Point2> perimeter(const TextBox& box, double step) {
-  const auto corners = box.corners();
-  std::vector<Point2> points;
-  for (size_t i = 0; i < 4; ++i) {
-    const Point2 a = corners[i], b = corners[(i + 1) % 4];
-    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
-    for (int j = 0; j < n; ++j) points.push_back(a + (b - a) * (static_cast<double>(j) / n));
-  }
-  return points;
-}
-
 // Whether two boxes keep `gap` apart: separated along one of their four
 // axes once one is grown by the gap (a little stricter than the true
 // distance near the corners, which only costs a smaller label there).
@@ -86,18 +74,49 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
   // Each candidate's room, whatever the height: a box centred there needs
   // half its height and the gap (at least a quarter of the height) between
   // its centre and the outline, so no box is taller than the most room / 0.75.
-  std::vector<double> room;
+  // Found as needed: once one candidate has room for the largest label, the
+  // others' is wanted only if it does not fit there.
+  std::vector<double> room(candidates.size(), std::numeric_limits<double>::quiet_NaN());
+  const auto roomAt = [&](size_t c) {
+    if (std::isnan(room[c])) room[c] = insidePolygon(region, candidates[c]) ? distanceToSides(candidates[c]) : -1.0;
+    return room[c];
+  };
   double most = 0;
-  for (const Point2& centre : candidates) {
-    room.push_back(insidePolygon(region, centre) ? distanceToSides(centre) : -1.0);
-    most = std::max(most, room.back());
-  }
+  for (size_t c = 0; c < candidates.size() && most < 0.75 * kLargestLabel; ++c) most = std::max(most, roomAt(c));
   // Clear of the outline by `gap`: a point near a candidate centre is at
   // least the centre's room less their distance from the sides (the
   // triangle inequality), which spares most points their own distance.
   const auto clear = [&](const Point2& p, double gap, size_t c) {
     return insidePolygon(region, p) &&
-           (room[c] - (p - candidates[c]).norm() >= gap + 1e-9 || distanceToSides(p) >= gap);
+           (roomAt(c) - (p - candidates[c]).norm() >= gap + 1e-9 || distanceToSides(p) >= gap);
+  };
+  // The whole box, its corners inside the region already: inside it (no
+  // side of the region across a side of the box) and `gap` or more from
+  // every side of the outline near it, exactly (a side's nearest point to
+  // a rectangle it does not cross is one of its ends or nearest one of the
+  // rectangle's corners).
+  const auto insideAndClear = [&](const TextBox& box, double gap) {
+    const std::vector<Point2> corners = box.corners();
+    for (size_t i = 0; i < region.size(); ++i) {
+      const Point2& a = region[i];
+      const Point2& b = region[(i + 1) % region.size()];
+      for (size_t k = 0; k < 4; ++k) {
+        if (core::properlyCross(a, b, corners[k], corners[(k + 1) % 4])) return false;
+      }
+    }
+    for (const auto& [a, b] : sides) {
+      if (box.distanceTo(a) < gap || box.distanceTo(b) < gap) return false;
+      const Point2 ab = b - a;
+      const double length = ab.squaredNorm();
+      for (const Point2& corner : corners) {
+        const double t = length > 0 ? std::clamp((corner - a).dot(ab) / length, 0.0, 1.0) : 0.0;
+        if ((a + t * ab - corner).squaredNorm() < gap * gap) return false;
+      }
+      for (size_t k = 0; k < 4; ++k) {
+        if (core::properlyCross(a, b, corners[k], corners[(k + 1) % 4])) return false;
+      }
+    }
+    return true;
   };
   // The region's extent along the text and across it: a box longer or
   // taller than that cannot fit anywhere. (Not with the gaps: the gap is
@@ -112,22 +131,15 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     const double gap = std::max(kLabelGap, height / 4);
     if (width > alongHigh - alongLow || height > upHigh - upLow) continue;
     for (size_t c = 0; c < candidates.size(); ++c) {
-      if (room[c] < height / 2 + gap) continue;
+      if (roomAt(c) < height / 2 + gap) continue;
       const Point2& centre = candidates[c];
       TextBox box{centre - width / 2 * along - height / 2 * up, angle, width, height, along};
-      // The cheap tests first: holes, the corners, then the other labels and the whole perimeter.
+      // The cheap tests first: holes, the corners, then the other labels and the whole box.
       bool fits = true;
       for (size_t i = 0; fits && i < holes.size(); ++i) fits = box.distanceTo(holes[i].centre) >= holes[i].radius + gap;
       for (const Point2& corner : box.corners()) fits = fits && clear(corner, gap, c);
       for (size_t i = 0; fits && i < taken.size(); ++i) fits = boxesApart(box, taken[i], gap);
-      if (!fits) continue;
-      for (const Point2& p : perimeter(box, gap)) {
-        if (!clear(p, gap, c)) {
-          fits = false;
-          break;
-        }
-      }
-      if (fits) return box;
+      if (fits && insideAndClear(box, gap)) return box;
     }
   }
   return std::nullopt;

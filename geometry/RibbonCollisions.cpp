@@ -130,6 +130,20 @@ struct Quad {
 // first cell their boxes share.
 using Segment = std::pair<int, int>;
 using Meetings = std::map<std::pair<Segment, Segment>, std::pair<int, int>>;
+using Found = std::pair<std::pair<Segment, Segment>, std::pair<int, int>>;
+
+// Meetings found in parts, each pair with its first rows.
+Meetings merged(const std::vector<std::vector<Found>>& parts) {
+  Meetings meeting;
+  for (const std::vector<Found>& found : parts) {
+    for (const auto& [pair, rows] : found) {
+      const auto [at, added] = meeting.emplace(pair, rows);
+      if (!added) at->second = std::min(at->second, rows);
+    }
+  }
+  return meeting;
+}
+
 Meetings meetingSegments(const std::vector<Ribbon>& ribbons, const core::WorkContext& context) {
   std::vector<Quad> quads;
   double extent = 0;
@@ -170,7 +184,6 @@ Meetings meetingSegments(const std::vector<Ribbon>& ribbons, const core::WorkCon
   context.check();
 
   // Found cell by cell, merged after: no lock while testing.
-  using Found = std::pair<std::pair<Segment, Segment>, std::pair<int, int>>;
   std::vector<std::vector<Found>> foundInCell(starts.size() - 1);
   // The quads cell by cell, in one array: read in order while testing.
   std::vector<Quad> inCells;
@@ -213,14 +226,57 @@ Meetings meetingSegments(const std::vector<Ribbon>& ribbons, const core::WorkCon
       }
     }
   });
-  Meetings meeting;
-  for (const std::vector<Found>& found : foundInCell) {
-    for (const auto& [pair, rows] : found) {
-      const auto [at, added] = meeting.emplace(pair, rows);
-      if (!added) at->second = std::min(at->second, rows);
+  return merged(foundInCell);
+}
+
+// The pairs of segments that meet among those that turn about one corner:
+// a vertex, or a face's centre (each segment turns about one of each, its
+// pass's `to`). Where few regions meet at a corner, wide ribbons cut across
+// it (eq. 4.17's cubic) into each other's way: nearly every meeting is
+// there, and these are a few pairs per corner instead of every quad near
+// another. Not a strip against its own.
+Meetings cornerMeetings(const std::vector<Ribbon>& ribbons, const core::WorkContext& context) {
+  int vertices = 0, faces = 0;
+  for (const Ribbon& ribbon : ribbons) {
+    for (const RibbonPass& pass : ribbon.passes) {
+      vertices = std::max(vertices, pass.to.vertex + 1);
+      faces = std::max(faces, pass.to.face + 1);
     }
   }
-  return meeting;
+  std::vector<std::vector<Segment>> about(static_cast<size_t>(vertices + faces));
+  for (size_t r = 0; r < ribbons.size(); ++r) {
+    for (size_t k = 0; k < ribbons[r].passes.size(); ++k) {
+      const FaceCorner& corner = ribbons[r].passes[k].to;
+      const Segment segment{static_cast<int>(r), static_cast<int>(k)};
+      about[static_cast<size_t>(corner.vertex)].push_back(segment);
+      about[static_cast<size_t>(vertices + corner.face)].push_back(segment);
+    }
+  }
+  std::vector<std::vector<Found>> foundAt(about.size());
+  context.parallelFor(about.size(), [&](size_t c) {
+    const std::vector<Segment>& segments = about[c];
+    for (size_t x = 0; x < segments.size(); ++x) {
+      for (size_t y = x + 1; y < segments.size(); ++y) {
+        Segment sa = segments[x], sb = segments[y];
+        if (sa.first == sb.first) continue;
+        if (sb < sa) std::swap(sa, sb);
+        const Ribbon& ra = ribbons[static_cast<size_t>(sa.first)];
+        const Ribbon& rb = ribbons[static_cast<size_t>(sb.first)];
+        bool met = false;
+        for (int i = sa.second * ra.samples; !met && i < (sa.second + 1) * ra.samples; ++i) {
+          const Box box = quadBox(ra.railP, ra.railQ, static_cast<size_t>(i));
+          for (int j = sb.second * rb.samples; !met && j < (sb.second + 1) * rb.samples; ++j) {
+            if (box.apart(quadBox(rb.railP, rb.railQ, static_cast<size_t>(j)))) continue;
+            if (quadsMeet(ra.railP, ra.railQ, static_cast<size_t>(i), rb.railP, rb.railQ, static_cast<size_t>(j))) {
+              foundAt[c].push_back({{sa, sb}, {i, j}});
+              met = true;
+            }
+          }
+        }
+      }
+    }
+  });
+  return merged(foundAt);
 }
 
 }  // namespace
@@ -229,18 +285,19 @@ namespace {
 
 // Per pair of meeting segments, the widest width at which the two alone,
 // made again with it at all their passes, do not meet, by `bisections`
-// bisections below the shape's width.
+// bisections between `least` and the shape's width (`least` when none
+// tried clears them).
 std::vector<double> pairClearWidths(const RotationSystem& rs, const WeaveThreads& weave,
                                     const std::vector<EdgeRegion>& regions, const std::vector<Ribbon>& ribbons,
                                     const RibbonShape& shape, const std::vector<std::pair<Segment, Segment>>& pairs,
-                                    int bisections, const core::WorkContext& context) {
+                                    double least, int bisections, const core::WorkContext& context) {
   std::vector<double> clear(pairs.size(), 0);
   context.parallelFor(pairs.size(), [&](size_t i) {
     const auto& [sa, sb] = pairs[i];
     const Thread& ta = weave.threads[static_cast<size_t>(sa.first)];
     const Thread& tb = weave.threads[static_cast<size_t>(sb.first)];
     RibbonShape trial = shape;
-    double low = 0, high = shape.width;
+    double low = least, high = shape.width;
     std::vector<Point3> pa, qa, pb, qb;
     for (int k = 0; k < bisections; ++k) {
       trial.width = (low + high) / 2;
@@ -288,7 +345,7 @@ RibbonCollisions ribbonCollisions(const RotationSystem& rs, const WeaveThreads& 
   const std::vector<std::pair<Segment, Segment>> pairs = pairsOf(meeting);
   // To a thousandth of the widest, as the warning gives it.
   constexpr int kBisections = 10;
-  const std::vector<double> clear = pairClearWidths(rs, weave, regions, ribbons, shape, pairs, kBisections, context);
+  const std::vector<double> clear = pairClearWidths(rs, weave, regions, ribbons, shape, pairs, 0, kBisections, context);
   for (size_t i = 0; i < pairs.size(); ++i) {
     const std::pair<int, int>& rows = meeting.at(pairs[i]);
     const int a = edgeNearest(ribbons, pairs[i].first, rows.first);
@@ -329,7 +386,10 @@ ClearedRibbons narrowUntilClear(const RotationSystem& rs, const WeaveThreads& we
   const double narrowest = shape.width / 4;
   for (int round = 0;; ++round) {
     result.ribbons = weaveRibbons(rs, weave, regions, shape, result.edgeWidths);
-    const Meetings meeting = meetingSegments(result.ribbons, context);
+    // First about each corner, where nearly all meet; every round after,
+    // and the check that ends them, everywhere.
+    Meetings meeting = round == 0 ? cornerMeetings(result.ribbons, context) : Meetings{};
+    if (meeting.empty()) meeting = meetingSegments(result.ribbons, context);
     context.check();
     if (meeting.empty()) break;
     if (round == kRounds) {
@@ -337,10 +397,11 @@ ClearedRibbons narrowUntilClear(const RotationSystem& rs, const WeaveThreads& we
       break;
     }
     const std::vector<std::pair<Segment, Segment>> pairs = pairsOf(meeting);
-    // To 1/32 of the widest: narrowing, what is left is checked again.
-    constexpr int kBisections = 5;
+    // To 3/64 of the widest, from the narrowest allowed: what is left is
+    // checked again.
+    constexpr int kBisections = 4;
     const std::vector<double> clear =
-        pairClearWidths(rs, weave, regions, result.ribbons, shape, pairs, kBisections, context);
+        pairClearWidths(rs, weave, regions, result.ribbons, shape, pairs, narrowest, kBisections, context);
     std::vector<double> widths = result.edgeWidths;
     for (size_t i = 0; i < pairs.size(); ++i) {
       for (const Segment& segment : {pairs[i].first, pairs[i].second}) {

@@ -38,10 +38,11 @@ RibbonCollisions ribbonCollisions(const RotationSystem& rs, const WeaveThreads& 
                                   const RibbonShape& shape, const core::WorkContext& context);
 
 // The ribbons at `shape`'s width but narrower at the edges where they would
-// meet: per pair of segments that meet, the passes of both take the pair's
-// own clearing width (or a tenth less than they had, when that is not
-// less), and the weave is made again and looked at again, a few rounds at
-// most. A dense weave (fig. 15) where the surface allows it, and no two
+// meet: per pair of segments that meet (the first round looks only at the
+// segments that turn about one corner, where nearly all do), the passes of
+// both take the pair's own clearing width (or a tenth less than they had,
+// when that is not less), and the weave is made again and looked at again,
+// everywhere, a few rounds at most. A dense weave (fig. 15) where the surface allows it, and no two
 // ribbons through each other where it does not.
 struct ClearedRibbons {
   std::vector<Ribbon> ribbons;

@@ -134,7 +134,7 @@ bool bothOutside(const std::array<std::array<Point3, 4>, 2>& rails, const Point3
 // `from` to `to`, refined by bisection; `from` when it holds everywhere.
 template <typename Outside>
 double firstOutside(double from, double to, const Outside& outside) {
-  constexpr int kScan = 16, kBisections = 10;
+  constexpr int kScan = 16, kBisections = 7;
   int last = kScan;
   while (last >= 0 && outside(from + (to - from) * last / kScan)) --last;
   if (last < 0) return from;

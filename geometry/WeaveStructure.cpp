@@ -559,6 +559,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   const HersheyFont& font = HersheyFont::simplex();
   result.panels.resize(woven.size());
   std::vector<std::vector<std::string>> unfittedOf(woven.size());
+  std::vector<char> stillFolded(woven.size(), 0);  // per panel: crosses itself even cut
   const int reach = std::max(1, options.shape.samples / 2);
   context.parallelFor(order.size(), [&](size_t k) {
     const size_t i = static_cast<size_t>(order[k]);
@@ -660,6 +661,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     }
     if (core::crossesItself(panel.outline)) {
       cutApart(w, panel, holeRowsOf[i], labelRows, d);
+      stillFolded[k] = core::crossesItself(panel.outline) ? 1 : 0;
     }
     result.panels[k] = std::move(panel);
   });
@@ -675,8 +677,8 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   }
   {
     std::vector<int> overlapping;
-    for (const Panel& panel : result.panels) {
-      if (core::crossesItself(panel.outline)) overlapping.push_back(panel.id);
+    for (size_t k = 0; k < result.panels.size(); ++k) {
+      if (stillFolded[k]) overlapping.push_back(result.panels[k].id);
     }
     if (!overlapping.empty()) {
       std::string some;
