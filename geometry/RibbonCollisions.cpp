@@ -21,8 +21,9 @@ bool segmentThrough(const Point3& a, const Point3& b, const Triangle& t) {
   const Point3 p = d.cross(e2);
   const double det = e1.dot(p);
   // A segment in the triangle's plane (or nearly: flat parts of one strip
-  // are coplanar) does not pass through it.
-  if (std::abs(det) <= 1e-12 * d.norm() * e1.norm() * e2.norm()) return false;
+  // are coplanar, and rounding grows with the coordinates) does not pass
+  // through it.
+  if (std::abs(det) <= 1e-9 * d.norm() * e1.norm() * e2.norm()) return false;
   const Point3 s = a - t[0];
   const double u = s.dot(p) / det;
   if (u < kInside || u > 1 - kInside) return false;
@@ -105,13 +106,25 @@ bool quadsMeet(const std::vector<Point3>& pa, const std::vector<Point3>& qa, siz
   return false;
 }
 
-bool stripsMeet(const std::vector<Point3>& pa, const std::vector<Point3>& qa, const std::vector<Point3>& pb,
-                const std::vector<Point3>& qb) {
+// A strip's own quads within this many rows of each other touch or nearly
+// (a sharp fold there is the unfolding's to find): not tested.
+constexpr int kOwnRowsApart = 3;
+bool ownNeighbours(int rowA, int rowB, int rows) {
+  const int apart = std::abs(rowA - rowB) % rows;
+  return std::min(apart, rows - apart) <= kOwnRowsApart;
+}
+
+// Whether two pieces of strip meet: rows `pa`, `qa` from strip row `firstA`
+// on, `pb`, `qb` from `firstB`; `rows` the strip's rows when both are of one
+// strip, else 0.
+bool stripsMeet(const std::vector<Point3>& pa, const std::vector<Point3>& qa, int firstA, const std::vector<Point3>& pb,
+                const std::vector<Point3>& qb, int firstB, int rows) {
   std::vector<Box> boxes;
   for (size_t j = 0; j + 1 < pb.size(); ++j) boxes.push_back(quadBox(pb, qb, j));
   for (size_t i = 0; i + 1 < pa.size(); ++i) {
     const Box box = quadBox(pa, qa, i);
     for (size_t j = 0; j + 1 < pb.size(); ++j) {
+      if (rows > 0 && ownNeighbours(firstA + static_cast<int>(i), firstB + static_cast<int>(j), rows)) continue;
       if (!box.apart(boxes[j]) && quadsMeet(pa, qa, i, pb, qb, j)) return true;
     }
   }
@@ -156,8 +169,8 @@ Meetings meetingSegments(const std::vector<Ribbon>& ribbons, const core::WorkCon
     }
   }
   if (quads.empty()) return {};
-  // Cells about twice as large as a quad: each quad in two or three of
-  // them (smaller cells, more entries, were slower on 50 000 faces).
+  // Cells about twice as large as a quad: each quad in a few of them
+  // (smaller cells, more entries, were slower on 50 000 faces).
   const double cell = std::max(2 * extent / static_cast<double>(quads.size()), 1e-9);
   const auto cellOf = [cell](double x) { return static_cast<std::int64_t>(std::floor(x / cell)); };
   const auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
@@ -200,15 +213,9 @@ Meetings meetingSegments(const std::vector<Ribbon>& ribbons, const core::WorkCon
       for (size_t j = i + 1; j < starts[c + 1] && inCells[j].box.low.x() <= a.box.high.x(); ++j) {
         const Quad& b = inCells[j];
         if (a.box.apart(b.box)) continue;
-        // A strip's quads within three rows touch or nearly (a sharp fold
-        // there is the unfolding's to find).
         const Ribbon& ra = ribbons[static_cast<size_t>(a.ribbon)];
         const Ribbon& rb = ribbons[static_cast<size_t>(b.ribbon)];
-        if (a.ribbon == b.ribbon) {
-          const int rows = static_cast<int>(ra.railP.size());
-          const int apart = std::abs(a.index - b.index);
-          if (std::min(apart, rows - apart) <= 3) continue;
-        }
+        if (a.ribbon == b.ribbon && ownNeighbours(a.index, b.index, static_cast<int>(ra.railP.size()))) continue;
         // Tested once, in the first cell the two boxes share.
         const Point3 shared = a.box.low.cwiseMax(b.box.low);
         if (key(cellOf(shared.x()), cellOf(shared.y()), cellOf(shared.z())) != entries[i].first) continue;
@@ -303,7 +310,9 @@ std::vector<double> pairClearWidths(const RotationSystem& rs, const WeaveThreads
       trial.width = (low + high) / 2;
       segmentRows(rs, regions, ta, ribbons[static_cast<size_t>(sa.first)], sa.second, trial, pa, qa);
       segmentRows(rs, regions, tb, ribbons[static_cast<size_t>(sb.first)], sb.second, trial, pb, qb);
-      (stripsMeet(pa, qa, pb, qb) ? high : low) = trial.width;
+      const Ribbon& ra = ribbons[static_cast<size_t>(sa.first)];
+      const int rows = sa.first == sb.first ? static_cast<int>(ra.railP.size()) : 0;
+      (stripsMeet(pa, qa, sa.second * ra.samples, pb, qb, sb.second * ra.samples, rows) ? high : low) = trial.width;
     }
     clear[i] = low;
   });

@@ -1,10 +1,11 @@
 #pragma once
 // Ribbons that pass through each other (the dissertation's open problem,
 // ch. VII: "the ribbons can intersect each other" where the surface turns
-// sharply or the ribbons are wide). Every triangle of every ribbon's strip
-// is put in a uniform grid by its box, and the triangles that share a cell
-// are tested against each other (an edge of one through the other), but
-// for a strip's own triangles within three rows, which touch or nearly. Then, per pair
+// sharply or the ribbons are wide). Every quad (two triangles) of every
+// ribbon's strip is put in a uniform grid by its box, and the quads that
+// share a cell are tested against each other (an edge of a triangle of one
+// through a triangle of the other), but for a strip's own quads within
+// three rows, which touch or nearly. Then, per pair
 // of ribbon segments that meet, the widest --width (by bisection, the two
 // segments made again at each try) at which they no longer do, and a width
 // at which no two ribbons meet, checked on the whole weave.

@@ -94,14 +94,18 @@ RibbonPass ribbonPass(const RotationSystem& rs, const EdgeRegion& region, const 
     // region's map transposed): its rails, as lines in the plane.
     pass.planePoint = region.midpoint;
     pass.planeNormal = region.normal;
-    const auto awayFrom = [&](double a, double outside, Point3& point, Point3& normal) {
+    // Each normal points away from the other strand's middle, which lies
+    // strictly between its rails at any width (at width 1 the rails are
+    // the region's sides).
+    const Point3 inside = plain(0.5, 0.5);
+    const auto awayFrom = [&](double a, Point3& point, Point3& normal) {
       point = plain(a, 0);
       normal = region.normal.cross(plain(a, 1) - point);
-      if ((plain(outside, 0.5) - point).dot(normal) < 0) normal = -normal;
+      if ((inside - point).dot(normal) > 0) normal = -normal;
       normal.normalize();
     };
-    awayFrom(b0, 0, pass.entryPoint, pass.entryNormal);
-    awayFrom(b1, 1, pass.exitPoint, pass.exitNormal);
+    awayFrom(b0, pass.entryPoint, pass.entryNormal);
+    awayFrom(b1, pass.exitPoint, pass.exitNormal);
   }
   return pass;
 }

@@ -48,8 +48,8 @@ struct RibbonPass {
   // The crossing's plane (IV.1.2: through P_m, normal N_e; a zero normal
   // beside an untwisted edge), and the two rails of the other thread's
   // strand across it as half-planes, each a point and a unit normal
-  // pointing away from that strand: the thread is over (or under) the other
-  // strand until it is outside both.
+  // pointing away from that strand: the thread reaches the other strand at
+  // the entry rail and leaves it past the exit rail.
   Point3 planePoint = Point3::Zero(), planeNormal = Point3::Zero();
   Point3 entryPoint = Point3::Zero(), entryNormal = Point3::Zero();
   Point3 exitPoint = Point3::Zero(), exitNormal = Point3::Zero();

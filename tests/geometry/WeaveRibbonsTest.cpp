@@ -179,59 +179,85 @@ bool beyondRail(const RibbonPass& other, int side, const Point3& point, const Po
   return here * there <= 0;
 }
 
+// Over (or under) the other strand of its crossings, at both ends of every
+// segment: each sampled rail point at exactly +h or -h over the crossing's
+// plane; where the segment turns, outside the other strand (beyond one of
+// its rails, as seen along N_e from its quad's centre), unless the segment
+// is too short to turn between its crossings' strands (kLeastTurn): those
+// are counted in `forced`.
+void expectFlatOverTheOtherStrand(const WovenMesh& w, const RibbonShape& shape, int& forced, int& segments) {
+  const std::vector<Ribbon> ribbons = weaveRibbons(w.rs, w.threads, w.regions, shape);
+  std::vector<std::vector<const RibbonPass*>> atEdge(w.regions.size());
+  for (const Ribbon& ribbon : ribbons) {
+    for (const RibbonPass& pass : ribbon.passes) atEdge[static_cast<size_t>(pass.edge)].push_back(&pass);
+  }
+  const auto otherAt = [&](const RibbonPass& pass) -> const RibbonPass& {
+    const auto& both = atEdge[static_cast<size_t>(pass.edge)];
+    return *(both[0] == &pass ? both[1] : both[0]);
+  };
+  const auto heightOver = [&](const RibbonPass& pass, const Point3& point) {
+    return (point - w.regions[static_cast<size_t>(pass.edge)].midpoint).dot(pass.lift.normalized());
+  };
+  for (const Ribbon& ribbon : ribbons) {
+    const size_t n = ribbon.passes.size();
+    for (size_t k = 0; k < n; ++k) {
+      const RibbonPass &here = ribbon.passes[k], &next = ribbon.passes[(k + 1) % n];
+      ASSERT_EQ(atEdge[static_cast<size_t>(here.edge)].size(), 2U);
+      const SegmentTurn turn = segmentTurn(here, next);
+      ++segments;
+      const bool tooShort = turn.arrive - turn.leave <= kLeastTurn + 1e-9;
+      forced += tooShort ? 1 : 0;
+      for (int side = 0; side < 2; ++side) {
+        for (int i = 0; i <= 8; ++i) {
+          const double leaving = turn.leave * i / 8, arriving = 1 - (1 - turn.arrive) * i / 8;
+          EXPECT_NEAR(heightOver(here, segmentPoint(here, next, turn, side, leaving)), shape.offset, 1e-9)
+              << "pass " << k << " t " << leaving;
+          EXPECT_NEAR(heightOver(next, segmentPoint(here, next, turn, side, arriving)), shape.offset, 1e-9)
+              << "pass " << k << " t " << arriving;
+        }
+        if (tooShort) continue;
+        for (const auto& [pass, t] : {std::pair{&here, turn.leave + 1e-9}, std::pair{&next, turn.arrive - 1e-9}}) {
+          const RibbonPass& other = otherAt(*pass);
+          const Point3 point = segmentPoint(here, next, turn, side, t),
+                       centre = (other.middle[0] + other.middle[1]) / 2;
+          EXPECT_TRUE(beyondRail(other, 0, point, centre) || beyondRail(other, 1, point, centre))
+              << "pass " << k << " side " << side << " t " << t;
+        }
+      }
+    }
+  }
+}
+
 TEST(WeaveRibbons, OverTheOtherStrandARibbonLiesFlatAtItsCrossingsHeightAndTurnsOnlyPastIt) {
   // The strands of a crossing are straight across (the strip's rows), so
   // wherever one lies over the other both stand in the crossing's plane,
   // +h and -h, 2h apart: a ribbon that followed the surface's curve there
   // would sink through the other's rows. Each ribbon turns towards its
-  // next crossing only once both its rails have passed both rails of the
-  // strand it crossed.
-  const RibbonShape shape{.width = 0.8, .curve = 0.6, .offset = 0.05, .samples = 6};
+  // next crossing only once it is outside the strand it crossed, and is
+  // flat again before it reaches the next.
   for (auto& [name, mesh] : ribbonMeshes()) {
     SCOPED_TRACE(name);
     const WovenMesh w = woven(mesh);
-    const std::vector<Ribbon> ribbons = weaveRibbons(w.rs, w.threads, w.regions, shape);
-    // The pass of the other thread at each edge.
-    std::vector<std::vector<const RibbonPass*>> atEdge(w.regions.size());
-    for (const Ribbon& ribbon : ribbons) {
-      for (const RibbonPass& pass : ribbon.passes) atEdge[static_cast<size_t>(pass.edge)].push_back(&pass);
-    }
-    int flat = 0, forced = 0, passes = 0;
-    for (const Ribbon& ribbon : ribbons) {
-      passes += static_cast<int>(ribbon.passes.size());
-      const size_t n = ribbon.passes.size();
-      for (size_t k = 0; k < n; ++k) {
-        const RibbonPass &here = ribbon.passes[k], &next = ribbon.passes[(k + 1) % n];
-        const auto& both = atEdge[static_cast<size_t>(here.edge)];
-        ASSERT_EQ(both.size(), 2U);
-        const RibbonPass& other = *(both[0] == &here ? both[1] : both[0]);
-        const Point3 normal = here.lift.normalized();
-        const EdgeRegion& region = w.regions[static_cast<size_t>(here.edge)];
-        const SegmentTurn turn = segmentTurn(here, next);
-        ASSERT_LT(turn.leave, turn.arrive);
-        for (int side = 0; side < 2; ++side) {
-          for (int i = 0; i <= 8; ++i) {
-            const double t = turn.leave * i / 8;
-            const Point3 point = segmentPoint(here, next, turn, side, t);
-            EXPECT_NEAR((point - region.midpoint).dot(normal), shape.offset, 1e-9) << "pass " << k << " t " << t;
-            ++flat;
-          }
-          // Where it turns, past both of the other strand's rails (as seen
-          // along N_e from its quad's centre), unless the segment is too
-          // short to turn between its crossings' strands (kLeastTurn).
-          if (turn.arrive - turn.leave <= kLeastTurn + 1e-9) {
-            ++forced;
-            continue;
-          }
-          const Point3 leaving = segmentPoint(here, next, turn, side, turn.leave + 1e-9);
-          const Point3 centre = (other.middle[0] + other.middle[1]) / 2;
-          EXPECT_TRUE(beyondRail(other, 0, leaving, centre) || beyondRail(other, 1, leaving, centre))
-              << "pass " << k << " side " << side;
-        }
+    int forced = 0, segments = 0;
+    expectFlatOverTheOtherStrand(w, {.width = 0.8, .curve = 0.6, .offset = 0.05, .samples = 6}, forced, segments);
+    EXPECT_GT(segments, 0);
+    EXPECT_LE(forced * 1000, segments);  // the bunny: 4 of 11 022
+    // The widest ribbons: the other strand fills the region, so a ribbon
+    // turns only between regions, about the segment's middle (forced),
+    // but is flat over the other strand as far as it goes.
+    const RibbonShape widest{.width = 1, .curve = 0.6, .offset = 0.05, .samples = 6};
+    int forcedWidest = 0;
+    segments = 0;
+    expectFlatOverTheOtherStrand(w, widest, forcedWidest, segments);
+    // Flat at least over most of its own quad (to its tail, about a third
+    // of the way), which lies over the other strand at this width.
+    for (const Ribbon& ribbon : weaveRibbons(w.rs, w.threads, w.regions, widest)) {
+      for (size_t k = 0; k < ribbon.passes.size(); ++k) {
+        const SegmentTurn turn = segmentTurn(ribbon.passes[k], ribbon.passes[(k + 1) % ribbon.passes.size()]);
+        EXPECT_GE(turn.leave, 0.2) << "pass " << k;
+        EXPECT_LE(turn.arrive, 0.8) << "pass " << k;
       }
     }
-    EXPECT_GT(flat, 0);
-    EXPECT_LE(forced * 1000, passes);  // the bunny: 4 rails of 11 022 passes
   }
 }
 
