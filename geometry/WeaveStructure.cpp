@@ -707,6 +707,20 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
           cut, plural(cut), cut == 1 ? "itself" : "themselves", pieces, plural(pieces)));
     }
   }
+  {
+    // An offset on the scale of the edges stands the ribbons over and
+    // under a crossing far apart: no longer a weave that holds together.
+    double meanEdge = 0;
+    for (const EdgeRegion& region : regions) meanEdge += (region.end - region.start).norm();
+    meanEdge /= static_cast<double>(std::max<size_t>(1, regions.size()));
+    if (options.shape.offset > kMostOffsetPerEdge * meanEdge) {
+      result.warnings.push_back(fmt::format(
+          "{} {:g} in stands the ribbons over and under each crossing {:g} in apart, more than {:.0f}% of the mean "
+          "edge ({:.3g} in): the panels will not lie on each other; half the material's thickness is the default",
+          options.names(Parameter::Offset), options.shape.offset, 2 * options.shape.offset, 200 * kMostOffsetPerEdge,
+          meanEdge));
+    }
+  }
   if (narrowed > 0) {
     const double narrowest = *std::min_element(edgeWidths.begin(), edgeWidths.end());
     result.notes.push_back(fmt::format(

@@ -19,6 +19,10 @@
 
 namespace rotafab::geometry {
 
+// Offsets above this share of the mean edge are warned of (ribbons over
+// and under a crossing that far apart do not hold each other).
+inline constexpr double kMostOffsetPerEdge = 0.1;
+
 struct WeaveOptions {
   WeaveCycles cycles = WeaveCycles::All;
   RibbonShape shape;

@@ -237,5 +237,19 @@ TEST(WeaveStructure, AFastenerTooLargeForTwoHolesGivesOneAndTooLargeForOneGrowsT
   EXPECT_TRUE(grown.structure.glued.empty());
 }
 
+TEST(WeaveStructure, AnOffsetOnTheScaleOfTheEdgesIsWarnedOfByName) {
+  // The soccer ball at construction size: edges of 2 in. Ribbons 0.6 in
+  // apart at each crossing do not hold each other; 0.1 in apart they do.
+  WeaveOptions options;
+  options.names = [](Parameter p) { return p == Parameter::Offset ? std::string("--offset") : parameterInWords(p); };
+  options.shape.offset = 0.3;
+  const Structure wide = wovenStructure(truncatedIcosahedron(), options);
+  ASSERT_EQ(wide.warnings.size(), 1U);
+  EXPECT_NE(wide.warnings[0].find("--offset 0.3 in"), std::string::npos) << wide.warnings[0];
+  EXPECT_NE(wide.warnings[0].find("0.6 in apart"), std::string::npos) << wide.warnings[0];
+  options.shape.offset = 0.05;
+  EXPECT_TRUE(wovenStructure(truncatedIcosahedron(), options).warnings.empty());
+}
+
 }  // namespace
 }  // namespace rotafab::geometry
