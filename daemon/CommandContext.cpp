@@ -9,21 +9,36 @@
 #include <cstdio>
 #include <ctime>
 #include <mutex>
+#include <string>
+#include <vector>
 
 namespace rotafab::cli {
-namespace {
+namespace {}  // namespace
 
-// Notes and warnings on standard error, one line each, as the command line has always printed them.
-class MessageLines : public spdlog::sinks::base_sink<std::mutex> {
+// Notes and warnings on standard error, one line each, as the command line
+// has always printed them, and kept for a summary that lists them.
+class CommandContext::MessageLines : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  [[nodiscard]] std::vector<std::string> kept(bool warnings) {
+    const std::lock_guard lock(this->mutex_);
+    return warnings ? warnings_ : notes_;
+  }
+
  protected:
   void sink_it_(const spdlog::details::log_msg& message) override {
-    const char* kind = message.level >= spdlog::level::warn ? "warning" : "note";
-    fmt::print(stderr, "{}: {}\n", kind, std::string_view(message.payload.data(), message.payload.size()));
+    const bool warning = message.level >= spdlog::level::warn;
+    std::string line(message.payload.data(), message.payload.size());
+    fmt::print(stderr, "{}: {}\n", warning ? "warning" : "note", line);
+    (warning ? warnings_ : notes_).push_back(std::move(line));
   }
   void flush_() override { std::fflush(stderr); }
+
+ private:
+  std::vector<std::string> notes_, warnings_;
 };
 
-}  // namespace
+std::vector<std::string> CommandContext::notes() const { return lines_->kept(false); }
+std::vector<std::string> CommandContext::warnings() const { return lines_->kept(true); }
 
 CommandContext::CommandContext(core::ProgressSink progress, unsigned threads, SecondSignal second) : second_(second) {
   sigemptyset(&blocked_);
@@ -48,7 +63,8 @@ CommandContext::CommandContext(core::ProgressSink progress, unsigned threads, Se
   });
   executor_ =
       std::make_unique<core::Executor>(threads > 0 ? threads : std::max(1u, std::thread::hardware_concurrency()));
-  auto log = std::make_shared<spdlog::logger>("rotafab", std::make_shared<MessageLines>());
+  lines_ = std::make_shared<MessageLines>();
+  auto log = std::make_shared<spdlog::logger>("rotafab", lines_);
   log->set_level(spdlog::level::info);
   context_ = std::make_unique<core::WorkContext>(*executor_, cancellation_, std::move(progress), std::move(log));
 }

@@ -13,7 +13,9 @@
 #include <atomic>
 #include <csignal>
 #include <memory>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "core/WorkContext.h"
 
@@ -35,8 +37,13 @@ class CommandContext {
   [[nodiscard]] int signal() const { return signal_; }
   // The exit status of a command its signal stopped: 128 + the signal, as a shell reports it.
   [[nodiscard]] int interruptedStatus() const { return 128 + signal_; }
+  // The notes and warnings printed so far, in order, without "note: " or "warning: ".
+  [[nodiscard]] std::vector<std::string> notes() const;
+  [[nodiscard]] std::vector<std::string> warnings() const;
 
  private:
+  class MessageLines;
+  std::shared_ptr<MessageLines> lines_;
   sigset_t blocked_{}, previous_{};
   SecondSignal second_;
   core::Cancellation cancellation_;

@@ -33,10 +33,15 @@ std::string stabilityLine(const geometry::Stability& stability) {
                      -stability.margin, mass, hang);
 }
 
-void printSummary(const MakeOptions& options, const jobs::PlannedJob& job) {
+void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const CommandContext& command) {
   const auto& s = job.seconds;
   if (options.json) {
-    std::cout << jobs::summaryJson(job).dump() << '\n';
+    // SPEC's summary, and the notes and warnings printed on the way (also
+    // on standard error), for a script that reads only the object.
+    nlohmann::ordered_json summary = jobs::summaryJson(job);
+    summary["notes"] = command.notes();
+    summary["warnings"] = command.warnings();
+    std::cout << summary.dump() << '\n';
     return;
   }
   const size_t sheets = job.sheets.sheets.size();
@@ -78,7 +83,7 @@ int runMake(const MakeOptions& options) {
     lines.folder = folder.string();
     CommandContext command{ProgressLines(lines)};
     try {
-      printSummary(options, jobs::makeJob(request, folder, command.context()));
+      printSummary(options, jobs::makeJob(request, folder, command.context()), command);
       return kSuccess;
     } catch (const core::Cancelled&) {
       fmt::print(stderr, "make: stopped; nothing was written\n");

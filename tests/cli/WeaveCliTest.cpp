@@ -104,6 +104,14 @@ TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
   const auto summary = nlohmann::json::parse(made.out);
   EXPECT_EQ(summary.at("panels"), 90);
   EXPECT_EQ(summary.at("fasteners"), 180);
+  // The ribbons narrowed where at the default width they would pass
+  // through each other: a note, in the summary as on standard error.
+  ASSERT_EQ(summary.at("notes").size(), 1U) << made.err;
+  const std::string note = summary.at("notes")[0];
+  EXPECT_TRUE(note.starts_with(std::string(kSource / "examples/soccer-ball.obj") + ": ribbons narrowed at 90 of 90 "))
+      << note;
+  EXPECT_NE(made.err.find("note: " + note + "\n"), std::string::npos) << made.err;
+  EXPECT_TRUE(summary.at("warnings").empty()) << made.err;
   const auto m = nlohmann::json::parse(readFile(out / "manifest.json"));
   EXPECT_EQ(expectWovenManifest(m, 90).size(), 10U);  // the truncated icosahedron's Petrie walks
   // Each sheet read by Ghostscript.
@@ -182,6 +190,21 @@ TEST(WeaveCli, EachStructuresOptionsAreRefusedWithTheOther) {
   const CommandResult offset = run(kCli + " make " + cube + " --structure weave --offset -1mm");
   EXPECT_EQ(offset.status, 1) << offset.err;
   EXPECT_NE(offset.err.find("--offset -1mm"), std::string::npos) << offset.err;
+}
+
+TEST(WeaveCli, AnOffsetOnTheScaleOfTheEdgesIsAWarningInTheJsonSummary) {
+  TempDir dir;
+  const CommandResult made =
+      run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
+          " --structure weave --offset 0.5in --layout rows --json --out " + quoted(dir.path() / "ball"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto summary = nlohmann::json::parse(made.out);
+  ASSERT_EQ(summary.at("warnings").size(), 1U) << made.err;
+  const std::string warning = summary.at("warnings")[0];
+  EXPECT_NE(warning.find(": --offset 0.5 in stands the ribbons over and under each crossing 1 in apart"),
+            std::string::npos)
+      << warning;
+  EXPECT_NE(made.err.find("warning: " + warning + "\n"), std::string::npos) << made.err;
 }
 
 }  // namespace
