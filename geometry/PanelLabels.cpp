@@ -106,11 +106,8 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     }
     for (const auto& [a, b] : sides) {
       if (box.distanceTo(a) < gap || box.distanceTo(b) < gap) return false;
-      const Point2 ab = b - a;
-      const double length = ab.squaredNorm();
       for (const Point2& corner : corners) {
-        const double t = length > 0 ? std::clamp((corner - a).dot(ab) / length, 0.0, 1.0) : 0.0;
-        if ((a + t * ab - corner).squaredNorm() < gap * gap) return false;
+        if (core::distanceToSegment(corner, a, b) < gap) return false;
       }
       for (size_t k = 0; k < 4; ++k) {
         if (core::properlyCross(a, b, corners[k], corners[(k + 1) % 4])) return false;

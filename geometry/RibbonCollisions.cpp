@@ -286,10 +286,6 @@ Meetings cornerMeetings(const std::vector<Ribbon>& ribbons, const core::WorkCont
   return merged(foundAt);
 }
 
-}  // namespace
-
-namespace {
-
 // Per pair of meeting segments, the widest width at which the two alone,
 // made again with it at all their passes, do not meet, by `bisections`
 // bisections between `least` and the shape's width (`least` when none

@@ -728,7 +728,6 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
         "each other",
         narrowed, edgeWidths.size(), narrowest, options.names(Parameter::Width), options.shape.width));
   }
-  // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   if (!collisions.pairs.empty()) {
     std::string some;
     for (size_t i = 0; i < collisions.pairs.size() && i < 3; ++i) {
@@ -750,6 +749,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
                                 options.names(Parameter::Width), n == 1 ? "it" : "them all",
                                 options.names(Parameter::Offset))));
   }
+  // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   result.fasteners = 0;
   for (size_t e = 0; e < crossingCount; ++e) {
     if (crossings[e].panel[0] >= 0 && !glued[e]) result.fasteners += holes[e].single ? 1 : 2;
