@@ -16,6 +16,15 @@ namespace {
 
 using SheetFiles = std::vector<std::pair<int, std::filesystem::path>>;  // (number, SVG file)
 
+void requireSvgSheets(const std::filesystem::path& manifestFile, const SheetFiles& sheets) {
+  if (sheets.empty()) {
+    throw core::UserError(
+        fmt::format("{}: lists no SVG sheet, which a cut is run from; make it again with svg in "
+                    "--formats (the default)",
+                    manifestFile.string()));
+  }
+}
+
 // The SVG sheets an output folder's manifest lists.
 SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
   const auto manifestFile = folder / "manifest.json";
@@ -31,12 +40,7 @@ SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::ord
   } catch (const nlohmann::json::exception& error) {
     throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
   }
-  if (sheets.empty()) {
-    throw core::UserError(
-        fmt::format("{}: lists no SVG sheet, which a cut is run from; make it again with svg in "
-                    "--formats (the default)",
-                    manifestFile.string()));
-  }
+  requireSvgSheets(manifestFile, sheets);
   return sheets;
 }
 
@@ -82,6 +86,14 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::op
 
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
   return readSheets(listedSheets(folder, manifest));
+}
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
+                                    const std::vector<std::pair<int, std::string>>& svgSheets) {
+  SheetFiles sheets;
+  for (const auto& [index, name] : svgSheets) sheets.emplace_back(index, folder / name);
+  requireSvgSheets(folder / "manifest.json", sheets);
+  return readSheets(sheets);
 }
 
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {

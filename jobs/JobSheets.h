@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "jobs/SheetDrawing.h"
@@ -24,6 +26,9 @@ struct JobSheet {
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only);
 // All the sheets of an output folder whose manifest (readManifest) the caller has read already.
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest);
+// The sheets of an output folder named as readManifestSheets lists them.
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
+                                    const std::vector<std::pair<int, std::string>>& svgSheets);
 
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);

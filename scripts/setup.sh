@@ -12,7 +12,7 @@ packages=(
   build-essential cmake ninja-build pkg-config clang clang-format
   libclang-rt-14-dev
   # libraries (see README "Dependencies" for what each is for)
-  libassimp-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
+  libassimp-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
   libspdlog-dev libfmt-dev libyaml-cpp-dev libboost-dev libboost-system-dev
   libsqlite3-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
   libopenmesh-dev

@@ -5,6 +5,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <atomic>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
@@ -182,6 +183,15 @@ struct Service::Impl {
   asio::thread_pool syncer{1};
   asio::strand<asio::thread_pool::executor_type> syncStrand{syncer.get_executor()};
   std::vector<std::shared_ptr<Pending>> toSync, toAdd;
+  // Group commit: a group of entries is synced once no other submission is
+  // still being written in the workers, or kGroupWait after its first entry,
+  // whichever comes first. Synced as soon as each came, the groups held one
+  // or two entries, and each paid a syncfs and a commit of its own.
+  static constexpr auto kGroupWait = std::chrono::milliseconds(1);
+  static constexpr size_t kLargestGroup = 256;
+  std::atomic<int> beingWritten{0};  // submissions in the workers
+  asio::steady_timer groupTimer{syncStrand};
+  bool groupTimerSet = false;
   size_t nextSubscriber = 1;
   bool stopping = false;
   std::function<void()> stopped;
@@ -283,7 +293,9 @@ struct Service::Impl {
     return out;
   }
 
-  void jobChanged(const JobRecord& job) { publish("job", jobJson(job)); }
+  void jobChanged(const JobRecord& job) {
+    if (!subscribers.empty()) publish("job", jobJson(job));
+  }
 
   void deviceChanged(const Device& device) { publish("device", deviceJson(device)); }
 
@@ -468,13 +480,21 @@ struct Service::Impl {
   // A planned folder's plan: its sheets read and checked against the bed
   // they are to be cut on; the summary the queue shows, from its manifest.
   static json planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine) {
-    const auto manifest = jobs::readManifest(folder);
-    const auto planned = jobs::readJobSheets(folder, manifest);
+    json summary;
+    std::vector<jobs::JobSheet> planned;
+    if (const auto listed = jobs::readManifestSheets(folder / "manifest.json")) {
+      planned = jobs::readJobSheets(folder, listed->svgSheets);
+      if (listed->panels) summary["panels"] = *listed->panels;
+      if (listed->cost) summary["cost"] = json::parse(*listed->cost);
+    } else {  // read again, to say what is wrong with it
+      const auto manifest = jobs::readManifest(folder);
+      planned = jobs::readJobSheets(folder, manifest);
+      // (An object: its sheets were listed from it.)
+      if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
+      if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
+    }
     jobs::checkSheetsFitBed(planned, machine);
-    json summary{{"sheets", static_cast<int>(planned.size())}};
-    // (An object: its sheets were listed from it.)
-    if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
-    if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
+    summary["sheets"] = static_cast<int>(planned.size());
     return summary;
   }
 
@@ -873,6 +893,20 @@ struct Service::Impl {
     pump();
   }
 
+  // On syncStrand, when an entry is written or a submission refused: the
+  // group is synced now, or once the submissions being written join it.
+  void groupChanged() {
+    if (toSync.empty()) return;
+    if (beingWritten.load() == 0 || toSync.size() >= kLargestGroup) return syncSubmissions();
+    if (groupTimerSet) return;
+    groupTimerSet = true;
+    groupTimer.expires_after(kGroupWait);
+    groupTimer.async_wait([this](const boost::system::error_code&) {
+      groupTimerSet = false;
+      if (!toSync.empty()) syncSubmissions();
+    });
+  }
+
   // On syncStrand: one syncfs for every entry written so far.
   void syncSubmissions() {
     auto batch = std::move(toSync);
@@ -1106,6 +1140,7 @@ void Service::start() {
 void Service::submit(Submission submission, ReplyHandler done) {
   Impl& impl = *impl_;
   // The bytes go to the spool off the strand; the row once they are durable.
+  ++impl.beingWritten;
   asio::post(impl.workers, [&impl, submission = std::move(submission), done = std::move(done)]() mutable {
     NewJob job;
     job.owner = submission.owner;
@@ -1193,13 +1228,18 @@ void Service::submit(Submission submission, ReplyHandler done) {
     if (refused.status != 0) {
       entry.reset();  // the half-written entry goes
       done(refused);
+      asio::post(impl.syncStrand, [&impl] {
+        --impl.beingWritten;
+        impl.groupChanged();  // a group may have waited for this one
+      });
       return;
     }
     // Synced to disk with whatever else came in meanwhile, then added with it.
     auto pending = std::make_shared<Impl::Pending>(Impl::Pending{std::move(*entry), job, std::move(done)});
     asio::post(impl.syncStrand, [&impl, pending] {
       impl.toSync.push_back(pending);
-      if (impl.toSync.size() == 1) asio::post(impl.syncStrand, [&impl] { impl.syncSubmissions(); });
+      --impl.beingWritten;
+      impl.groupChanged();
     });
   });
 }

@@ -8,6 +8,9 @@
 #include <sqlite3.h>
 
 #include <chrono>
+#include <optional>
+#include <string>
+#include <unordered_map>
 #include <utility>
 
 #include "daemon/service/JobStore.h"
@@ -56,17 +59,62 @@ constexpr const char* kMigrations[] = {
        CREATE INDEX events_job ON events(job, id);)",
     // 3: the jobs the scheduler looks for (queued, ready) found without reading every job.
     R"(CREATE INDEX jobs_state ON jobs(state, priority DESC, position);)",
+    // 4: the end of the queue, where a new job goes, found without reading
+    // every job (MAX over jobs_queue's second column reads the whole index).
+    R"(CREATE INDEX jobs_position ON jobs(position);)",
 };
 constexpr int kNewest = static_cast<int>(std::size(kMigrations));
 
 double now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
+
+// The store's statements, each prepared once: preparing took more of a
+// submission's time on the store than the insert it prepared.
+class StatementCache {
+ public:
+  explicit StatementCache(sqlite3* db) : db_(db) {}
+  ~StatementCache() {
+    for (const auto& [sql, statement] : prepared_) sqlite3_finalize(statement);
+  }
+  StatementCache(const StatementCache&) = delete;
+  StatementCache& operator=(const StatementCache&) = delete;
+
+  // The prepared statement for `sql`, or null when it is in use (a visit
+  // that queries again); the caller then prepares one of its own.
+  sqlite3_stmt* take(const std::string& sql) {
+    sqlite3_stmt*& statement = prepared_[sql];
+    if (!statement &&
+        sqlite3_prepare_v3(db_, sql.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &statement, nullptr) != SQLITE_OK)
+      return nullptr;
+    if (sqlite3_stmt_busy(statement)) return nullptr;
+    return statement;
+  }
+  sqlite3* db() const { return db_; }
+
+ private:
+  sqlite3* db_;
+  std::unordered_map<std::string, sqlite3_stmt*> prepared_;
+};
 
 class Statement {
  public:
   Statement(sqlite3* db, const char* sql) : db_(db) {
     if (sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr) != SQLITE_OK) fail("prepare");
   }
-  ~Statement() { sqlite3_finalize(statement_); }
+  Statement(StatementCache& cache, const std::string& sql) : db_(cache.db()), statement_(cache.take(sql)) {
+    if (statement_) {
+      cached_ = true;
+    } else if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
+      fail("prepare");
+    }
+  }
+  ~Statement() {
+    if (!cached_) {
+      sqlite3_finalize(statement_);
+      return;
+    }
+    sqlite3_reset(statement_);
+    sqlite3_clear_bindings(statement_);
+  }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
 
@@ -110,6 +158,7 @@ class Statement {
 
   sqlite3* db_;
   sqlite3_stmt* statement_ = nullptr;
+  bool cached_ = false;
 };
 
 // One line for what SQLite said, in the words of what the daemon was doing.
@@ -191,12 +240,16 @@ class SqliteStore final : public JobStore {
       execute(db_, "PRAGMA synchronous=FULL", doing("set synchronous=FULL").c_str());
       execute(db_, "PRAGMA foreign_keys=ON", doing("turn on foreign keys").c_str());
       migrate(upTo.value_or(kNewest));
+      statements_.emplace(db_);
     } catch (...) {
       sqlite3_close(db_);
       throw;
     }
   }
-  ~SqliteStore() override { sqlite3_close(db_); }
+  ~SqliteStore() override {
+    statements_.reset();  // finalized before the database closes
+    sqlite3_close(db_);
+  }
 
   JobRecord addJob(const NewJob& job, std::string_view reason) override {
     return addJobs({job}, {std::string(reason)}).front();
@@ -215,11 +268,11 @@ class SqliteStore final : public JobStore {
       }
     }
     Transaction transaction(db_);
-    Statement last(db_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
+    Statement last(*statements_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
     last.step();
     double position = last.real(0);
     const double at = now();
-    Statement insert(db_,
+    Statement insert(*statements_,
                      "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
                      "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     std::vector<JobId> ids;
@@ -255,7 +308,7 @@ class SqliteStore final : public JobStore {
   }
 
   std::optional<JobRecord> job(JobId id) override {
-    Statement select(db_, fmt::format("SELECT {} FROM jobs WHERE id = ?", kJobColumns).c_str());
+    Statement select(*statements_, fmt::format("SELECT {} FROM jobs WHERE id = ?", kJobColumns));
     select.bind(1, id);
     if (!select.step()) return std::nullopt;
     return jobOf(select);
@@ -268,17 +321,17 @@ class SqliteStore final : public JobStore {
   }
 
   void eachJob(const std::function<void(const JobRecord&)>& visit) override {
-    Statement select(db_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns).c_str());
+    Statement select(*statements_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns));
     while (select.step()) visit(jobOf(select));
   }
 
   std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit, const std::string& device) override {
     std::string marks;
     for (size_t i = 0; i < states.size(); ++i) marks += i == 0 ? "?" : ", ?";
-    Statement select(db_, fmt::format("SELECT {} FROM jobs WHERE state IN ({}){} ORDER BY priority DESC, position "
-                                      "LIMIT ?",
-                                      kJobColumns, marks, device.empty() ? "" : " AND device = ?")
-                              .c_str());
+    Statement select(*statements_,
+                     fmt::format("SELECT {} FROM jobs WHERE state IN ({}){} ORDER BY priority DESC, position "
+                                 "LIMIT ?",
+                                 kJobColumns, marks, device.empty() ? "" : " AND device = ?"));
     int index = 1;
     for (JobState state : states) select.bind(index++, stateName(state));
     if (!device.empty()) select.bind(index++, device);
@@ -306,14 +359,15 @@ class SqliteStore final : public JobStore {
 
   void reorder(JobId id, int priority, double position) override {
     Transaction transaction(db_);
-    Statement set(db_, "UPDATE jobs SET priority = ?, position = ?, updated = ? WHERE id = ?");
+    Statement set(*statements_, "UPDATE jobs SET priority = ?, position = ?, updated = ? WHERE id = ?");
     set.bind(1, static_cast<int64_t>(priority)).bind(2, position).bind(3, now()).bind(4, id);
     set.step();
     transaction.commit();
   }
 
   std::vector<Transition> transitions(JobId id) override {
-    Statement select(db_, "SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = ? ORDER BY id");
+    Statement select(*statements_,
+                     "SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = ? ORDER BY id");
     select.bind(1, id);
     std::vector<Transition> all;
     while (select.step()) {
@@ -329,7 +383,7 @@ class SqliteStore final : public JobStore {
   }
 
   void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) override {
-    Statement insert(db_, "INSERT INTO events (job, at, kind, text) VALUES (?, ?, ?, ?)");
+    Statement insert(*statements_, "INSERT INTO events (job, at, kind, text) VALUES (?, ?, ?, ?)");
     if (job) {
       insert.bind(1, *job);
     } else {
@@ -340,8 +394,9 @@ class SqliteStore final : public JobStore {
   }
 
   std::vector<Event> events(std::optional<JobId> job, size_t newest) override {
-    Statement select(db_, job ? "SELECT id, job, at, kind, text FROM events WHERE job = ? ORDER BY id DESC LIMIT ?"
-                              : "SELECT id, job, at, kind, text FROM events ORDER BY id DESC LIMIT ?");
+    Statement select(*statements_,
+                     job ? "SELECT id, job, at, kind, text FROM events WHERE job = ? ORDER BY id DESC LIMIT ?"
+                         : "SELECT id, job, at, kind, text FROM events ORDER BY id DESC LIMIT ?");
     int index = 1;
     if (job) select.bind(index++, *job);
     select.bind(index, static_cast<int64_t>(newest));
@@ -394,13 +449,13 @@ class SqliteStore final : public JobStore {
   void apply(JobId id, const JobChange& change) {
     const auto setText = [&](const char* column, const std::optional<std::string>& value) {
       if (!value) return;
-      Statement set(db_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column).c_str());
+      Statement set(*statements_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column));
       set.bind(1, *value).bind(2, id);
       set.step();
     };
     const auto setNumber = [&](const char* column, std::optional<int64_t> value) {
       if (!value) return;
-      Statement set(db_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column).c_str());
+      Statement set(*statements_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column));
       set.bind(1, *value).bind(2, id);
       set.step();
     };
@@ -417,14 +472,15 @@ class SqliteStore final : public JobStore {
     if (!allowedTransition(from, to)) {
       throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
     }
-    Statement set(db_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
+    Statement set(*statements_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
     set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
     set.step();
     record(id, from, to, at, reason);
   }
 
   void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
-    Statement insert(db_, "INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES (?, ?, ?, ?, ?)");
+    Statement insert(*statements_,
+                     "INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES (?, ?, ?, ?, ?)");
     insert.bind(1, id);
     if (from) {
       insert.bind(2, stateName(*from));
@@ -437,6 +493,7 @@ class SqliteStore final : public JobStore {
 
   std::filesystem::path file_;
   sqlite3* db_ = nullptr;
+  std::optional<StatementCache> statements_;
 };
 
 }  // namespace

@@ -153,6 +153,29 @@ TEST(JobStore, TheQueueIsInPriorityThenSubmissionOrderAndCanBeReordered) {
   EXPECT_EQ(store->jobsIn({JobState::Planning, JobState::Ready}).size(), 1u);
 }
 
+// The store's statements are prepared once and kept: a visit that asks the
+// store again, even the same question, gets answers of its own; a new job
+// goes after the last one, wherever a reorder put it.
+TEST(JobStore, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
+  TempDir dir;
+  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+  const JobId a = store->addJob(meshJob("a"), "s").id;
+  const JobId b = store->addJob(meshJob("b"), "s").id;
+  std::vector<std::pair<JobId, JobId>> pairs;
+  store->eachJob([&](const JobRecord& outer) {
+    EXPECT_EQ(store->job(outer.id)->source, outer.source);
+    store->eachJob([&](const JobRecord& inner) { pairs.emplace_back(outer.id, inner.id); });
+  });
+  EXPECT_EQ(pairs, (std::vector<std::pair<JobId, JobId>>{{a, a}, {a, b}, {b, a}, {b, b}}));
+
+  store->reorder(a, 0, 100.0);
+  const JobRecord c = store->addJob(meshJob("c"), "s");
+  EXPECT_GT(c.position, 100.0);
+  std::vector<JobId> order;
+  for (const JobRecord& job : store->jobs()) order.push_back(job.id);
+  EXPECT_EQ(order, (std::vector<JobId>{b, a, c.id}));
+}
+
 TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {
   TempDir dir;
   const auto file = dir.path() / "jobs.sqlite3";

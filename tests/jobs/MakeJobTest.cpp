@@ -15,6 +15,7 @@
 #include "core/UserError.h"
 #include "support/TestContext.h"
 #include "support/TestSupport.h"
+#include "support/WorkshopRequest.h"
 
 namespace rotafab::jobs {
 namespace {
@@ -27,15 +28,7 @@ size_t threadsOfThisProcess() {
   return count;
 }
 
-MakeRequest bunny(bool rows) {
-  const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
-  MakeRequest request;
-  request.mesh = kSource / "examples/bunny.obj";
-  request.machine = profiles::findMachine(catalogue, "workshop-32x18");
-  request.material = profiles::findMaterial(catalogue, "posterboard");
-  request.rows = rows;
-  return request;
-}
+MakeRequest bunny(bool rows) { return test::workshopRequest(kSource / "examples/bunny.obj", rows); }
 
 struct CancelPoint {
   std::string phase, step;
