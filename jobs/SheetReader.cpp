@@ -22,7 +22,7 @@ bool number(std::string_view text, size_t& at, double& value) {
   return true;
 }
 
-bool contains(const std::string& line, std::string_view tag) { return line.find(tag) != std::string::npos; }
+bool contains(std::string_view line, std::string_view tag) { return line.find(tag) != std::string_view::npos; }
 
 // The path data rotafab writes: "M x y", then absolute "L x y" or relative
 // "l dx dy" pairs (a command's letter may be left out before its next pair),
@@ -107,7 +107,14 @@ DrawnPath pathOf(std::string_view d, double height, const Fail& fail) {
 }  // namespace
 
 SheetDrawing readSheetSvg(const std::filesystem::path& file) {
+  // Read whole, then taken a line at a time: the daemon reads every sheet of a folder submitted to it.
   std::ifstream in(file, std::ios::binary);
+  if (!in) throw std::invalid_argument(fmt::format("{}: cannot read it", file.string()));
+  std::string text;
+  in.seekg(0, std::ios::end);
+  text.resize(static_cast<size_t>(std::max<std::streamoff>(0, in.tellg())));
+  in.seekg(0);
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (!in) throw std::invalid_argument(fmt::format("{}: cannot read it", file.string()));
   const auto fail = [&](int line, const std::string& what) {
     return std::invalid_argument(fmt::format("{}:{}: {}", file.string(), line, what));
@@ -126,16 +133,18 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
   Operation group = Operation::Outline;
   bool inGroup = false;
   int depth = 0;  // groups open inside the operation's (a part's)
-  std::string line;
   int lineNumber = 0;
-  while (std::getline(in, line)) {
+  for (size_t start = 0; start < text.size();) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view line(text.data() + start, end - start);
+    start = end + 1;
     ++lineNumber;
-    std::smatch m;
+    std::match_results<std::string_view::const_iterator> m;
     if (line.starts_with(pathStart) && line.ends_with(pathEnd)) {
       if (!inGroup) throw fail(lineNumber, "a path outside an operation's group");
       if (!sized) throw fail(lineNumber, "a path before the <svg> element's viewBox");
-      const std::string_view d =
-          std::string_view(line).substr(pathStart.size(), line.size() - pathStart.size() - pathEnd.size());
+      const std::string_view d = line.substr(pathStart.size(), line.size() - pathStart.size() - pathEnd.size());
       DrawnPath path = pathOf(d, sheet.height, [&](size_t at, const std::string& what) {
         return fail(lineNumber, fmt::format("path data: {} at character {}", what, at + 1));
       });
@@ -143,15 +152,16 @@ SheetDrawing readSheetSvg(const std::filesystem::path& file) {
       if (path.points.size() < 2) throw fail(lineNumber, "a path of fewer than 2 points");
       sheet.paths.push_back(std::move(path));
       // (Each regular expression only where its tag is: most lines are none of these.)
-    } else if (!sized && contains(line, "<svg ") && std::regex_search(line, m, svgTag)) {
+    } else if (!sized && contains(line, "<svg ") && std::regex_search(line.begin(), line.end(), m, svgTag)) {
       sheet.width = std::stod(m[1]), sheet.height = std::stod(m[2]);
       sized = true;
-    } else if (contains(line, "<desc>") && std::regex_search(line, m, descTag)) {
+    } else if (contains(line, "<desc>") && std::regex_search(line.begin(), line.end(), m, descTag)) {
       sheet.index = std::stoi(m[1]), sheet.sheetCount = std::stoi(m[2]), sheet.margin = std::stod(m[3]);
       described = true;
-    } else if (contains(line, "<title>") && std::regex_search(line, m, titleTag)) {
+    } else if (contains(line, "<title>") && std::regex_search(line.begin(), line.end(), m, titleTag)) {
       sheet.title = m[1];
-    } else if (contains(line, "<g id=\"") && std::regex_search(line, m, groupTag)) {
+    } else if (contains(line, "<g id=\"") && contains(line, "stroke=\"#") &&
+               std::regex_search(line.begin(), line.end(), m, groupTag)) {
       const auto named = profiles::operationNamed(m[1].str());
       if (!named) {
         throw fail(lineNumber, fmt::format("group \"{}\" is not an operation (cut, score, etch, outline)", m[1].str()));

@@ -14,9 +14,12 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <charconv>
+#include <chrono>
 #include <deque>
 #include <filesystem>
 #include <set>
+#include <unordered_map>
+#include <utility>
 
 #include "daemon/service/Multipart.h"
 
@@ -143,13 +146,25 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   };
   std::vector<std::weak_ptr<Connection>> open;
 
-  Identity identify(asio::local::stream_protocol::socket& socket) const {
+  // The names of the users who connected lately, on the I/O thread: a
+  // lookup reads /etc/passwd through NSS, on every connection. A minute
+  // old at most, so that a renamed account is seen under its new name.
+  static constexpr auto kNameKeptFor = std::chrono::seconds(60);
+  std::unordered_map<uid_t, std::pair<std::string, std::chrono::steady_clock::time_point>> names;
+
+  Identity identify(asio::local::stream_protocol::socket& socket) {
     struct ucred credentials {};
     socklen_t size = sizeof credentials;
     if (::getsockopt(socket.native_handle(), SOL_SOCKET, SO_PEERCRED, &credentials, &size) != 0) {
       return {false, "", "the peer's credentials cannot be read"};
     }
-    return {true, userName(credentials.uid), ""};
+    const auto now = std::chrono::steady_clock::now();
+    auto& [name, looked] = names[credentials.uid];
+    if (name.empty() || now - looked > kNameKeptFor) {
+      name = userName(credentials.uid);
+      looked = now;
+    }
+    return {true, name, ""};
   }
 
   template <typename Request>
