@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 #include <unordered_map>
 
@@ -164,13 +165,16 @@ GrownStructure growUntilRoom(PolygonMesh& mesh, const std::function<Structure(co
                              const core::WorkContext& context) {
   GrownStructure result;
   std::vector<double> firstScales;  // of the size given
+  int withoutRoomBefore = std::numeric_limits<int>::max();
   for (int attempt = 1;; ++attempt) {
     try {
       result.structure = build(mesh);
       return result;
     } catch (const NoRoomForHoleError& error) {
       if (attempt == 1) firstScales = error.scales;
-      if (attempt == kGrowAttempts || !std::isfinite(error.scaleNeeded)) {
+      const bool fewer = error.bands < withoutRoomBefore;
+      withoutRoomBefore = error.bands;
+      if (attempt >= kMostGrowAttempts || (attempt >= kGrowAttempts && !fewer) || !std::isfinite(error.scaleNeeded)) {
         NoRoomForHoleError last = error;
         last.scales = firstScales;
         throw last;

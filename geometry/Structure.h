@@ -138,8 +138,12 @@ void writeStructureObj(std::ostream& out, const Structure& structure, std::strin
 // A structure built at the smallest size, from the mesh's, at which every
 // fastener hole has room (FastenerHoles.h, kLeastClearance): when `build`
 // throws NoRoomForHoleError, the mesh is scaled by what the places without
-// room ask (every length of the structure scales with it) and built again,
-// at most kGrowAttempts times. `mesh` is left at the size built; `grown`
+// room ask and built again: kGrowAttempts times, and on while each attempt
+// leaves fewer places without room, at most kMostGrowAttempts times. (A
+// band's lengths all scale with the mesh; a weave's offset and the widths
+// it narrows to do not, so the scale its crossings ask for falls a little
+// short at the next size: CGAL's knot2 needed 1.39, 1.12, then 1.03 more.)
+// `mesh` is left at the size built; `grown`
 // says how many times its size it became (1: as given). Throws what `build`
 // does, the NoRoomForHoleError of the last attempt with the `scales` of the
 // size given, as the first try found them. Progress: phase "geometry", step
@@ -151,6 +155,7 @@ struct GrownStructure {
   std::vector<double> scalesNeeded;  // what each of them needed, times the size given
 };
 constexpr int kGrowAttempts = 3;
+constexpr int kMostGrowAttempts = 6;
 GrownStructure growUntilRoom(PolygonMesh& mesh, const std::function<Structure(const PolygonMesh&)>& build,
                              const core::WorkContext& context);
 

@@ -47,7 +47,7 @@ struct WeaveOptions {
 Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context);
 
 // As buildBandStructureWithRoom(): the mesh grown until every crossing has
-// room for its holes, at most kGrowAttempts times.
+// room for its holes (growUntilRoom, Structure.h).
 GrownStructure buildWeaveStructureWithRoom(PolygonMesh& mesh, const WeaveOptions& options,
                                            const core::WorkContext& context);
 
