@@ -31,7 +31,12 @@ SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::ord
   SheetFiles sheets;
   try {
     for (const auto& sheet : manifest.at("sheets")) {
-      const int index = sheet.at("index");
+      const int64_t number = sheet.at("index");
+      if (number < 1 || number > INT32_MAX) {
+        throw core::UserError(
+            fmt::format("{}: sheets: index {} is not a sheet's number (1, 2, ...)", manifestFile.string(), number));
+      }
+      const int index = static_cast<int>(number);
       for (const auto& file : sheet.at("files")) {
         const std::string name = file;
         if (name.ends_with(".svg")) sheets.emplace_back(index, folder / name);

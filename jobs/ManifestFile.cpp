@@ -52,8 +52,14 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
   // that grew for a large manifest is let go, not kept for the daemon's life.
   constexpr size_t kKeptCapacity = 1 << 20;
   thread_local std::optional<simdjson::dom::parser> kept;
-  if (!kept || kept->capacity() > kKeptCapacity) kept.emplace();
+  if (!kept) kept.emplace();
   simdjson::dom::parser& parser = *kept;
+  struct LetGoIfGrown {
+    std::optional<simdjson::dom::parser>& kept;
+    ~LetGoIfGrown() {
+      if (kept->capacity() > kKeptCapacity) kept.reset();
+    }
+  } letGo{kept};
   simdjson::dom::element manifest;
   simdjson::dom::array sheets;
   if (parser.parse(text).get(manifest) != simdjson::SUCCESS || manifest["sheets"].get(sheets) != simdjson::SUCCESS)
@@ -66,7 +72,7 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
       return std::nullopt;
     for (simdjson::dom::element file : files) {
       std::string_view name;
-      if (file.get(name) != simdjson::SUCCESS || index < INT32_MIN || index > INT32_MAX) return std::nullopt;
+      if (file.get(name) != simdjson::SUCCESS || index < 1 || index > INT32_MAX) return std::nullopt;
       if (name.ends_with(".svg")) read.svgSheets.emplace_back(static_cast<int>(index), std::string(name));
     }
   }

@@ -161,7 +161,12 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
     const auto now = std::chrono::steady_clock::now();
     auto& [name, looked] = names[credentials.uid];
     if (name.empty() || now - looked > kNameKeptFor) {
-      name = userName(credentials.uid);
+      const std::string found = userName(credentials.uid);
+      if (found.starts_with("uid ")) {  // not found, perhaps only for now: asked again next time
+        names.erase(credentials.uid);
+        return {true, found, ""};
+      }
+      name = found;
       looked = now;
     }
     return {true, name, ""};

@@ -903,9 +903,9 @@ struct Service::Impl {
     if (groupTimerSet) return;
     groupTimerSet = true;
     groupTimer.expires_after(kGroupWait);
-    groupTimer.async_wait([this](const boost::system::error_code&) {
+    groupTimer.async_wait([this](const boost::system::error_code& error) {
       groupTimerSet = false;
-      if (!toSync.empty()) syncSubmissions();
+      if (!error && !toSync.empty()) syncSubmissions();
     });
   }
 
@@ -1144,6 +1144,19 @@ void Service::submit(Submission submission, ReplyHandler done) {
   // The bytes go to the spool off the strand; the row once they are durable.
   ++impl.beingWritten;
   asio::post(impl.workers, [&impl, submission = std::move(submission), done = std::move(done)]() mutable {
+    // However the submission ends, its entry (if it has one) goes to be
+    // synced, and the group commit stops waiting for it.
+    struct Written {
+      Impl& impl;
+      std::shared_ptr<Impl::Pending> pending;
+      ~Written() {
+        asio::post(impl.syncStrand, [&impl = impl, pending = std::move(pending)] {
+          if (pending) impl.toSync.push_back(pending);
+          --impl.beingWritten;
+          impl.groupChanged();
+        });
+      }
+    } written{impl, nullptr};
     NewJob job;
     job.owner = submission.owner;
     job.device = submission.device;
@@ -1230,19 +1243,10 @@ void Service::submit(Submission submission, ReplyHandler done) {
     if (refused.status != 0) {
       entry.reset();  // the half-written entry goes
       done(refused);
-      asio::post(impl.syncStrand, [&impl] {
-        --impl.beingWritten;
-        impl.groupChanged();  // a group may have waited for this one
-      });
       return;
     }
     // Synced to disk with whatever else came in meanwhile, then added with it.
-    auto pending = std::make_shared<Impl::Pending>(Impl::Pending{std::move(*entry), job, std::move(done)});
-    asio::post(impl.syncStrand, [&impl, pending] {
-      impl.toSync.push_back(pending);
-      --impl.beingWritten;
-      impl.groupChanged();
-    });
+    written.pending = std::make_shared<Impl::Pending>(Impl::Pending{std::move(*entry), job, std::move(done)});
   });
 }
 

@@ -73,26 +73,37 @@ class StatementCache {
  public:
   explicit StatementCache(sqlite3* db) : db_(db) {}
   ~StatementCache() {
-    for (const auto& [sql, statement] : prepared_) sqlite3_finalize(statement);
+    for (const auto& [sql, kept] : prepared_) sqlite3_finalize(kept.statement);
   }
   StatementCache(const StatementCache&) = delete;
   StatementCache& operator=(const StatementCache&) = delete;
 
   // The prepared statement for `sql`, or null when it is in use (a visit
-  // that queries again); the caller then prepares one of its own.
+  // that queries again); the caller then prepares one of its own, and
+  // gives the cached one back (giveBack) when it is done with it.
   sqlite3_stmt* take(const std::string& sql) {
-    sqlite3_stmt*& statement = prepared_[sql];
-    if (!statement &&
-        sqlite3_prepare_v3(db_, sql.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &statement, nullptr) != SQLITE_OK)
+    Kept& kept = prepared_[sql];
+    if (kept.inUse) return nullptr;
+    if (!kept.statement &&
+        sqlite3_prepare_v3(db_, sql.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &kept.statement, nullptr) != SQLITE_OK)
       return nullptr;
-    if (sqlite3_stmt_busy(statement)) return nullptr;
-    return statement;
+    kept.inUse = true;
+    return kept.statement;
+  }
+  void giveBack(sqlite3_stmt* statement) {
+    sqlite3_reset(statement);
+    sqlite3_clear_bindings(statement);
+    prepared_[sqlite3_sql(statement)].inUse = false;
   }
   sqlite3* db() const { return db_; }
 
  private:
+  struct Kept {
+    sqlite3_stmt* statement = nullptr;
+    bool inUse = false;
+  };
   sqlite3* db_;
-  std::unordered_map<std::string, sqlite3_stmt*> prepared_;
+  std::unordered_map<std::string, Kept> prepared_;
 };
 
 class Statement {
@@ -102,18 +113,17 @@ class Statement {
   }
   Statement(StatementCache& cache, const std::string& sql) : db_(cache.db()), statement_(cache.take(sql)) {
     if (statement_) {
-      cached_ = true;
+      cache_ = &cache;
     } else if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
       fail("prepare");
     }
   }
   ~Statement() {
-    if (!cached_) {
+    if (cache_) {
+      cache_->giveBack(statement_);
+    } else {
       sqlite3_finalize(statement_);
-      return;
     }
-    sqlite3_reset(statement_);
-    sqlite3_clear_bindings(statement_);
   }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
@@ -158,7 +168,7 @@ class Statement {
 
   sqlite3* db_;
   sqlite3_stmt* statement_ = nullptr;
-  bool cached_ = false;
+  StatementCache* cache_ = nullptr;  // the cache's, given back when done; else finalized
 };
 
 // One line for what SQLite said, in the words of what the daemon was doing.

@@ -292,6 +292,10 @@ TEST(Daemon, APlannedFolderIsReadyWhenSubmittedAndOneWithABrokenSheetIsRefusedNa
   EXPECT_EQ(job["state"], "ready");
   EXPECT_EQ(job["device"], "laser1");
   EXPECT_EQ(job["sheets"], 3);
+  // What the queue shows of the plan, from the manifest as the fast reader lists it.
+  EXPECT_EQ(job["summary"]["sheets"], 3);
+  EXPECT_GT(job["summary"]["panels"].get<int>(), 0);
+  EXPECT_EQ(job["summary"]["cost"]["sheets"], 3);
   std::vector<std::string> states;
   for (const json& t : job["transitions"]) states.push_back(t["to"]);
   EXPECT_EQ(states, (std::vector<std::string>{"queued", "planning", "ready"}));
@@ -310,6 +314,17 @@ TEST(Daemon, APlannedFolderIsReadyWhenSubmittedAndOneWithABrokenSheetIsRefusedNa
   EXPECT_EQ(refused.status, 1);
   EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
   EXPECT_NE(refused.err.find(sheet), std::string::npos) << refused.err;
+  // A manifest cut short: the full reader's words (the fast one gives up), naming it, and no job.
+  const fs::path cutShort = root.path() / "cut-short";
+  fs::copy(threeSheets(), cutShort);
+  {
+    const std::string text = readFile(cutShort / "manifest.json");
+    std::ofstream(cutShort / "manifest.json", std::ios::trunc) << text.substr(0, text.size() / 2);
+  }
+  const CommandResult notJson = daemon.client("submit " + quoted(cutShort));
+  EXPECT_EQ(notJson.status, 1);
+  EXPECT_EQ(std::count(notJson.err.begin(), notJson.err.end(), '\n'), 1) << notJson.err;
+  EXPECT_NE(notJson.err.find((cutShort / "manifest.json").string() + ": not JSON"), std::string::npos) << notJson.err;
   EXPECT_EQ(daemon.clientJson("jobs")["jobs"].size(), 1u);
   size_t entries = 0;
   for (const auto& entry : fs::directory_iterator(daemon.stateDir() / "spool")) entries += entry.is_directory() ? 1 : 0;

@@ -170,6 +170,20 @@ TEST(JobStore, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
 
   store->reorder(a, 0, 100.0);
   const JobRecord c = store->addJob(meshJob("c"), "s");
+  // Found by an index, not by reading every job (schema version 4).
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open((dir.path() / "jobs.sqlite3").c_str(), &db), SQLITE_OK);
+    sqlite3_stmt* plan = nullptr;
+    ASSERT_EQ(
+        sqlite3_prepare_v2(db, "EXPLAIN QUERY PLAN SELECT COALESCE(MAX(position), 0) FROM jobs", -1, &plan, nullptr),
+        SQLITE_OK);
+    std::string steps;
+    while (sqlite3_step(plan) == SQLITE_ROW) steps += reinterpret_cast<const char*>(sqlite3_column_text(plan, 3));
+    sqlite3_finalize(plan);
+    sqlite3_close(db);
+    EXPECT_NE(steps.find("jobs_position"), std::string::npos) << steps;
+  }
   EXPECT_GT(c.position, 100.0);
   std::vector<JobId> order;
   for (const JobRecord& job : store->jobs()) order.push_back(job.id);

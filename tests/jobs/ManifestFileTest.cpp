@@ -74,11 +74,21 @@ TEST(ManifestFile, AManifestNotAsMakeWritesItIsLeftToTheFullReader) {
            std::string("{\"sheets\": [{\"index\": 1, \"files\": \"sheet-001.svg\"}]}"),
            std::string("{\"sheets\": [{\"index\": 1, \"files\": [7]}]}"),
            std::string("{\"sheets\": [{\"index\": 4294967297, \"files\": [\"sheet-001.svg\"]}]}"),
+           std::string("{\"sheets\": [{\"index\": 0, \"files\": [\"sheet-001.svg\"]}]}"),
        }) {
     writeManifestText(manifest, text);
     EXPECT_FALSE(readManifestSheets(manifest).has_value()) << text;
   }
   EXPECT_FALSE(readManifestSheets(dir.path() / "missing.json").has_value());
+  // ... and the full reader refuses a sheet number out of range (it wrapped 4294967297 to 1).
+  writeManifestText(manifest, R"({"sheets": [{"index": 4294967297, "files": ["sheet-001.svg"]}]})");
+  try {
+    readJobSheets(dir.path(), std::nullopt);
+    FAIL() << "read";
+  } catch (const core::UserError& error) {
+    EXPECT_NE(std::string(error.what()).find("index 4294967297 is not a sheet's number"), std::string::npos)
+        << error.what();
+  }
 
   // A manifest that lists no SVG is read, and refused by the sheets' reader in the words of the full one.
   writeManifestText(manifest, R"({"sheets": [{"index": 1, "files": ["sheet-001.eps"]}]})");
