@@ -17,6 +17,7 @@
 #include <chrono>
 #include <deque>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <utility>
@@ -39,12 +40,12 @@ struct Identity {
   std::string refusal;
 };
 
-std::string userName(uid_t uid) {
+std::optional<std::string> accountName(uid_t uid) {
   struct passwd entry {};
   struct passwd* found = nullptr;
   char buffer[4096];
-  if (::getpwuid_r(uid, &entry, buffer, sizeof buffer, &found) == 0 && found) return found->pw_name;
-  return fmt::format("uid {}", uid);
+  if (::getpwuid_r(uid, &entry, buffer, sizeof buffer, &found) == 0 && found) return std::string(found->pw_name);
+  return std::nullopt;
 }
 
 std::optional<long long> wholeNumber(std::string_view text) {
@@ -159,17 +160,14 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
       return {false, "", "the peer's credentials cannot be read"};
     }
     const auto now = std::chrono::steady_clock::now();
-    auto& [name, looked] = names[credentials.uid];
-    if (name.empty() || now - looked > kNameKeptFor) {
-      const std::string found = userName(credentials.uid);
-      if (found.starts_with("uid ")) {  // not found, perhaps only for now: asked again next time
-        names.erase(credentials.uid);
-        return {true, found, ""};
-      }
-      name = found;
-      looked = now;
+    auto known = names.find(credentials.uid);
+    if (known == names.end() || now - known->second.second > kNameKeptFor) {
+      const auto found = accountName(credentials.uid);
+      // Not found, perhaps only for now: not kept, asked again next time.
+      if (!found) return {true, fmt::format("uid {}", credentials.uid), ""};
+      known = names.insert_or_assign(credentials.uid, std::pair{*found, now}).first;
     }
-    return {true, name, ""};
+    return {true, known->second.first, ""};
   }
 
   template <typename Request>

@@ -78,30 +78,30 @@ class StatementCache {
   StatementCache(const StatementCache&) = delete;
   StatementCache& operator=(const StatementCache&) = delete;
 
-  // The prepared statement for `sql`, or null when it is in use (a visit
-  // that queries again); the caller then prepares one of its own, and
-  // gives the cached one back (giveBack) when it is done with it.
-  sqlite3_stmt* take(const std::string& sql) {
+  struct Kept {
+    sqlite3_stmt* statement = nullptr;
+    bool inUse = false;
+  };
+  // The prepared statement for `sql`, lent until giveBack(); null when it
+  // is lent already (a visit that queries again), and the caller prepares
+  // one of its own.
+  Kept* take(const std::string& sql) {
     Kept& kept = prepared_[sql];
     if (kept.inUse) return nullptr;
     if (!kept.statement &&
         sqlite3_prepare_v3(db_, sql.c_str(), -1, SQLITE_PREPARE_PERSISTENT, &kept.statement, nullptr) != SQLITE_OK)
       return nullptr;
     kept.inUse = true;
-    return kept.statement;
+    return &kept;  // (an unordered_map's values stay where they are)
   }
-  void giveBack(sqlite3_stmt* statement) {
-    sqlite3_reset(statement);
-    sqlite3_clear_bindings(statement);
-    prepared_[sqlite3_sql(statement)].inUse = false;
+  static void giveBack(Kept& kept) {
+    sqlite3_reset(kept.statement);
+    sqlite3_clear_bindings(kept.statement);
+    kept.inUse = false;
   }
   sqlite3* db() const { return db_; }
 
  private:
-  struct Kept {
-    sqlite3_stmt* statement = nullptr;
-    bool inUse = false;
-  };
   sqlite3* db_;
   std::unordered_map<std::string, Kept> prepared_;
 };
@@ -111,16 +111,16 @@ class Statement {
   Statement(sqlite3* db, const char* sql) : db_(db) {
     if (sqlite3_prepare_v2(db, sql, -1, &statement_, nullptr) != SQLITE_OK) fail("prepare");
   }
-  Statement(StatementCache& cache, const std::string& sql) : db_(cache.db()), statement_(cache.take(sql)) {
-    if (statement_) {
-      cache_ = &cache;
+  Statement(StatementCache& cache, const std::string& sql) : db_(cache.db()), lent_(cache.take(sql)) {
+    if (lent_) {
+      statement_ = lent_->statement;
     } else if (sqlite3_prepare_v2(db_, sql.c_str(), -1, &statement_, nullptr) != SQLITE_OK) {
       fail("prepare");
     }
   }
   ~Statement() {
-    if (cache_) {
-      cache_->giveBack(statement_);
+    if (lent_) {
+      StatementCache::giveBack(*lent_);
     } else {
       sqlite3_finalize(statement_);
     }
@@ -168,7 +168,7 @@ class Statement {
 
   sqlite3* db_;
   sqlite3_stmt* statement_ = nullptr;
-  StatementCache* cache_ = nullptr;  // the cache's, given back when done; else finalized
+  StatementCache::Kept* lent_ = nullptr;  // the cache's, given back when done; else finalized
 };
 
 // One line for what SQLite said, in the words of what the daemon was doing.
