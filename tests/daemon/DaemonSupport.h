@@ -103,6 +103,12 @@ class Daemon {
       ::kill(pid_, SIGKILL);
       ::waitpid(pid_, nullptr, 0);
     }
+    // A failure that shows only in a loaded CI run is explained by what the daemon logged.
+    if (::testing::Test::HasFailure() && std::filesystem::exists(log())) {
+      const std::string text = readFile(log());
+      std::fprintf(stderr, "--- the daemon's log (its last 8 KB) ---\n%s\n",
+                   text.substr(text.size() > 8192 ? text.size() - 8192 : 0).c_str());
+    }
   }
   Daemon(const Daemon&) = delete;
   Daemon& operator=(const Daemon&) = delete;

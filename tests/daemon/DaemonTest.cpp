@@ -443,7 +443,8 @@ TEST(Daemon, ADeviceFaultFailsOnlyItsJobWithTheDevicesOwnMessage) {
   const long long good = daemon.clientJson("submit " + quoted(threeSheets()) + " --device good")["id"];
   for (long long id : {bad, good}) {
     ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
-    ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+    const CommandResult started = daemon.client(fmt::format("start {}", id));
+    ASSERT_EQ(started.status, 0) << started.err;
   }
   const json failed = daemon.waitForJob(bad, [](const json& j) { return state(j) == "failed"; });
   EXPECT_EQ(state(failed), "failed") << failed.dump();
