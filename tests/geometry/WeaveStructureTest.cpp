@@ -116,6 +116,80 @@ TEST(WeaveStructure, TheNeighbourNumberNamesAPanelUnderTheCrossing) {
   }
 }
 
+// A woven panel's centre line in space, row by row, in the order its rows
+// run along the thread (the strip's triangles (P_r, Q_r, P_r+1), (Q_r, Q_r+1, P_r+1)).
+std::vector<Point3> centreLine(const Panel& panel) {
+  const size_t rows = panel.surface.size() / 2 + 1;
+  std::vector<Point3> line;
+  for (size_t r = 0; r + 1 < rows; ++r) line.push_back(0.5 * (panel.surface[2 * r][0] + panel.surface[2 * r][1]));
+  line.push_back(0.5 * (panel.surface[2 * rows - 4][2] + panel.surface[2 * rows - 3][1]));
+  return line;
+}
+
+size_t nearestRow(const std::vector<Point3>& line, const Point3& p) {
+  size_t best = 0;
+  for (size_t r = 1; r < line.size(); ++r) {
+    if ((line[r] - p).squaredNorm() < (line[best] - p).squaredNorm()) best = r;
+  }
+  return best;
+}
+
+// The A12 rule (docs/WEAVE.md 1.12) from the panels alone: for the panel P
+// over edge e, N_e points from the panels under e up to P (the up ribbon
+// lies above them); the under thread runs from the down panel that ends at
+// e to the one that starts there; the underlined number is the one met
+// first turning counter-clockwise about N_e from the way P runs.
+TEST(WeaveStructure, TheNeighbourNumberIsTheUnderPanelMetFirstCounterClockwise) {
+  for (auto& [name, mesh] : std::vector<std::pair<const char*, PolygonMesh>>{
+           {"cube", cube()}, {"soccer ball", truncatedIcosahedron()}, {"torus", torus(9, 6)}}) {
+    SCOPED_TRACE(name);
+    const Structure s = wovenStructure(mesh);
+    // Where each panel meets edge e in space: the mean of its holes there.
+    const auto holesAt = [](const Panel& panel, int edge) {
+      Point3 sum = Point3::Zero();
+      int count = 0;
+      for (const PanelHole& hole : panel.holes) {
+        if (hole.edge != edge) continue;
+        const auto p = inSpace(panel, hole.xy);
+        if (p) sum += *p, ++count;
+      }
+      return count ? std::optional<Point3>(sum / count) : std::nullopt;
+    };
+    int checked = 0;
+    for (const Panel& over : s.panels) {
+      SCOPED_TRACE(over.id);
+      const int e = over.id;
+      const auto top = holesAt(over, e);
+      ASSERT_TRUE(top);
+      const std::vector<Point3> overLine = centreLine(over);
+      const size_t u = nearestRow(overLine, *top);
+      const Point3 overRuns = overLine[std::min(u + 1, overLine.size() - 1)] - overLine[u == 0 ? 0 : u - 1];
+      const Panel *before = nullptr, *after = nullptr;
+      Point3 underRuns = Point3::Zero(), normal = Point3::Zero();
+      for (const Panel& down : s.panels) {
+        if (&down == &over) continue;
+        const auto bottom = holesAt(down, e);
+        if (!bottom) continue;
+        normal += *top - *bottom;
+        const std::vector<Point3> line = centreLine(down);
+        const size_t r = nearestRow(line, *bottom);
+        // e at its last rows: the thread arrives at e on it.
+        (r > line.size() / 2 ? before : after) = &down;
+        underRuns += line[std::min(r + 1, line.size() - 1)] - line[r == 0 ? 0 : r - 1];
+      }
+      ASSERT_TRUE(before && after) << "edge " << e << " has no down panel on each side";
+      const int expected = overRuns.cross(underRuns).dot(normal) > 0 ? after->id : before->id;
+      int underlined = 0;
+      for (const PanelLabel& label : over.labels) {
+        if (label.role == LabelRole::Neighbor) underlined = label.edge;
+      }
+      EXPECT_EQ(underlined, expected) << "before " << before->id << ", after " << after->id;
+      ++checked;
+    }
+    EXPECT_EQ(checked, static_cast<int>(s.panels.size()));
+  }
+}
+
 TEST(WeaveStructure, TheHolesOfACrossingLineUpThroughItsThreePanels) {
   WeaveOptions options;
   for (auto& [name, mesh] : std::vector<std::pair<const char*, PolygonMesh>>{
