@@ -388,7 +388,7 @@ ClearedRibbons narrowUntilClear(const RotationSystem& rs, const WeaveThreads& we
   constexpr double kStep = 0.9, kNoLess = 0.98;
   // Not to nothing: a pair no width clears (faces folded sharply onto each
   // other) is left to the warning.
-  const double narrowest = shape.width / 4;
+  const double narrowest = narrowestUsefulWidth(shape);
   for (int round = 0;; ++round) {
     result.ribbons = weaveRibbons(rs, weave, regions, shape, result.edgeWidths);
     // First about each corner, where nearly all meet; every round after,

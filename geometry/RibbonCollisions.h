@@ -45,6 +45,10 @@ RibbonCollisions ribbonCollisions(const RotationSystem& rs, const WeaveThreads& 
 // when that is not less), and the weave is made again and looked at again,
 // everywhere, a few rounds at most. A dense weave (fig. 15) where the surface allows it, and no two
 // ribbons through each other where it does not.
+// The narrowest a ribbon is made, or worth advising, at `shape`'s width: a
+// quarter of it. Narrower ribbons leave their crossings no room for holes.
+inline double narrowestUsefulWidth(const RibbonShape& shape) { return shape.width / 4; }
+
 struct ClearedRibbons {
   std::vector<Ribbon> ribbons;
   std::vector<double> edgeWidths;  // w per edge, as the ribbons were made with

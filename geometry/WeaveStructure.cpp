@@ -740,14 +740,22 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     // Floored to what the option is written with (to the thousandth below 0.01, never up).
     const double digits = collisions.clearWidth >= 0.01 ? 100 : 1000;
     const double width = std::floor(collisions.clearWidth * digits) / digits;
-    result.warnings.push_back(fmt::format(
-        "{} pair{} of ribbons pass through each other ({}{}): {}", n, n == 1 ? "" : "s", some, n > 3 ? ", ..." : "",
-        width > 0 ? fmt::format("{} {:g} or less clears {}", options.names(Parameter::Width), width,
-                                n == 1 ? "it" : "them all")
-                  : fmt::format("no {} tried clears {} (the faces meet at too sharp an angle); a larger {} or a "
-                                "smoother mesh may",
-                                options.names(Parameter::Width), n == 1 ? "it" : "them all",
-                                options.names(Parameter::Offset))));
+    const std::string them = n == 1 ? "it" : "them all";
+    const std::string widthName = options.names(Parameter::Width);
+    // A width under the narrowest the ribbons are narrowed to leaves the
+    // crossings no room for their holes: no advice (it was 0.004 on CGAL's bull).
+    const std::string advice =
+        width >= narrowestUsefulWidth(options.shape)
+            ? fmt::format("{} {:g} or less clears {}", widthName, width, them)
+            : fmt::format(
+                  "{} (the faces meet at too sharp an angle): fewer and evener faces (--panels N), a smoother "
+                  "mesh or a larger {} may clear {}",
+                  width > 0 ? fmt::format("only {} {:g} or less clears {}, under a quarter of {:g}", widthName, width,
+                                          them, options.shape.width)
+                            : fmt::format("no {} tried clears {}", widthName, them),
+                  options.names(Parameter::Offset), n == 1 ? "it" : "them");
+    result.warnings.push_back(fmt::format("{} pair{} of ribbons pass through each other ({}{}): {}", n,
+                                          n == 1 ? "" : "s", some, n > 3 ? ", ..." : "", advice));
   }
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   result.fasteners = 0;

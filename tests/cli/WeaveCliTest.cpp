@@ -207,5 +207,37 @@ TEST(WeaveCli, AnOffsetOnTheScaleOfTheEdgesIsAWarningInTheJsonSummary) {
   EXPECT_NE(made.err.find("warning: " + warning + "\n"), std::string::npos) << made.err;
 }
 
+// The width a warning of ribbons that meet gives is one they can be built
+// at; where only a sliver of a ribbon would clear them (a wedge whose faces
+// meet at a fraction of a degree), it says so and what may help instead.
+TEST(WeaveCli, RibbonsThatMeetAreWarnedOfWithAWidthThatCanBeBuilt) {
+  TempDir dir;
+  const auto warningOf = [&](const std::filesystem::path& mesh) {
+    const CommandResult made = run(kCli + " make " + quoted(mesh) + " --structure weave --width 0.8 --layout rows " +
+                                   "--json --out " + quoted(dir.path() / mesh.stem()));
+    EXPECT_EQ(made.status, 0) << made.err;
+    for (const auto& warning : nlohmann::json::parse(made.out, nullptr, false).value("warnings", nlohmann::json())) {
+      if (warning.get<std::string>().find("pass through each other") != std::string::npos)
+        return warning.get<std::string>();
+    }
+    return std::string();
+  };
+  const std::string ball = warningOf(kSource / "examples/soccer-ball.obj");
+  const size_t at = ball.find("): --width 0.");
+  ASSERT_NE(at, std::string::npos) << ball;
+  EXPECT_GE(std::stod(ball.substr(at + 11)), 0.2) << ball;
+  EXPECT_NE(ball.find(" or less clears them all"), std::string::npos) << ball;
+  // A prism on a triangle 1 wide and 0.003 high: two faces at 0.17 degrees.
+  const std::filesystem::path wedge = dir.path() / "wedge.obj";
+  std::ofstream(wedge) << "v 0 0 0\nv 1 0 0\nv 0 0 0.003\nv 0 1 0\nv 1 1 0\nv 0 1 0.003\n"
+                          "f 1 3 2\nf 4 5 6\nf 1 2 5 4\nf 2 3 6 5\nf 3 1 4 6\n";
+  const std::string sharp = warningOf(wedge);
+  EXPECT_NE(sharp.find(": only --width 0."), std::string::npos) << sharp;
+  EXPECT_NE(sharp.find("under a quarter of 0.8 (the faces meet at too sharp an angle): fewer and evener faces "
+                       "(--panels N), a smoother mesh or a larger --offset may clear them"),
+            std::string::npos)
+      << sharp;
+}
+
 }  // namespace
 }  // namespace rotafab::test
