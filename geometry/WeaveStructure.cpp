@@ -205,10 +205,12 @@ struct RowSpan {
 // some of its rows is the same as theirs in the whole), so its holes and
 // labels stay where they are, each on the part whose rows hold it (a hole
 // in a lap on both). The part over the panel's edge stays the panel; the
-// others become its pieces, "17a", "17b". Leaves the panel as it was when no
-// cut gives parts that keep their holes' clearance and hold their labels.
+// others become its pieces, "17a", "17b", each with its name etched on it
+// (as a band's piece on its tab; `unfitted` names those it does not fit).
+// Leaves the panel as it was when no cut gives parts that keep their holes'
+// clearance and hold their labels.
 void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRows, const std::vector<int>& labelRows,
-              double diameter) {
+              double diameter, const HersheyFont& font, std::vector<std::string>& unfitted) {
   constexpr int kLongestLap = 4, kCuts = 2;
   std::vector<RowSpan> spans{{0, w.rows() - 1}};
   std::vector<int> laps;  // the row of each cut's hole
@@ -319,6 +321,26 @@ void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRow
   panel.holes = holesOf(*main);
   panel.labels = labelsOf(*main);
   panel.area = w.areaOfRows(main->first, main->last);
+  // A piece's name, from its middle row outwards, reading along the thread
+  // there (a piece is short: its rows turn little), clear of its holes and labels.
+  const auto pieceName = [&](const RowSpan& span, const PanelPiece& piece) -> std::optional<PanelLabel> {
+    std::vector<Circle> circles;
+    for (const PanelHole& hole : piece.holes) circles.push_back({hole.xy, hole.diameter / 2});
+    std::vector<TextBox> taken;
+    for (const PanelLabel& label : piece.labels) taken.push_back(label.box);
+    const int middle = (span.first + span.last) / 2;
+    std::vector<int> rows{middle};
+    for (int k = 1; middle - k >= span.first || middle + k <= span.last; ++k) {
+      for (int row : {middle - k, middle + k}) {
+        if (row >= span.first && row <= span.last) rows.push_back(row);
+      }
+    }
+    const auto box = fitText(font, piece.name, angleAtRow(w, middle), piece.outline, piece.outline, circles, taken,
+                             labelCandidates(w, rows));
+    if (!box) return std::nullopt;
+    return PanelLabel{piece.name, 0, LabelRole::Piece, *box,
+                      font.strokes(piece.name, box->origin, box->height, box->angle)};
+  };
   char letter = 'a';
   for (auto span = spans.begin(); span != spans.end(); ++span) {
     if (span == main) continue;
@@ -330,6 +352,11 @@ void cutApart(const WovenPanel& w, Panel& panel, const std::vector<int>& holeRow
     piece.labels = labelsOf(*span);
     piece.area = w.areaOfRows(span->first, span->last);
     piece.fastening = PieceFastening::Tab;
+    if (auto name = pieceName(*span, piece)) {
+      piece.labels.push_back(std::move(*name));
+    } else {
+      unfitted.push_back(fmt::format("piece {}", piece.name));
+    }
     panel.pieces.push_back(std::move(piece));
   }
 }
@@ -660,7 +687,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
       place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach, labelCandidates(w, rows));
     }
     if (core::crossesItself(panel.outline)) {
-      cutApart(w, panel, holeRowsOf[i], labelRows, d);
+      cutApart(w, panel, holeRowsOf[i], labelRows, d, font, unfittedOf[i]);
       stillFolded[k] = core::crossesItself(panel.outline) ? 1 : 0;
     }
     result.panels[k] = std::move(panel);

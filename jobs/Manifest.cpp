@@ -191,11 +191,14 @@ nlohmann::ordered_json panelEntry(const geometry::Structure& structure, size_t i
   };
   entry["holes"] = nlohmann::ordered_json::array();
   for (const auto& hole : panel.holes) entry["holes"].push_back(holeEntry(hole));
-  // The number each label shows (without the mark of 6 and 9): an edge's, or the panel's own.
+  // What each label shows (without the mark of 6 and 9): an edge's number,
+  // the panel's own, or a piece's name ("17a").
   const auto labelsJson = [&](const std::vector<geometry::PanelLabel>& labels) {
     nlohmann::ordered_json list = nlohmann::ordered_json::array();
     for (const auto& label : labels) {
-      nlohmann::ordered_json l = {{"text", label.edge > 0 ? std::to_string(label.edge) : std::to_string(panel.id)}};
+      nlohmann::ordered_json l = {{"text", label.role == geometry::LabelRole::Piece ? label.text
+                                           : label.edge > 0                         ? std::to_string(label.edge)
+                                                                                    : std::to_string(panel.id)}};
       if (label.edge > 0) l["edge"] = label.edge;
       l["role"] = geometry::roleName(label.role);
       list.push_back(l);

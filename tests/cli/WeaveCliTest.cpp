@@ -45,7 +45,17 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
     // with a hole of its own (edge 0).
     std::vector<const nlohmann::json*> parts{&p};
     if (p.contains("pieces")) {
-      for (const auto& piece : p.at("pieces")) parts.push_back(&piece);
+      for (const auto& piece : p.at("pieces")) {
+        parts.push_back(&piece);
+        // Its name etched on it, so that the builder knows whose piece it is.
+        int named = 0;
+        for (const auto& label : piece.value("labels", nlohmann::json::array())) {
+          if (label.at("role") != "piece") continue;
+          ++named;
+          EXPECT_EQ(label.at("text"), piece.at("name"));
+        }
+        EXPECT_EQ(named, 1) << piece.at("name");
+      }
     }
     std::map<int, int> mine;
     for (const auto* part : parts) {

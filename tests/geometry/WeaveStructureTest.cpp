@@ -277,6 +277,18 @@ TEST(WeaveStructure, APanelThatWouldOverlapItselfIsCutIntoLappedPiecesThatDoNot)
       EXPECT_GT(core::signedArea(piece.outline), 0);
       EXPECT_EQ(piece.fastening, PieceFastening::Tab);
       for (const PanelHole& hole : piece.holes) laps += hole.edge == 0 ? 1 : 0;
+      // Its name etched on it, inside it and clear of its holes, so that
+      // the builder can tell whose piece it is.
+      int named = 0;
+      for (const PanelLabel& label : piece.labels) {
+        if (label.role != LabelRole::Piece) continue;
+        ++named;
+        EXPECT_EQ(label.text, piece.name);
+        EXPECT_FALSE(label.strokes.empty());
+        for (const Point2& corner : label.box.corners()) EXPECT_TRUE(core::insidePolygon(piece.outline, corner));
+        for (const PanelHole& hole : piece.holes) EXPECT_GT(label.box.distanceTo(hole.xy), hole.diameter / 2);
+      }
+      EXPECT_EQ(named, 1) << piece.name;
     }
   }
   EXPECT_GT(pieces, 0);
