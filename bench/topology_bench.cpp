@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "core/HugePageHeap.h"
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
 #include "geometry/CoplanarMerge.h"
@@ -281,6 +282,8 @@ BENCHMARK(BM_MakeBand)
 }  // namespace
 
 int main(int argc, char** argv) {
+  // As the program does: the structures' heap in huge pages.
+  rotafab::core::startAgainWithHugePageHeap(argv);
   if (argc == 4 && std::string(argv[1]) == "write-mesh") {
     std::ofstream out(argv[3], std::ios::binary);
     geo::writeObj(out, triangulatedTorus(std::stol(argv[2])), "rotafab benchmark mesh: triangulated torus");

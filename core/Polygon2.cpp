@@ -131,7 +131,9 @@ std::vector<Point2> simplifiedLine(const std::vector<Point2>& points, double tol
       runs.emplace_back(at, last);
     }
   }
+  // Sized exactly: a large job's sheets keep every simplified line at once.
   std::vector<Point2> out;
+  out.reserve(static_cast<size_t>(std::count(kept.begin(), kept.end(), 1)));
   for (size_t i = 0; i < n; ++i) {
     if (kept[i]) out.push_back(points[i]);
   }

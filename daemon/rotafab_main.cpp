@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/HugePageHeap.h"
 #include "daemon/DevicesCommand.h"
 #include "daemon/ExitCode.h"
 #include "daemon/InspectCommand.h"
@@ -50,6 +51,8 @@ int usageError(const std::string& message, const std::string& help) {
 
 int main(int argc, char** argv) {
   using namespace rotafab::cli;
+  // Large jobs' first touches of their heap, in huge pages (core/HugePageHeap.h).
+  rotafab::core::startAgainWithHugePageHeap(argv);
   CLI::App app{"rotafab: turn a 3D mesh into numbered laser-cut panels (Xing 2011), and run the cutter"};
   app.set_version_flag("--version", "rotafab 0.1.0");
   app.require_subcommand(1);

@@ -110,6 +110,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
       for (const Polyline2& stroke : strokes) {
         if (stroke.size() < 2) continue;
         DrawnPath path{operation, {}, closed, partId(parts[placed.part].name)};
+        path.points.reserve(stroke.size());
         for (const Point2& p : stroke) path.points.push_back(onSheet(placed, p));
         path.points = core::simplifiedLine(path.points, kSheetSimplification, closed);
         sheet.paths.push_back(std::move(path));
