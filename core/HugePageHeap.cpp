@@ -15,6 +15,8 @@ void startAgainWithHugePageHeap(char** argv) {
   const char* set = std::getenv("GLIBC_TUNABLES");
   const std::string tunables = set ? set : "";
   if (tunables.find(kTunable) != std::string::npos) return;
+  // Under a tool that preloads itself (valgrind, heaptrack), the program as it was started.
+  if (const char* preload = std::getenv("LD_PRELOAD"); preload && *preload) return;
   std::ifstream mode("/sys/kernel/mm/transparent_hugepage/enabled");
   const std::string modes((std::istreambuf_iterator<char>(mode)), std::istreambuf_iterator<char>());
   if (modes.find("[madvise]") == std::string::npos) return;

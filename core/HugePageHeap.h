@@ -12,9 +12,11 @@ namespace rotafab::core {
 // starts; so the program is started again at once, the same process (the
 // same pid, arguments and descriptors), with that tunable added to
 // GLIBC_TUNABLES. Nothing happens when GLIBC_TUNABLES already names it
-// (the second start, or a person's own choice), when the kernel's mode is
-// not "madvise" (under "always" the heap has them already; under "never"
-// it cannot), or when the start fails: the program goes on as it was.
+// (the second start, or a person's own choice), under a tool that preloads
+// a library (valgrind, heaptrack: valgrind would not follow the start), when
+// the kernel's mode is not "madvise" (under "always" the heap has them
+// already; under "never" it cannot), or when the start fails: the program
+// goes on as it was.
 // Call first thing in main(), before any thread starts.
 void startAgainWithHugePageHeap(char** argv);
 

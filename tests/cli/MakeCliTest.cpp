@@ -848,5 +848,39 @@ TEST(MakeCli, InterruptStopsAtOnceAndWritesNothing) {
   }
 }
 
+// A large job's heap on huge pages where the kernel gives them on request
+// (core/HugePageHeap.h): the program started again with glibc's tunable, and
+// huge pages in its memory as it nests; not where the person refused them.
+TEST(MakeCli, TheHeapIsOnHugePagesWhereTheKernelGivesThemOnRequest) {
+  if (readFile("/sys/kernel/mm/transparent_hugepage/enabled").find("[madvise]") == std::string::npos) {
+    GTEST_SKIP() << "the kernel's transparent huge pages are not in madvise mode";
+  }
+  for (const std::string tunables : {"", "glibc.malloc.hugetlb=0"}) {
+    SCOPED_TRACE(tunables);
+    TempDir dir;
+    const auto err = dir.path() / "err";
+    const CommandResult r =
+        run("(env -u LD_PRELOAD GLIBC_TUNABLES=" + tunables + " " + kCli + " make " +
+            quoted(kSource / "examples/bunny.obj") + " --structure band --out " + quoted(dir.path() / "bunny") +
+            " 2> " + quoted(err) + " & pid=$!; for i in $(seq 600); do grep -q 'nesting: first layout' " + quoted(err) +
+            " && break; sleep 0.05; done; tr '\\0' '\\n' < /proc/$pid/environ | grep '^GLIBC_TUNABLES='; "
+            "grep '^AnonHugePages:' /proc/$pid/smaps_rollup; kill -INT $pid; wait $pid)");
+    EXPECT_EQ(r.status, 130) << r.err;
+    std::istringstream lines(r.out);
+    std::string environment, label;
+    long kilobytes = -1;
+    lines >> environment >> label >> kilobytes;
+    if (tunables.empty()) {
+      EXPECT_EQ(environment, "GLIBC_TUNABLES=glibc.malloc.hugetlb=1") << r.out;
+#ifndef ROTAFAB_SANITIZED  // (the sanitizer's allocator is not glibc's)
+      EXPECT_GT(kilobytes, 0) << r.out;
+#endif
+    } else {
+      EXPECT_EQ(environment, "GLIBC_TUNABLES=" + tunables) << r.out;
+      EXPECT_EQ(kilobytes, 0) << r.out;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rotafab::test
