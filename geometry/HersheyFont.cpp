@@ -129,7 +129,11 @@ std::vector<Polyline> HersheyFont::strokes(std::string_view text, Point2 origin,
   const Eigen::Vector2d along(std::cos(angleRadians), std::sin(angleRadians));
   const Eigen::Vector2d up(-along.y(), along.x());
 
+  // Sized exactly: a large weave keeps a million of these.
+  size_t count = 0;
+  for (size_t i = 0; i < text.size(); ++i) count += glyphFor(text, i).strokes.size();
   std::vector<Polyline> out;
+  out.reserve(count);
   double pen = 0;  // font units along the baseline
   for (size_t i = 0; i < text.size(); ++i) {
     const Glyph& glyph = glyphFor(text, i);

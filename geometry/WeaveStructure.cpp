@@ -598,11 +598,13 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     panel.outline = outlines[i];
     panel.holes = holesOf[i];
     panel.area = w.area;
-    for (int r = 0; r + 1 < w.rows(); ++r) {
-      panel.surface.push_back(
-          {w.railP[static_cast<size_t>(r)], w.railQ[static_cast<size_t>(r)], w.railP[static_cast<size_t>(r + 1)]});
-      panel.surface.push_back(
-          {w.railQ[static_cast<size_t>(r)], w.railQ[static_cast<size_t>(r + 1)], w.railP[static_cast<size_t>(r + 1)]});
+    // A quad per row, (P_r+1, P_r, Q_r, Q_r+1): its fan from the first
+    // corner is the strip's two triangles (P_r, Q_r, P_r+1), (Q_r, Q_r+1,
+    // P_r+1), as they were unfolded; half the polygons of two triangles
+    // (a 50,000-face weave keeps 3.6 million rows).
+    panel.surface.reserve(static_cast<size_t>(std::max(0, w.rows() - 1)));
+    for (size_t r = 0; r + 1 < w.railP.size(); ++r) {
+      panel.surface.push_back({w.railP[r + 1], w.railP[r], w.railQ[r], w.railQ[r + 1]});
     }
     // Joins: under it at its up crossing, and over it and on its own thread at each end.
     const CrossingPanels& atUp = crossings[static_cast<size_t>(w.upEdge)];

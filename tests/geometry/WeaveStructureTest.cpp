@@ -24,14 +24,15 @@ namespace rotafab::geometry {
 namespace {
 
 // A flat point of a woven panel back in space: the panel's outline is one
-// rail forwards and the other backwards, row by row, and its surface the
-// strip's triangles in row order (P_r, Q_r, P_r+1), (Q_r, Q_r+1, P_r+1).
+// rail forwards and the other backwards, row by row, and its surface a quad
+// per row, (P_r+1, P_r, Q_r, Q_r+1), whose fan from its first corner is the
+// strip's triangles (P_r, Q_r, P_r+1), (Q_r, Q_r+1, P_r+1).
 std::optional<Point3> inSpace(const Panel& panel, const Point2& xy) {
   const size_t rows = panel.outline.size() / 2;
   std::vector<Point2> a(panel.outline.begin(), panel.outline.begin() + static_cast<long>(rows));
   std::vector<Point2> b(panel.outline.rbegin(), panel.outline.rbegin() + static_cast<long>(rows));
   // Which flat rail is P: the one whose first side is as long as P's in space.
-  const Point3 &p0 = panel.surface[0][0], &p1 = panel.surface[0][2];
+  const Point3 &p0 = panel.surface[0][1], &p1 = panel.surface[0][0];
   if (std::abs((a[1] - a[0]).norm() - (p1 - p0).norm()) > std::abs((b[1] - b[0]).norm() - (p1 - p0).norm())) {
     std::swap(a, b);
   }
@@ -42,7 +43,9 @@ std::optional<Point3> inSpace(const Panel& panel, const Point2& xy) {
       const double area = core::cross(f[1] - f[0], f[2] - f[0]);
       const double w1 = core::cross(xy - f[0], f[2] - f[0]) / area, w2 = core::cross(f[1] - f[0], xy - f[0]) / area;
       if (w1 < -1e-9 || w2 < -1e-9 || w1 + w2 > 1 + 1e-9) continue;
-      const auto& s = panel.surface[2 * r + t];
+      const auto& q = panel.surface[r];
+      const std::array<Point3, 3> s =
+          t == 0 ? std::array<Point3, 3>{q[1], q[2], q[0]} : std::array<Point3, 3>{q[2], q[3], q[0]};
       return (1 - w1 - w2) * s[0] + w1 * s[1] + w2 * s[2];
     }
   }
@@ -117,12 +120,11 @@ TEST(WeaveStructure, TheNeighbourNumberNamesAPanelUnderTheCrossing) {
 }
 
 // A woven panel's centre line in space, row by row, in the order its rows
-// run along the thread (the strip's triangles (P_r, Q_r, P_r+1), (Q_r, Q_r+1, P_r+1)).
+// run along the thread (its quads (P_r+1, P_r, Q_r, Q_r+1)).
 std::vector<Point3> centreLine(const Panel& panel) {
-  const size_t rows = panel.surface.size() / 2 + 1;
   std::vector<Point3> line;
-  for (size_t r = 0; r + 1 < rows; ++r) line.push_back(0.5 * (panel.surface[2 * r][0] + panel.surface[2 * r][1]));
-  line.push_back(0.5 * (panel.surface[2 * rows - 4][2] + panel.surface[2 * rows - 3][1]));
+  for (const auto& q : panel.surface) line.push_back(0.5 * (q[1] + q[2]));
+  line.push_back(0.5 * (panel.surface.back()[0] + panel.surface.back()[3]));
   return line;
 }
 
