@@ -22,6 +22,7 @@ jobs::MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileC
                             : request.structure == geometry::StructureKind::Weave ? "fill"
                                                                                   : "keep";
   request.holes = holes == "fill"    ? jobs::HolesMode::Fill
+                  : holes == "patch" ? jobs::HolesMode::Patch
                   : holes == "error" ? jobs::HolesMode::Error
                                      : jobs::HolesMode::Keep;
   request.repair = options.repair == "auto";
@@ -93,7 +94,8 @@ void checkStructureOptions(const CLI::App& make, const MakeOptions& options) {
   if (weave && options.holes == "keep") {
     throw CLI::ValidationError(
         "--holes keep: a plain weave crosses every edge, and a boundary edge has one side; fill (the default for "
-        "weave) caps each hole with a face, error refuses an open mesh");
+        "weave) caps each hole with a face, patch closes it with triangles like the mesh's own, error refuses an "
+        "open mesh");
   }
 }
 
@@ -112,9 +114,10 @@ void addMakeOptions(CLI::App& make, MakeOptions& options) {
   auto* size = make.add_option("--size", options.size, "Scale so that the largest bounding-box side is this long");
   make.add_option("--scale", options.scale, "Scale the mesh by this factor (inches per mesh unit)")->excludes(size);
   make.add_option("--holes", options.holes,
-                  "Open meshes: keep the boundary open (the default for band), fill each hole with a face (the "
-                  "default for weave), or refuse")
-      ->check(CLI::IsMember({"keep", "fill", "error"}));
+                  "Open meshes: keep the boundary open (the default for band), fill each hole with one face (the "
+                  "default for weave), patch it with triangles as long as its edges (for a wide or bent hole, "
+                  "whose one face would make a weave's panels as wide as the hole), or error: refuse")
+      ->check(CLI::IsMember({"keep", "fill", "patch", "error"}));
   make.add_option("--repair", options.repair,
                   "auto: weld, drop duplicate faces, split non-manifold edges and bow-tie vertices, orient (each "
                   "repair said and recorded in manifest.json); none: refuse a broken mesh")

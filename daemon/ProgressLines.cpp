@@ -16,6 +16,8 @@ void ProgressLines::operator()(const core::Progress& p) {
   std::string line;
   if (p.phase == "import" && p.step == "holes filled") {
     line = fmt::format("filled {} hole{} with one face each", p.done, plural(p.done));
+  } else if (p.phase == "import" && p.step == "holes patched") {
+    line = fmt::format("closed {} hole{} with triangles like the mesh's own", p.done, plural(p.done));
   } else if (p.phase == "geometry") {
     if (p.step == "band decomposition") line = fmt::format("band decomposition of {} faces", p.total);
     if (p.step == "panels split") {

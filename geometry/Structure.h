@@ -126,6 +126,14 @@ struct Structure {
 // and a band's half cut off either panel goes on with the join of its edge.
 std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
 
+// Each panel turned in its own frame so that its outline's least-area
+// bounding box (Freeman and Shapira, CACM 1975: one of its sides lies along
+// a side of the convex hull) is axis-aligned, its longer side along x: the
+// frame a nester's quarter turns and a row of boxes waste least room in (a
+// woven panel lay at any angle, its box twice its least on average). Its
+// outline, holes, labels, pieces and scores all turn together.
+void layPanelsAlongTheirLeastBoxes(std::vector<Panel>& panels, const core::WorkContext& context);
+
 // The panels' 3D surfaces as one mesh, polygon by polygon, each panel's
 // polygons sharing their common corners (panels share none).
 PolygonMesh surfaceMesh(const Structure& structure);

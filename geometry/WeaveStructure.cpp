@@ -520,7 +520,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     // whole structure grow for a sliver: the mesh grows only as far as all
     // but those need.
     const size_t mayGlue = static_cast<size_t>(result.edges) / 100;
-    if (withoutRoom > 0 && static_cast<size_t>(withoutRoom) <= mayGlue) {
+    if (withoutRoom > 0 && (options.glueCrossingsWithoutRoom || static_cast<size_t>(withoutRoom) <= mayGlue)) {
       for (size_t e = 0; e < crossingCount; ++e) {
         if (crossings[e].panel[0] >= 0 && holes[e].clearance < kLeastClearance) {
           glued[e] = 1;
@@ -792,6 +792,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     if (crossings[e].panel[0] >= 0 && !glued[e]) result.fasteners += holes[e].single ? 1 : 2;
   }
   for (const Panel& panel : result.panels) result.fasteners += static_cast<int>(panel.pieces.size());
+  layPanelsAlongTheirLeastBoxes(result.panels, context);
   result.steps = weaveSteps(result.panels);
   return result;
 }

@@ -31,7 +31,11 @@ struct WeaveOptions {
   // warn of them.
   bool narrowWhereRibbonsMeet = true;
   double fastener = 0.125;  // hole diameter, inches
-  int up = 1;               // the vertical axis for "lowest": 0 x, 1 y, 2 z
+  // Glue every crossing without room for its holes (with a warning), not
+  // only one in a hundred: when the size at which they have room would not
+  // fit the bed (MakeJob's sizing, as a band decomposition's).
+  bool glueCrossingsWithoutRoom = false;
+  int up = 1;  // the vertical axis for "lowest": 0 x, 1 y, 2 z
   ParameterNames names = parameterInWords;
 };
 

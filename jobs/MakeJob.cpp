@@ -146,12 +146,13 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   if (const int loops = analysis.topology.boundaryLoops; loops > 0) {
     if (request.holes == HolesMode::Error) {
       // (A weave crosses every edge: a boundary edge has no second side to cross to.)
-      throw core::UserError(fmt::format("{}: the surface is open ({} boundary loop{}); {} {} builds it", name, loops,
-                                        plural(loops), request.names(Parameter::Holes),
-                                        request.structure == geometry::StructureKind::Weave ? "fill" : "keep or fill"));
+      throw core::UserError(
+          fmt::format("{}: the surface is open ({} boundary loop{}); {} {} builds it", name, loops, plural(loops),
+                      request.names(Parameter::Holes),
+                      request.structure == geometry::StructureKind::Weave ? "fill or patch" : "keep, fill or patch"));
     }
-    if (request.holes == HolesMode::Fill) {
-      geometry::fillHoles(mesh);
+    if (request.holes == HolesMode::Fill || request.holes == HolesMode::Patch) {
+      request.holes == HolesMode::Fill ? geometry::fillHoles(mesh) : geometry::patchHoles(mesh);
       analysis = geometry::analyzeMesh(mesh);
       try {
         geometry::requireUsable(analysis);
@@ -159,7 +160,8 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
         throw core::UserError(
             fmt::format("{}: with its {} hole{} filled: {}", name, loops, plural(loops), error.what()));
       }
-      context.report({"import", "holes filled", static_cast<size_t>(loops), 0});
+      context.report({"import", request.holes == HolesMode::Fill ? "holes filled" : "holes patched",
+                      static_cast<size_t>(loops), 0});
     }
   }
   // After the holes are filled, so that their caps are among the faces counted.
@@ -219,6 +221,19 @@ struct Sizing {
 // ribbons follow the surface within the offset, so --size scales the mesh;
 // with no size or scale given it grows until every crossing has room for
 // its two holes.
+// What to add to a refusal when the mesh's holes were capped with one face
+// each: such a cap across a wide or bent hole folds back over its
+// neighbours or makes panels as wide as the hole, and a patch avoids it.
+std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh) {
+  const bool capped = request.holes == HolesMode::Fill &&
+                      std::find(mesh.sourceFace.begin(), mesh.sourceFace.end(), -1) != mesh.sourceFace.end();
+  return capped ? fmt::format(
+                      " (its holes are capped with one face each: {} patch closes them with triangles like "
+                      "the mesh's own)",
+                      request.names(Parameter::Holes))
+                : "";
+}
+
 geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
                                const core::WorkContext& context) {
   const std::string name = request.mesh.string();
@@ -244,6 +259,38 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
     if (request.size || request.scale) return geometry::buildWeaveStructure(mesh, weave, context);
     geometry::GrownStructure built = geometry::buildWeaveStructureWithRoom(mesh, weave, context);
     sizing.grown = built.grown;
+    const double kerf = request.kerf.value_or(request.material.kerf);
+    if (built.grown > 1 && roomOnTheBed(structureParts(built.structure), request.machine, kerf) < 1) {
+      // The size at which every crossing has room makes a panel larger than
+      // the bed (a mesh whose faces differ much in size): as for a band
+      // decomposition, the largest size that fits the bed, no smaller than
+      // the default, and the crossings without room there glued.
+      weave.glueCrossingsWithoutRoom = true;
+      constexpr int kShrinkAttempts = 3;
+      const double defaultSide = geometry::boundingBoxSize(mesh).maxCoeff() / built.grown;
+      const auto grownBy = [&] { return geometry::boundingBoxSize(mesh).maxCoeff() / defaultSide; };
+      geometry::Structure glued;
+      for (int attempt = 1; attempt <= kShrinkAttempts && grownBy() > 1; ++attempt) {
+        const double room = roomOnTheBed(structureParts(attempt == 1 ? built.structure : glued), request.machine, kerf);
+        if (room >= 1) break;
+        // (1% to spare: a label's size does not grow with the rest)
+        const double shrink = std::max(0.99 * room, 1 / grownBy());
+        for (geometry::Point3& p : mesh.positions) p *= shrink;
+        context.report({"geometry", "smaller, for the bed", static_cast<size_t>(attempt), 0});
+        glued = geometry::buildWeaveStructure(mesh, weave, context);
+      }
+      sizing.grown = grownBy();
+      sizing.bedLimited = true;
+      context.note(fmt::format(
+          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the largest size that fits the bed, below the {:.2f} "
+          "in at which every crossing has room for {:.3f} in fastener holes; {} crossing{} without room {} glued; {} "
+          "N, fewer and evener faces, needs less",
+          name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches,
+          geometry::kMeanEdgeInches * built.grown, weave.fastener, glued.glued.size(),
+          plural(static_cast<int>(glued.glued.size())), glued.glued.size() == 1 ? "is" : "are",
+          request.names(Parameter::Panels)));
+      return glued;
+    }
     if (built.grown > 1) {
       context.note(fmt::format(
           "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the smallest size at which its crossings have room "
@@ -259,7 +306,7 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
     throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
                                       roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing", true)));
   } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    throw core::UserError(fmt::format("{}: {}{}", name, error.what(), oneFaceCapAdvice(request, mesh)));
   }
 }
 
@@ -468,14 +515,15 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
     job.sheets = planSheets(structureParts(job.structure), request.machine, plan, context);
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format(
-        "{}: {}{}", name, error.what(),
+        "{}: {}{}{}", name, error.what(),
         sizing.grown > 1 && !sizing.bedLimited
             ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
                           "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
                           sizing.grown, request.structure == geometry::StructureKind::Weave ? "crossing" : "band",
                           request.structure == geometry::StructureKind::Weave ? " holes" : "",
                           request.names(Parameter::Fastener), request.names(Parameter::Panels))
-            : ""));
+            : "",
+        oneFaceCapAdvice(request, mesh)));
   }
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;

@@ -26,8 +26,9 @@
 
 namespace rotafab::jobs {
 
-// SPEC's --holes: leave the boundary open, fill each hole, or refuse an open mesh.
-enum class HolesMode { Keep, Fill, Error };
+// SPEC's --holes: leave the boundary open, cap each hole with one face, close
+// it with a patch of triangles like the mesh's own, or refuse an open mesh.
+enum class HolesMode { Keep, Fill, Patch, Error };
 
 // A woven ribbon's least offset over or under the surface, inches: paper's thickness.
 constexpr double kLeastOffset = 0.01;

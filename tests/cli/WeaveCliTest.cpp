@@ -5,8 +5,10 @@
 // steps thread by thread; single-cycle weaves; open meshes filled by
 // default; the weave's options refused with band and band's with weave.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -22,8 +24,14 @@ namespace {
 // in order, panel k from edge k of cycle >= 1, on a sheet; `up` k on panel
 // k alone and each edge `down` on two panels; two holes (or one) of each of
 // its three crossings, the same count on the three panels of a crossing,
-// none nearer its outline than a diameter. Returns the cycles.
-std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
+// none nearer its outline than a diameter. Returns the cycles. With
+// `lapses`, what make warns of is counted there instead: crossings with no
+// holes on any of their panels (no room for them: glued), and up and down
+// numbers not etched (no room for them on a narrowed ribbon).
+struct Lapses {
+  size_t glued = 0, unlabelled = 0;
+};
+std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels, Lapses* lapses = nullptr) {
   EXPECT_EQ(m.at("structure"), "weave");
   EXPECT_EQ(m.at("panels").size(), panels);
   std::map<int, int> up, down;
@@ -73,7 +81,8 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
     }
     // Its own edge and the two at its ends (one of them its own edge again
     // where a single thread goes round a leaf face of its tree).
-    EXPECT_GE(mine.size(), 2U) << "panel " << id;
+    // (A panel whose crossings are glued has fewer: the crossings' holes are counted below.)
+    if (lapses == nullptr) EXPECT_GE(mine.size(), 2U) << "panel " << id;
     EXPECT_LE(mine.size(), 3U) << "panel " << id;
     for (const auto& [edge, count] : mine) holesAt[edge].push_back(count);
     // No hole's centre nearer than a diameter to its part's outline.
@@ -82,16 +91,25 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels) {
       for (const auto& hole : part->at("holes")) {
         const double nearest = distanceToOutline(outline, hole.at("xy")[0], hole.at("xy")[1]);
         EXPECT_TRUE(insideOutline(outline, hole.at("xy")[0], hole.at("xy")[1])) << "panel " << id;
-        EXPECT_GE(nearest, hole.at("diameter").get<double>() - 1e-9) << "panel " << id;
+        // (The outline as written is within 0.0002 in of the planned one, SPEC.)
+        EXPECT_GE(nearest, hole.at("diameter").get<double>() - 2e-4) << "panel " << id;
       }
     }
   }
   for (int e = 1; e <= static_cast<int>(panels); ++e) {
-    EXPECT_EQ(up[e], 1) << "edge " << e;
-    EXPECT_EQ(down[e], 2) << "edge " << e;
+    if (lapses != nullptr && up[e] <= 1 && down[e] <= 2) {
+      lapses->unlabelled += static_cast<size_t>(3 - up[e] - down[e]);
+    } else {
+      EXPECT_EQ(up[e], 1) << "edge " << e;
+      EXPECT_EQ(down[e], 2) << "edge " << e;
+    }
     // Three panels of as many holes each, two of them maybe one panel.
     int holes = 0;
     for (int count : holesAt[e]) holes += count;
+    if (lapses != nullptr && holes == 0) {
+      ++lapses->glued;
+      continue;
+    }
     EXPECT_TRUE(holes == 3 || holes == 6) << "edge " << e << ": " << holes << " holes";
     EXPECT_TRUE(holesAt[e].size() == 3 || holesAt[e].size() == 2) << "edge " << e;
     // As many on each of the three (two of them one panel: twice as many on it).
@@ -177,8 +195,75 @@ TEST(WeaveCli, AnOpenMeshIsFilledByDefaultAndKeepingItsHolesIsRefused) {
   EXPECT_NE(kept.err.find("--holes keep: a plain weave crosses every edge"), std::string::npos) << kept.err;
   const CommandResult refused = run(kCli + " make " + quoted(open) + " --structure weave --holes error");
   EXPECT_EQ(refused.status, 1);
-  EXPECT_NE(refused.err.find("the surface is open (1 boundary loop); --holes fill builds it"), std::string::npos)
+  EXPECT_NE(refused.err.find("the surface is open (1 boundary loop); --holes fill or patch builds it"),
+            std::string::npos)
       << refused.err;
+}
+
+// What the manifest lacks, make said: the crossings glued (edge numbers
+// "glue them (edges 12, 40, ...)") and the labels not etched, as many.
+void expectLapsesWarned(const std::string& err, const Lapses& lapses) {
+  if (lapses.glued > 0) {
+    EXPECT_NE(err.find(fmt::format("{} crossings have no room", lapses.glued)), std::string::npos) << err;
+  }
+  if (lapses.unlabelled > 0) {
+    const auto at = err.find(" labels are not etched");
+    ASSERT_NE(at, std::string::npos) << err;
+    const auto start = err.rfind(' ', at - 1) + 1;
+    EXPECT_GE(std::stoul(err.substr(start, at - start)), lapses.unlabelled) << err;
+  }
+}
+
+// CGAL's half cylinder: one face across its open side (two half circles
+// and two straight sides) turns against the arch beside it, and the weave
+// is refused, pointing to a patch; patched, it weaves.
+TEST(WeaveCli, ABentHoleThatOneFaceCannotCloseIsWovenPatched) {
+  TempDir dir;
+  const std::string cylinder = quoted(publicMesh(cgalMesh("cylinder.off")));
+  const CommandResult capped = run(kCli + " make " + cylinder + " --structure weave --out " + quoted(dir.path() / "a"));
+  EXPECT_EQ(capped.status, 1);
+  EXPECT_NE(capped.err.find("its two faces fold back onto each other"), std::string::npos) << capped.err;
+  EXPECT_NE(capped.err.find("(its holes are capped with one face each: --holes patch closes them with triangles like "
+                            "the mesh's own)"),
+            std::string::npos)
+      << capped.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "a"));
+
+  const CommandResult patched = run(kCli + " make " + cylinder +
+                                    " --structure weave --holes patch --layout rows --out " + quoted(dir.path() / "b"));
+  ASSERT_EQ(patched.status, 0) << patched.err;
+  EXPECT_NE(patched.err.find("closed 1 hole with triangles like the mesh's own"), std::string::npos) << patched.err;
+  const auto m = nlohmann::json::parse(readFile(dir.path() / "b/manifest.json"));
+  // One panel per edge of the mesh as built: its 3,461 and the patch's.
+  const size_t edges = m.at("mesh").at("edges").get<size_t>();
+  EXPECT_GT(edges, 3461U);
+  Lapses lapses;
+  expectWovenManifest(m, edges, &lapses);
+  EXPECT_LE(lapses.glued, edges / 100) << "one crossing in a hundred may be glued";
+  expectLapsesWarned(patched.err, lapses);
+}
+
+// CGAL's head: its edges differ in length thirty times over, and at the size
+// where its smallest crossings have room its largest panel is larger than
+// the bed. It is woven at the largest size that fits the bed, the
+// crossings without room there glued, and the note says so.
+TEST(WeaveCli, AMeshOfVeryUnevenFacesIsWovenAtTheLargestSizeThatFitsTheBed) {
+  TempDir dir;
+  const CommandResult made = run(kCli + " make " + quoted(publicMesh(cgalMesh("head.off"))) +
+                                 " --structure weave --layout rows --json --out " + quoted(dir.path() / "head"));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const auto summary = nlohmann::json::parse(made.out);
+  std::string note;
+  for (const auto& line : summary.at("notes")) {
+    if (line.get<std::string>().find("the largest size that fits the bed") != std::string::npos) note = line;
+  }
+  EXPECT_NE(note, "") << made.out;
+  const auto m = nlohmann::json::parse(readFile(dir.path() / "head/manifest.json"));
+  Lapses lapses;
+  expectWovenManifest(m, m.at("mesh").at("edges").get<size_t>(), &lapses);
+  EXPECT_GT(lapses.glued, 0U);
+  EXPECT_NE(note.find(fmt::format("; {} crossings without room are glued", lapses.glued)), std::string::npos) << note;
+  expectLapsesWarned(made.err, lapses);
 }
 
 TEST(WeaveCli, EachStructuresOptionsAreRefusedWithTheOther) {
