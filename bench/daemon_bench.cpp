@@ -4,7 +4,8 @@
 //   1. the rate of bare SQLite transactions (WAL, synchronous=FULL) on that
 //      disk: the limit a durable submission cannot beat;
 //   2. submissions of a planned `make` folder per second, from 1 and from 8
-//      clients at once, each a new connection;
+//      clients at once, each a new connection, then each client's on one
+//      connection kept open;
 //   3. status queries per second (GET /api/jobs/ID), 4 clients;
 //   4. with 10,000 jobs in the store: the time from the daemon's start to its
 //      first answer, and its memory (VmRSS) then and after a list of all.
@@ -87,6 +88,61 @@ int request(const fs::path& socket, const std::string& bytes) {
   return reply.size() > 12 ? std::stoi(reply.substr(9, 3)) : 0;
 }
 
+// Requests one after another on one connection kept open (HTTP/1.1
+// keep-alive), as a client that submits a batch would send them.
+class KeptConnection {
+ public:
+  explicit KeptConnection(const fs::path& socket) : socket_(socket) {}
+  ~KeptConnection() { closeIt(); }
+  KeptConnection(const KeptConnection&) = delete;
+  KeptConnection& operator=(const KeptConnection&) = delete;
+
+  // The status code of the reply; the connection opened again when the server closed it.
+  int exchange(const std::string& bytes) {
+    if (fd_ < 0 && (fd_ = connectTo(socket_)) < 0) return 0;
+    if (::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(bytes.size())) {
+      closeIt();
+      return 0;
+    }
+    // The head, then as many bytes of body as it says.
+    size_t headEnd;
+    while ((headEnd = buffer_.find("\r\n\r\n")) == std::string::npos) {
+      if (!receive()) return 0;
+    }
+    const std::string head = buffer_.substr(0, headEnd);
+    size_t length = 0;
+    if (const auto at = head.find("Content-Length: "); at != std::string::npos) {
+      length = std::stoul(head.substr(at + 16));
+    }
+    while (buffer_.size() < headEnd + 4 + length) {
+      if (!receive()) return 0;
+    }
+    buffer_.erase(0, headEnd + 4 + length);
+    if (head.find("Connection: close") != std::string::npos) closeIt();
+    return head.size() > 12 ? std::stoi(head.substr(9, 3)) : 0;
+  }
+
+ private:
+  bool receive() {
+    char chunk[8192];
+    const ssize_t n = ::recv(fd_, chunk, sizeof chunk, 0);
+    if (n <= 0) {
+      closeIt();
+      return false;
+    }
+    buffer_.append(chunk, static_cast<size_t>(n));
+    return true;
+  }
+  void closeIt() {
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    buffer_.clear();
+  }
+  fs::path socket_;
+  int fd_ = -1;
+  std::string buffer_;
+};
+
 struct Daemon {
   pid_t pid = 0;
   fs::path root;
@@ -130,19 +186,22 @@ struct Daemon {
   }
 };
 
-// Submissions of `folder` by path from `clients` threads for about `seconds`; per second.
-double submissionRate(const fs::path& socket, const fs::path& folder, int clients, double seconds) {
+// Submissions of `folder` by path from `clients` threads for about
+// `seconds`, each on a new connection or each client's on one kept open; per second.
+double submissionRate(const fs::path& socket, const fs::path& folder, int clients, double seconds, bool keptAlive) {
   const std::string body = fmt::format(R"({{"path": "{}"}})", folder.string());
   const std::string bytes = fmt::format(
-      "POST /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\nContent-Type: application/json\r\nContent-Length: "
-      "{}\r\n\r\n{}",
-      body.size(), body);
+      "POST /api/jobs HTTP/1.1\r\nHost: x\r\n{}Content-Type: application/json\r\nContent-Length: {}\r\n\r\n{}",
+      keptAlive ? "" : "Connection: close\r\n", body.size(), body);
   std::atomic<int> done{0}, failed{0};
   const auto start = Clock::now();
   std::vector<std::thread> threads;
   for (int c = 0; c < clients; ++c) {
     threads.emplace_back([&] {
-      while (since(start) < seconds) (request(socket, bytes) == 201 ? done : failed)++;
+      KeptConnection connection(socket);
+      while (since(start) < seconds) {
+        (((keptAlive ? connection.exchange(bytes) : request(socket, bytes)) == 201) ? done : failed)++;
+      }
     });
   }
   for (auto& thread : threads) thread.join();
@@ -195,10 +254,13 @@ int main(int argc, char** argv) {
       << "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=100\"}]\n";
   daemon.start();
   daemon.waitServing();
-  for (int clients : {1, 8}) {
-    const double rate = submissionRate(daemon.socket(), planned, clients, 5);
-    fmt::print("submissions of a planned folder, {} client{}: {:.0f}/s ({:.0f}% of bare SQLite)\n", clients,
-               clients == 1 ? "" : "s", rate, 100 * rate / bare);
+  for (const bool keptAlive : {false, true}) {
+    for (int clients : {1, 8}) {
+      const double rate = submissionRate(daemon.socket(), planned, clients, 5, keptAlive);
+      fmt::print("submissions of a planned folder, {} client{}{}: {:.0f}/s ({:.0f}% of bare SQLite)\n", clients,
+                 clients == 1 ? "" : "s", keptAlive ? ", each on one connection kept open" : "", rate,
+                 100 * rate / bare);
+    }
   }
   fmt::print("status queries (GET /api/jobs/1), 4 clients: {:.0f}/s\n", statusRate(daemon.socket(), 4, 3));
   daemon.stop();

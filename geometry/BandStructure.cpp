@@ -538,7 +538,6 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
                                           unfitted.size() == 1 ? "its" : "their", kSmallestLabel, some,
                                           unfitted.size() > 3 ? ", ..." : ""));
   }
-  layPanelsAlongTheirLeastBoxes(result.panels, context);
   result.steps = stepsInPanelOrder(result.panels);
   return result;
 }

@@ -130,8 +130,9 @@ std::vector<AssemblyStep> stepsInPanelOrder(const std::vector<Panel>& panels);
 // bounding box (Freeman and Shapira, CACM 1975: one of its sides lies along
 // a side of the convex hull) is axis-aligned, its longer side along x: the
 // frame a nester's quarter turns and a row of boxes waste least room in (a
-// woven panel lay at any angle, its box twice its least on average). Its
-// outline, holes, labels, pieces and scores all turn together.
+// woven panel lay at any angle, its box twice its least on average; a band
+// panel's own frame packed as well or better). Its outline, holes, labels,
+// pieces and scores all turn together.
 void layPanelsAlongTheirLeastBoxes(std::vector<Panel>& panels, const core::WorkContext& context);
 
 // The panels' 3D surfaces as one mesh, polygon by polygon, each panel's

@@ -1,15 +1,12 @@
-// Each panel of either structure lies in its own frame along its least
-// box: no turn of its outline has a smaller axis-aligned box, and the box's
-// longer side is along x. Measured by turning each outline through every
-// half degree, apart from the hull-side construction that chose the frame.
+// Each woven panel lies in its own frame along its least box: no turn of its outline has a smaller axis-aligned box,
+// and the box's longer side is along x. Measured by turning each outline through every half degree, apart from the
+// hull-side construction that chose the frame.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
 #include <numbers>
 
-#include "geometry/BandStructure.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
 #include "geometry/WeaveStructure.h"
 #include "support/MeshSupport.h"
@@ -50,11 +47,6 @@ TEST(PanelFrames, EveryWovenPanelLiesAlongItsLeastBox) {
   PolygonMesh mesh = test::atConstructionSize(truncatedIcosahedron());
   requireUsable(analyzeMesh(mesh));
   expectEachPanelAlongItsLeastBox(buildWeaveStructure(mesh, {}, test::context()));
-}
-
-TEST(PanelFrames, EveryBandPanelLiesAlongItsLeastBox) {
-  PolygonMesh mesh = test::atBuildableSize(importMesh(std::string(ROTAFAB_SOURCE_DIR) + "/examples/bunny.obj").mesh);
-  expectEachPanelAlongItsLeastBox(buildBandStructure(mesh, {}, test::context()));
 }
 
 }  // namespace
