@@ -32,7 +32,8 @@ std::vector<EdgeRegion> edgeRegions(const PolygonMesh& mesh, const RotationSyste
     const Point3 across = sum - sum.dot(along) * along;
     // Two faces folded flat onto each other, or a face of no area: no plane.
     if (!(across.norm() > 1e-6)) {
-      throw std::invalid_argument(name() + ": its two faces fold back onto each other, so no plane lies between them");
+      throw FoldedEdgeError(name() + ": its two faces fold back onto each other, so no plane lies between them",
+                            static_cast<int>(left), static_cast<int>(right));
     }
     region.normal = across.normalized();
     const auto projected = [&](const Point3& p) {

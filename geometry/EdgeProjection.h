@@ -12,6 +12,8 @@
 // out, normalised. Eq. 4.15-4.16 give the projected centres relative to
 // the midpoint; here they are points.
 
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "geometry/PolygonMesh.h"
@@ -35,10 +37,18 @@ struct EdgeRegion {
   }
 };
 
-// Per edge of `rs` (built from `mesh`). Throws std::invalid_argument naming
-// the edge when its two faces fold back onto each other (their normals'
-// sum has nothing across the edge: no plane to project on), or when it
-// lies on a boundary.
+// An edge whose two faces fold back onto each other (their normals' sum
+// has nothing across the edge: no plane to project on); the faces' indices.
+class FoldedEdgeError : public std::invalid_argument {
+ public:
+  FoldedEdgeError(const std::string& what, int leftFace, int rightFace)
+      : std::invalid_argument(what), leftFace(leftFace), rightFace(rightFace) {}
+  int leftFace, rightFace;
+};
+
+// Per edge of `rs` (built from `mesh`). Throws FoldedEdgeError naming the
+// edge when its two faces fold back onto each other, std::invalid_argument
+// when it lies on a boundary.
 std::vector<EdgeRegion> edgeRegions(const PolygonMesh& mesh, const RotationSystem& rs);
 
 }  // namespace rotafab::geometry

@@ -13,6 +13,7 @@
 #include "geometry/BandStructure.h"
 #include "geometry/ConstructionScale.h"
 #include "geometry/CoplanarMerge.h"
+#include "geometry/EdgeProjection.h"
 #include "geometry/FastenerHoles.h"
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
@@ -305,6 +306,25 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
     // (An estimate: the ribbons' offset does not grow with the mesh.)
     throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
                                       roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing", true)));
+  } catch (const geometry::FoldedEdgeError& error) {
+    // Where one of the two faces closes a hole, say what closes it, and
+    // that an open surface flat there has no inside to weave around.
+    const auto closesAHole = [&](int face) {
+      return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
+             mesh.sourceFace[static_cast<size_t>(face)] == -1;
+    };
+    if (!closesAHole(error.leftFace) && !closesAHole(error.rightFace)) {
+      throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    }
+    throw core::UserError(fmt::format(
+        "{}: {}: one of them closes a hole, {}; an open surface that is flat about its hole has no inside to weave "
+        "around with either",
+        name, error.what(),
+        request.holes == HolesMode::Fill
+            ? fmt::format("with one face ({} patch closes it with triangles like the mesh's own, which bend with a "
+                          "bent hole)",
+                          request.names(Parameter::Holes))
+            : std::string("with triangles that lie back against the surface beside it")));
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format("{}: {}{}", name, error.what(), oneFaceCapAdvice(request, mesh)));
   }

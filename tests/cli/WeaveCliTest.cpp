@@ -82,7 +82,9 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels, Lapses
     // Its own edge and the two at its ends (one of them its own edge again
     // where a single thread goes round a leaf face of its tree).
     // (A panel whose crossings are glued has fewer: the crossings' holes are counted below.)
-    if (lapses == nullptr) EXPECT_GE(mine.size(), 2U) << "panel " << id;
+    if (lapses == nullptr) {
+      EXPECT_GE(mine.size(), 2U) << "panel " << id;
+    }
     EXPECT_LE(mine.size(), 3U) << "panel " << id;
     for (const auto& [edge, count] : mine) holesAt[edge].push_back(count);
     // No hole's centre nearer than a diameter to its part's outline.
@@ -223,11 +225,19 @@ TEST(WeaveCli, ABentHoleThatOneFaceCannotCloseIsWovenPatched) {
   const CommandResult capped = run(kCli + " make " + cylinder + " --structure weave --out " + quoted(dir.path() / "a"));
   EXPECT_EQ(capped.status, 1);
   EXPECT_NE(capped.err.find("its two faces fold back onto each other"), std::string::npos) << capped.err;
-  EXPECT_NE(capped.err.find("(its holes are capped with one face each: --holes patch closes them with triangles like "
-                            "the mesh's own)"),
+  EXPECT_NE(capped.err.find("one of them closes a hole, with one face (--holes patch closes it with triangles like "
+                            "the mesh's own, which bend with a bent hole)"),
             std::string::npos)
       << capped.err;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "a"));
+  // A flat open surface (CGAL's one quad) closed is two sides back to back, patched or not.
+  const CommandResult flat = run(kCli + " make " + quoted(publicMesh(cgalMesh("quad.off"))) +
+                                 " --structure weave --holes patch --out " + quoted(dir.path() / "c"));
+  EXPECT_EQ(flat.status, 1);
+  EXPECT_NE(flat.err.find("one of them closes a hole, with triangles that lie back against the surface beside it; an "
+                          "open surface that is flat about its hole has no inside to weave around with either"),
+            std::string::npos)
+      << flat.err;
 
   const CommandResult patched = run(kCli + " make " + cylinder +
                                     " --structure weave --holes patch --layout rows --out " + quoted(dir.path() / "b"));
