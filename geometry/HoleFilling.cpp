@@ -87,7 +87,13 @@ class Patch {
     }
     double perimeter = 0;
     for (size_t i = 0; i < loop.size(); ++i) perimeter += (point(loop[(i + 1) % loop.size()]) - point(loop[i])).norm();
-    target_ = perimeter / static_cast<double>(loop.size());
+    // The loop's own edge length, or longer where a patch of those would
+    // pass kMostTriangles (a disc of this perimeter, in equilateral
+    // triangles): a hole of thousands of corners is not worth millions of
+    // panels.
+    const double discArea = perimeter * perimeter / (4 * std::numbers::pi);
+    target_ = std::max(perimeter / static_cast<double>(loop.size()),
+                       std::sqrt(discArea / (kMostTriangles * std::sqrt(3.0) / 4)));
     if (!triangulateLeastArea(loop)) fan(loop);
   }
 
@@ -119,6 +125,9 @@ class Patch {
   // A triangle's area over its longest side squared below which it is a
   // sliver (a corner of about a tenth of a degree).
   static constexpr double kLeastAreaPerSquaredLength = 1e-3;
+  [[nodiscard]] bool isSliver(int a, int b, int c) const {
+    return area(a, b, c) <= kLeastAreaPerSquaredLength * longestSquared(a, b, c);
+  }
   [[nodiscard]] double area(int a, int b, int c) const {
     return (point(b) - point(a)).cross(point(c) - point(a)).norm() / 2;
   }
@@ -171,8 +180,8 @@ class Patch {
           for (size_t m = i + 1; m < j; ++m) {
             // Not three corners in a line (a straight stretch of the loop),
             // which would cost nothing and give a triangle of no area.
+            if (isSliver(loop[i], loop[m], loop[j])) continue;
             const double a = area(loop[i], loop[m], loop[j]);
-            if (a <= kLeastAreaPerSquaredLength * longestSquared(loop[i], loop[m], loop[j])) continue;
             if (foldsBack({loop[i], loop[m], loop[j]})) continue;
             const double w = weight[i * n + m] + weight[m * n + j] + a;
             if (w < best) best = w, middle[i * n + j] = static_cast<int>(m);
@@ -199,13 +208,18 @@ class Patch {
   // face across that side (Liepa weighs the dihedral angle first for
   // this): the least area would often lay an ear of a bent hole flat on the
   // face beside it, and a flip or the fairing can too.
-  [[nodiscard]] bool foldsBack(const Triangle& triangle) const {
+  [[nodiscard]] bool foldsBack(const Triangle& triangle) const { return turnFromBeside(triangle) < kMostFoldCosine; }
+  // The least cosine between the triangle's normal and the normals of the
+  // faces beside its sides on the loop (1 when none is on the loop).
+  [[nodiscard]] double turnFromBeside(const Triangle& triangle) const {
     const Point3 normal = (point(triangle[1]) - point(triangle[0])).cross(point(triangle[2]) - point(triangle[0]));
+    double least = 1;
     for (int k = 0; k < 3; ++k) {
       const auto beside = besideNormal_.find(edgeKey(triangle[k], triangle[(k + 1) % 3]));
-      if (beside != besideNormal_.end() && normal.dot(beside->second) < kMostFoldCosine * normal.norm()) return true;
+      if (beside == besideNormal_.end()) continue;
+      least = std::min(least, normal.norm() > 0 ? normal.dot(beside->second) / normal.norm() : -1.0);
     }
-    return false;
+    return least;
   }
 
   // A fan from a new vertex at the loop's centroid: always a valid start.
@@ -265,7 +279,10 @@ class Patch {
         // Not where the two new triangles would fold onto each other.
         const Point3 n1 = (point(d) - point(a)).cross(point(c) - point(a)),
                      n2 = (point(c) - point(b)).cross(point(d) - point(b));
-        if (!(n1.dot(n2) > 0) || foldsBack({a, d, c}) || foldsBack({b, c, d})) continue;
+        if (!(n1.dot(n2) > 0) || foldsBack({a, d, c}) || foldsBack({b, c, d}) || isSliver(a, d, c) ||
+            isSliver(b, c, d)) {
+          continue;
+        }
         set(t1, {a, d, c});
         set(t2, {b, c, d});
         flipped = true;
@@ -302,12 +319,19 @@ class Patch {
       }
       for (size_t v = 0; v < count; ++v) {
         if (neighbours[v] == 0) continue;
+        const auto& around = trianglesAt[v];
+        const auto leastTurn = [&] {
+          double least = 1;
+          for (const int t : around) least = std::min(least, turnFromBeside(triangles_[static_cast<size_t>(t)]));
+          return least;
+        };
+        const double turnBefore = leastTurn();
         const Point3 before = positions_[first + v];
         positions_[first + v] = sum[v] / neighbours[v];
-        const auto& around = trianglesAt[v];
-        if (std::any_of(around.begin(), around.end(), [&](int t) { return foldsBack(triangles_[t]); })) {
-          positions_[first + v] = before;  // not onto the face beside the hole
-        }
+        // Not onto the face beside the hole: undone where it folds further
+        // back than allowed and than it was (a vertex already folded may move out).
+        const double turnAfter = leastTurn();
+        if (turnAfter < kMostFoldCosine && turnAfter < turnBefore) positions_[first + v] = before;
       }
     }
   }
@@ -324,6 +348,10 @@ class Patch {
   // about 120 degrees (a hole's rim can be a right angle, as where a tube's
   // end is closed; it cannot lie back on the surface).
   static constexpr double kMostFoldCosine = -0.5;
+  // The disc's triangles at the target length, which the refinement's
+  // edges (2/3 to 4/3 of it) and the loop's shorter ones make about half as
+  // many again: about 20,000 a patch at most.
+  static constexpr double kMostTriangles = 13000;
 };
 
 }  // namespace

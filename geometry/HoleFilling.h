@@ -5,7 +5,8 @@
 // around it:
 // - `fill` caps a loop with one polygon face;
 // - `patch` closes it with triangles about as long as the loop's own edges,
-//   after Liepa, "Filling holes in meshes" (SGP 2003): a least-area
+//   (longer for a hole of thousands of corners: about 20,000 triangles
+//   at most), after Liepa, "Filling holes in meshes" (SGP 2003): a least-area
 //   triangulation of the loop, refined until no edge is much longer than
 //   the loop's, its edges flipped towards Delaunay, and its new vertices
 //   faired (umbrella smoothing with the loop held). A weave's ribbons run

@@ -268,26 +268,28 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
       // the default, and the crossings without room there glued.
       weave.glueCrossingsWithoutRoom = true;
       constexpr int kShrinkAttempts = 3;
-      const double defaultSide = geometry::boundingBoxSize(mesh).maxCoeff() / built.grown;
-      const auto grownBy = [&] { return geometry::boundingBoxSize(mesh).maxCoeff() / defaultSide; };
-      geometry::Structure glued;
-      for (int attempt = 1; attempt <= kShrinkAttempts && grownBy() > 1; ++attempt) {
-        const double room = roomOnTheBed(structureParts(attempt == 1 ? built.structure : glued), request.machine, kerf);
-        if (room >= 1) break;
-        // (1% to spare: a label's size does not grow with the rest)
-        const double shrink = std::max(0.99 * room, 1 / grownBy());
+      const double grownAtFirst = built.grown;
+      geometry::Structure glued = std::move(built.structure);
+      double room = roomOnTheBed(structureParts(glued), request.machine, kerf);
+      for (int attempt = 1; attempt <= kShrinkAttempts && room < 1; ++attempt) {
+        // (1% to spare: a label's size does not grow with the rest; never below the default size)
+        const double shrink = std::max(0.99 * room, 1 / sizing.grown);
+        if (!(shrink < 1)) break;
         for (geometry::Point3& p : mesh.positions) p *= shrink;
+        sizing.grown *= shrink;
         context.report({"geometry", "smaller, for the bed", static_cast<size_t>(attempt), 0});
         glued = geometry::buildWeaveStructure(mesh, weave, context);
+        room = roomOnTheBed(structureParts(glued), request.machine, kerf);
       }
-      sizing.grown = grownBy();
+      // (Still over the bed: the planner's refusal names the panel, with the size advice.)
+      if (room < 1) return glued;
       sizing.bedLimited = true;
       context.note(fmt::format(
           "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the largest size that fits the bed, below the {:.2f} "
           "in at which every crossing has room for {:.3f} in fastener holes; {} crossing{} without room {} glued; {} "
           "N, fewer and evener faces, needs less",
           name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches,
-          geometry::kMeanEdgeInches * built.grown, weave.fastener, glued.glued.size(),
+          geometry::kMeanEdgeInches * grownAtFirst, weave.fastener, glued.glued.size(),
           plural(static_cast<int>(glued.glued.size())), glued.glued.size() == 1 ? "is" : "are",
           request.names(Parameter::Panels)));
       return glued;
@@ -313,8 +315,13 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
       return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
              mesh.sourceFace[static_cast<size_t>(face)] == -1;
     };
-    if (!closesAHole(error.leftFace) && !closesAHole(error.rightFace)) {
-      throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    const int closing = (closesAHole(error.leftFace) ? 1 : 0) + (closesAHole(error.rightFace) ? 1 : 0);
+    if (closing == 0) throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    if (closing == 2) {
+      throw core::UserError(
+          fmt::format("{}: {}: both close a hole, with triangles folded onto each other; an open "
+                      "surface that is flat about its hole has no inside to weave around",
+                      name, error.what()));
     }
     throw core::UserError(fmt::format(
         "{}: {}: one of them closes a hole, {}; an open surface that is flat about its hole has no inside to weave "

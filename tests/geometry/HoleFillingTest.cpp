@@ -86,6 +86,34 @@ TEST(HoleFilling, OneFaceCapsEachLoopAndThePatchClosesItWithTrianglesLikeItsEdge
   }
 }
 
+// A hole of 600 corners (a short wide tube, open at both ends): past the
+// least-area triangulation's reach, a fan refined; and not to the loop's
+// own edge length, which would take some 65,000 triangles a hole, but to
+// about the most a patch is refined to.
+TEST(HoleFilling, AHoleOfManyCornersIsPatchedWithinItsBudget) {
+  constexpr int kAround = 600;
+  PolygonMesh tube;
+  for (int ring = 0; ring < 2; ++ring) {
+    for (int i = 0; i < kAround; ++i) {
+      const double a = 2 * std::numbers::pi * i / kAround;
+      tube.positions.emplace_back(10 * std::cos(a), 10 * std::sin(a), ring * 0.2);
+    }
+  }
+  for (int i = 0; i < kAround; ++i) {
+    const int j = (i + 1) % kAround;
+    tube.faces.push_back({i, j, kAround + j, kAround + i});
+  }
+  ASSERT_EQ(analyzeMesh(tube).topology.boundaryLoops, 2);
+  EXPECT_EQ(patchHoles(tube), 2);
+  const MeshAnalysis after = analyzeMesh(tube);
+  EXPECT_TRUE(after.usable()) << (after.problems.empty() ? "" : after.problems[0].message);
+  EXPECT_EQ(after.topology.boundaryLoops, 0);
+  EXPECT_EQ(after.topology.genus, 0);
+  const int patchFaces = tube.faceCount() - kAround;
+  EXPECT_GT(patchFaces, 2 * 2000) << "refined, not a fan alone";
+  EXPECT_LT(patchFaces, 2 * 25000) << "about 20,000 triangles a hole at most";
+}
+
 // Where one face across the half cylinder's open side turns its normal
 // against the curved faces beside it (the Newell normal of the loop points
 // down, the arch's top faces up), the patch bends with the hole: at every
