@@ -1,8 +1,13 @@
 #include "daemon/QueueCommands.h"
 
+#include <fcntl.h>
 #include <fmt/format.h>
+#include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -49,6 +54,36 @@ int talking(Body&& body) {
     fmt::print(stderr, "error: {}\n", error.what());
     return kUserError;
   }
+}
+
+// Starts the desktop's browser on `url` (xdg-open), without waiting for
+// it; false where there is no desktop or no xdg-open.
+bool openInBrowser(const std::string& url) {
+  const char* display = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if ((!display || !*display) && (!wayland || !*wayland)) return false;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  // Its chatter is not ours to print.
+  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  std::string program = "xdg-open";
+  std::vector<char*> argv{program.data(), const_cast<char*>(url.c_str()), nullptr};
+  pid_t child = 0;
+  const int error = ::posix_spawnp(&child, "xdg-open", &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) return false;
+  // xdg-open hands the link to a running browser and ends, failing when
+  // none takes it; where it starts the browser itself it may stay as long
+  // as the browser does: still running after 3 s, it has opened it.
+  for (int tenth = 0; tenth < 30; ++tenth) {
+    int exitStatus = 0;
+    const pid_t ended = ::waitpid(child, &exitStatus, WNOHANG);
+    if (ended == child) return WIFEXITED(exitStatus) && WEXITSTATUS(exitStatus) == 0;
+    if (ended < 0) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return true;
 }
 
 std::string sheetsOf(const json& job) {
@@ -513,6 +548,43 @@ void addQueueCommands(CLI::App& app, int& status) {
           std::cout << answer.dump(1) << '\n';
         } else {
           printJobs(answer["jobs"]);
+        }
+        return kSuccess;
+      });
+    });
+  }
+  // dashboard
+  {
+    auto client = std::make_shared<ClientOptions>();
+    auto urlOnly = std::make_shared<bool>(false);
+    CLI::App* dashboard =
+        app.add_subcommand("dashboard", "Open the workshop page (queue, machines, previews, assembly guide) signed in");
+    dashboard->add_flag("--url", *urlOnly, "Only print the one-time login link, for a browser you open yourself");
+    addClientOptions(*dashboard, *client);
+    dashboard->footer(
+        "The daemon serves the page on loopback TCP (http://127.0.0.1:8730 unless that port was taken: rotafabd.json\n"
+        "in its state directory says where). A browser gets in only with a session, which a one-time link\n"
+        "opens: this command asks the daemon for one over its Unix socket, as this machine's user, and opens\n"
+        "it in the browser. The link works once, within five minutes; the session lasts a week unused.\n\n"
+        "Examples:\n"
+        "  rotafab dashboard\n"
+        "  rotafab dashboard --url          # print the link only (another browser, a tablet over SSH tunnel)");
+    dashboard->callback([client, urlOnly, &status] {
+      status = talking([&]() -> int {
+        const json link = clientOf(*client).post("/api/sessions", json::object());
+        const std::string url = link.value("url", "");
+        if (client->json) {
+          std::cout << link.dump(1) << '\n';
+          return kSuccess;
+        }
+        if (*urlOnly) {
+          fmt::print("{}\n", url);
+          return kSuccess;
+        }
+        if (openInBrowser(url)) {
+          fmt::print("opened the workshop page in your browser; the link works once, within five minutes:\n{}\n", url);
+        } else {
+          fmt::print("open this link in a browser on this machine (it works once, within five minutes):\n{}\n", url);
         }
         return kSuccess;
       });

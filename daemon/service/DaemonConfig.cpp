@@ -71,11 +71,16 @@ fs::path defaultSocket(const fs::path& stateDir) {
   return runtime.empty() ? stateDir / "rotafabd.sock" : fs::path(runtime) / "rotafab/rotafabd.sock";
 }
 
+// The Unix socket for `rotafab`, and loopback TCP for a browser (the workshop page).
+static std::vector<std::string> defaultListen(const fs::path& stateDir) {
+  return {"unix:" + defaultSocket(stateDir).string(), fmt::format("tcp://127.0.0.1:{}", kPagePort)};
+}
+
 DaemonConfig defaultConfig() {
   DaemonConfig config;
   config.stateDir = defaultStateDir();
   config.host = hostName();
-  config.listen = {"unix:" + defaultSocket(config.stateDir).string()};
+  config.listen = defaultListen(config.stateDir);
   // A simulated GRBL that runs 100 times faster than the machine it stands
   // for, so that a first job is seen through to its end; progress is said in real time.
   config.devices = {{"laser1", "grbl-diode-400", "sim:grbl?speed=100", "posterboard", false}};
@@ -111,6 +116,7 @@ DaemonConfig loadConfig(const fs::path& file) {
       if (!listen.IsSequence())
         reader.fail(listen, "listen", "expected a list such as [unix:/run/rotafab.sock, tcp://127.0.0.1:8730]");
       config.listen.clear();
+      config.defaultListen = false;
       listenGiven = true;
       for (size_t i = 0; i < listen.size(); ++i) {
         const std::string key = fmt::format("listen[{}]", i);
@@ -170,7 +176,7 @@ DaemonConfig loadConfig(const fs::path& file) {
     if (root["body_timeout"]) config.bodyTimeout = reader.number(root["body_timeout"], "body_timeout", 0.1, 86400);
     if (root["plan_timeout"]) config.planTimeout = reader.number(root["plan_timeout"], "plan_timeout", 1, 7 * 86400);
     if (root["planners"]) config.planners = static_cast<unsigned>(reader.integer(root["planners"], "planners", 1, 64));
-    if (!listenGiven && root["state_dir"]) config.listen = {"unix:" + defaultSocket(config.stateDir).string()};
+    if (!listenGiven && root["state_dir"]) config.listen = defaultListen(config.stateDir);
     // A listener beyond this machine needs a token to let anyone in.
     for (size_t i = 0; i < config.listen.size(); ++i) {
       const std::string& address = config.listen[i];

@@ -12,6 +12,9 @@
 
 namespace rotafab::service {
 
+// The workshop page's port on loopback by default (SPEC, "Daemon").
+constexpr int kPagePort = 8730;
+
 struct DeviceConfig {
   std::string name;                      // how people and the API call it: "laser1"
   std::string machine;                   // its machine profile: what jobs for it are planned against
@@ -31,6 +34,9 @@ struct DaemonConfig {
   std::string host;  // this daemon's name (default: the host name)
   // "unix:PATH" and "tcp://HOST:PORT"; the first Unix one is where `rotafab` looks.
   std::vector<std::string> listen;
+  // The listeners are the defaults: the socket, and loopback TCP for the
+  // workshop page on kPagePort, or on any free port when another program has it.
+  bool defaultListen = true;
   std::vector<TokenConfig> tokens;
   std::vector<DeviceConfig> devices;
   size_t uploadLimit = 256u << 20;  // bytes of one request's body

@@ -1,6 +1,7 @@
 #include "daemon/service/HttpServer.h"
 
 #include <fmt/format.h>
+#include <openssl/rand.h>
 #include <pwd.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
@@ -17,11 +18,14 @@
 #include <chrono>
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <regex>
 #include <set>
 #include <unordered_map>
 #include <utility>
 
+#include "core/ProgramFolders.h"
 #include "daemon/service/Multipart.h"
 
 namespace rotafab::service {
@@ -38,7 +42,86 @@ struct Identity {
   bool allowed = false;
   std::string name;  // the owner of what they submit
   std::string refusal;
+  bool bySession = false;  // a browser's session cookie: its actions must come from the page's own origin
 };
+
+using Clock = std::chrono::steady_clock;
+
+// The name of the browser's session cookie.
+constexpr std::string_view kSessionCookie = "rotafab_session";
+// A login link works once, within this time; a session lasts this long unused.
+constexpr auto kLoginLinkLasts = std::chrono::minutes(5);
+constexpr auto kSessionLasts = std::chrono::hours(24 * 7);
+
+// 32 random bytes from OpenSSL's generator, as hex: a login code or a session.
+std::string randomSecret() {
+  unsigned char bytes[32];
+  if (RAND_bytes(bytes, sizeof bytes) != 1) throw ApiError(500, "no random bytes for a secret");
+  std::string text;
+  for (unsigned char byte : bytes) text += fmt::format("{:02x}", byte);
+  return text;
+}
+
+std::string cookieValue(std::string_view header, std::string_view name) {
+  while (!header.empty()) {
+    const size_t semicolon = header.find(';');
+    std::string_view pair = header.substr(0, semicolon);
+    while (pair.starts_with(' ')) pair.remove_prefix(1);
+    if (pair.starts_with(name) && pair.size() > name.size() && pair[name.size()] == '=') {
+      return std::string(pair.substr(name.size() + 1));
+    }
+    if (semicolon == std::string_view::npos) break;
+    header = header.substr(semicolon + 1);
+  }
+  return "";
+}
+
+// The page's files (HTML, CSS, JavaScript): PREFIX/share/rotafab/web once
+// installed; the source tree's daemon/web for a program run from its build tree.
+fs::path pageFolder() {
+  const fs::path installed = core::installedDataFolder() / "web";
+  std::error_code error;
+  if (fs::is_directory(installed, error)) return installed;
+#if defined(ROTAFAB_WEB_DIR) && defined(ROTAFAB_BUILD_DIR)
+  if (fs::equivalent(core::programFolder(), ROTAFAB_BUILD_DIR, error)) return ROTAFAB_WEB_DIR;
+#endif
+  return "/usr/share/rotafab/web";
+}
+
+// Debian's libjs-three, which the page's 3D view loads: only the files it uses.
+constexpr std::string_view kThreeFolder = "/usr/share/javascript/three";
+const std::set<std::string>& threeFiles() {
+  static const std::set<std::string> files{"build/three.min.js", "examples/js/controls/OrbitControls.js"};
+  return files;
+}
+
+std::string contentTypeOf(const fs::path& file) {
+  const std::string extension = file.extension().string();
+  const std::string name = file.filename().string();
+  if (extension == ".html") return "text/html; charset=utf-8";
+  if (extension == ".js") return "text/javascript; charset=utf-8";
+  if (extension == ".css") return "text/css; charset=utf-8";
+  if (extension == ".svg") return "image/svg+xml";
+  if (extension == ".png") return "image/png";
+  if (extension == ".json") return "application/json";
+  return "text/plain; charset=utf-8";
+}
+
+// What a browser without a session is shown: how to get one.
+std::string signInPage(const std::string& why) {
+  return fmt::format(R"(<!doctype html>
+<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
+<title>Rotafab: sign in</title>
+<style>body{{font:16px/1.5 system-ui,sans-serif;max-width:36em;margin:3em auto;padding:0 1em}}code{{background:#eee;padding:.1em .3em}}</style>
+</head><body><h1>Rotafab workshop</h1>
+<p>{}</p>
+<p>On the machine where <code>rotafabd</code> runs, as the user who runs it, type</p>
+<p><code>rotafab dashboard</code></p>
+<p>It opens this page signed in (or prints the link with <code>--url</code>). A link works once, for five minutes.</p>
+</body></html>
+)",
+                     why);
+}
 
 std::optional<std::string> accountName(uid_t uid) {
   struct passwd entry {};
@@ -170,21 +253,76 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
     return {true, known->second.first, ""};
   }
 
+  // Over TCP nobody gets in without a token of the configuration or a
+  // session of a browser that came by a one-time login link.
   template <typename Request>
-  Identity identify(asio::ip::tcp::socket&, const Request& request) const {
+  Identity identify(asio::ip::tcp::socket&, const Request& request) {
     const auto& tokens = service.config().tokens;
-    if (tokens.empty())
-      return {true, "local", ""};  // loopback only: the configuration refuses any other without tokens
     const auto header = request[http::field::authorization];
     const std::string_view value(header.data(), header.size());
-    if (!value.starts_with("Bearer ")) {
-      return {false, "", "this listener needs a token: send `Authorization: Bearer TOKEN` (rotafab --token T)"};
+    if (value.starts_with("Bearer ")) {
+      const std::string token(value.substr(7));
+      for (const TokenConfig& configured : tokens) {
+        if (tokenMatches(token, configured.hash)) return {true, configured.name, "", false};
+      }
+      return {false, "", "the token is not one this daemon knows"};
     }
-    const std::string token(value.substr(7));
-    for (const TokenConfig& configured : tokens) {
-      if (tokenMatches(token, configured.hash)) return {true, configured.name, ""};
+    const auto cookies = request[http::field::cookie];
+    const std::string session = cookieValue(std::string_view(cookies.data(), cookies.size()), kSessionCookie);
+    if (!session.empty()) {
+      const auto found = sessions.find(session);
+      const auto now = Clock::now();
+      if (found != sessions.end() && now - found->second.second < kSessionLasts) {
+        found->second.second = now;
+        return {true, found->second.first, "", true};
+      }
+      if (found != sessions.end()) sessions.erase(found);
+      return {false, "", "the session has ended (or the daemon started again): run `rotafab dashboard` for a new link"};
     }
-    return {false, "", "the token is not one this daemon knows"};
+    return {false, "",
+            tokens.empty() ? "this listener needs a session: run `rotafab dashboard` on the daemon's machine for a "
+                             "login link"
+                           : "this listener needs a token: send `Authorization: Bearer TOKEN` (rotafab --token T), "
+                             "or a browser's session from `rotafab dashboard`"};
+  }
+
+  // One-time login links (code -> who, until when) and the sessions they
+  // opened (secret -> who, last used); in memory: a daemon started again
+  // asks everyone to sign in again.
+  std::unordered_map<std::string, std::pair<std::string, Clock::time_point>> loginCodes;
+  std::unordered_map<std::string, std::pair<std::string, Clock::time_point>> sessions;
+  fs::path pages = pageFolder();
+
+  std::string newLoginCode(const std::string& name) {
+    const auto now = Clock::now();
+    std::erase_if(loginCodes, [&](const auto& entry) { return entry.second.second < now; });
+    std::string code = randomSecret();
+    loginCodes[code] = {name, now + kLoginLinkLasts};
+    return code;
+  }
+
+  // The secret of a new session for the code's holder; none when the code is unknown, used or old.
+  std::optional<std::string> openSession(const std::string& code) {
+    const auto found = loginCodes.find(code);
+    if (found == loginCodes.end()) return std::nullopt;
+    const auto [name, until] = found->second;
+    loginCodes.erase(found);
+    const auto now = Clock::now();
+    if (until < now) return std::nullopt;
+    std::erase_if(sessions, [&](const auto& entry) { return now - entry.second.second >= kSessionLasts; });
+    std::string secret = randomSecret();
+    sessions[secret] = {name, now};
+    return secret;
+  }
+
+  // Where a browser on this machine reaches the daemon: its first loopback TCP listener.
+  std::optional<std::string> loopbackPage() const {
+    for (const std::string& address : bound) {
+      if (address.starts_with("tcp://127.") || address.starts_with("tcp://[::1]")) {
+        return "http://" + address.substr(6);
+      }
+    }
+    return std::nullopt;
   }
 };
 
@@ -249,7 +387,26 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
                                    server_->service.config().connectionLimit));
     }
     if constexpr (std::is_same_v<Protocol, asio::ip::tcp>) identity_ = server_->identify(stream_.socket(), request);
-    if (!identity_.allowed) return fail(401, identity_.refusal);
+    const std::string_view path(request.target().data(), request.target().size());
+    const bool page = !path.starts_with("/api");
+    if (!identity_.allowed && !(page && path.starts_with("/login"))) {
+      if (!page) return fail(401, identity_.refusal);
+      Reply signIn{401, nullptr};
+      signIn.text = signInPage(identity_.refusal);
+      signIn.contentType = "text/html; charset=utf-8";
+      keepAlive_ = false;
+      return respond(std::move(signIn));
+    }
+    // A browser's session acts only from the page itself: a request another
+    // site makes the browser send says so in its Origin.
+    if (identity_.bySession && request.method() != http::verb::get) {
+      const auto origin = request[http::field::origin];
+      const auto host = request[http::field::host];
+      if (!origin.empty() &&
+          std::string_view(origin.data(), origin.size()) != "http://" + std::string(host.data(), host.size())) {
+        return fail(403, "a session's actions come from the workshop page itself, not from another site");
+      }
+    }
     if (request.has_content_length() && *header_->content_length() > server_->service.config().uploadLimit) {
       return fail(413, fmt::format("the body is {} bytes; the daemon takes at most {}", *header_->content_length(),
                                    server_->service.config().uploadLimit));
@@ -321,13 +478,14 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     const auto wrongMethod = [&](const char* allowed) {
       throw ApiError(405, fmt::format("{} takes {}", std::string(request_.target()), allowed));
     };
-    if (parts.empty() || parts[0] != "api") {
-      throw ApiError(404, fmt::format("no such page: {} (the API is under /api; see docs/API.md)",
-                                      std::string(request_.target())));
-    }
+    if (parts.empty() || parts[0] != "api") return page(parts, query);
     if (parts.size() == 1) {
       if (method != http::verb::get) wrongMethod("GET");
       return respond({200, {{"name", "rotafabd"}, {"version", "0.1.0"}, {"host", server_->service.config().host}}});
+    }
+    if (parts[1] == "sessions" && parts.size() == 2) {
+      if (method != http::verb::post) wrongMethod("POST");
+      return loginLink();
     }
     if (parts[1] == "devices" && parts.size() == 2) {
       if (method != http::verb::get) wrongMethod("GET");
@@ -349,6 +507,16 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
       if (method != http::verb::get) wrongMethod("GET");
       return server_->service.manifest(*id, replier());
     }
+    if (parts.size() == 5 && parts[3] == "files") {
+      if (method != http::verb::get) wrongMethod("GET");
+      return server_->service.file(*id, parts[4], replier());
+    }
+    if (parts.size() == 5 && parts[3] == "sheets") {
+      if (method != http::verb::get) wrongMethod("GET");
+      const auto sheet = wholeNumber(parts[4]);
+      if (!sheet || *sheet < 1 || *sheet > 1000000) throw ApiError(404, fmt::format("no sheet {}", parts[4]));
+      return server_->service.sheet(*id, static_cast<int>(*sheet), replier());
+    }
     if (parts.size() == 4) {
       static const std::set<std::string> actions{"cancel", "pause", "resume", "start", "next", "move"};
       if (!actions.contains(parts[3])) {
@@ -358,6 +526,80 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
       return server_->service.act(*id, parts[3], bodyJson(), identity_.name, replier());
     }
     throw ApiError(404, fmt::format("no such resource: {}", std::string(request_.target())));
+  }
+
+  // The workshop page: its files, Debian's three.js, and the login link's landing.
+  void page(const std::vector<std::string>& parts, const std::string& query) {
+    if (request_.method() != http::verb::get) {
+      throw ApiError(405, fmt::format("{} takes GET", std::string(request_.target())));
+    }
+    const auto notFound = [&] {
+      return ApiError(404, fmt::format("no such page: {} (the page is at /, the API under /api; see docs/API.md)",
+                                       std::string(request_.target())));
+    };
+    if (parts.size() == 1 && parts[0] == "login") {
+      const auto secret = server_->openSession(queryValue(query, "code"));
+      if (!secret) {
+        Reply refused{401, nullptr};
+        refused.text = signInPage("That login link has been used already, or is more than five minutes old.");
+        refused.contentType = "text/html; charset=utf-8";
+        return respond(std::move(refused));
+      }
+      Reply signedIn{303, nullptr};
+      signedIn.text = "signed in\n";
+      signedIn.contentType = "text/plain; charset=utf-8";
+      // HttpOnly: no script reads it; SameSite=Strict: no other site's page sends it.
+      signedIn.headers = {
+          {"Set-Cookie", fmt::format("{}={}; Path=/; HttpOnly; SameSite=Strict; Max-Age={}", kSessionCookie, *secret,
+                                     std::chrono::seconds(kSessionLasts).count())},
+          {"Location", "/"}};
+      return respond(std::move(signedIn));
+    }
+    Reply file;
+    if (parts.empty()) {
+      file.file = server_->pages / "index.html";
+    } else if (parts.size() == 2 && parts[0] == "app") {
+      static const std::regex kPageFile(R"([A-Za-z0-9_-]+\.(html|js|css|svg|png))");
+      if (!std::regex_match(parts[1], kPageFile)) throw notFound();
+      file.file = server_->pages / parts[1];
+    } else if (parts.size() > 2 && parts[0] == "lib" && parts[1] == "three") {
+      std::string rest;
+      for (size_t i = 2; i < parts.size(); ++i) rest += (i > 2 ? "/" : "") + parts[i];
+      if (!threeFiles().contains(rest)) throw notFound();
+      file.file = fs::path(kThreeFolder) / rest;
+    } else {
+      throw notFound();
+    }
+    std::error_code error;
+    if (!fs::is_regular_file(file.file, error)) {
+      throw ApiError(404, fmt::format("{} is not installed (the page's files; see the README)", file.file.string()));
+    }
+    respond(std::move(file));
+  }
+
+  // A one-time link that opens a browser's session for who asks (over the
+  // Unix socket: this machine's user; over TCP: the token's holder).
+  void loginLink() {
+    std::string base;
+    if constexpr (std::is_same_v<Protocol, asio::ip::tcp>) {
+      if (identity_.bySession) throw ApiError(403, "a login link is asked for with a token or on this machine");
+      const auto host = request_[http::field::host];
+      base = "http://" + std::string(host.data(), host.size());
+    } else {
+      const auto page = server_->loopbackPage();
+      if (!page) {
+        throw ApiError(409,
+                       "the daemon has no TCP listener on this machine for a browser: add tcp://127.0.0.1:8730 to "
+                       "listen in its configuration");
+      }
+      base = *page;
+    }
+    const std::string code = server_->newLoginCode(identity_.name);
+    respond({201,
+             {{"url", base + "/login?code=" + code},
+              {"page", base + "/"},
+              {"user", identity_.name},
+              {"expires_in", std::chrono::seconds(kLoginLinkLasts).count()}}});
   }
 
   Submission submission() const {
@@ -425,11 +667,24 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   }
 
   void respond(Reply reply) {
+    if (!reply.file.empty()) {
+      std::ifstream in(reply.file, std::ios::binary);
+      std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      if (!in.good() && !in.eof()) {
+        reply = Reply{500, {{"error", fmt::format("{} cannot be read", reply.file.string())}}};
+      } else {
+        reply.contentType = contentTypeOf(reply.file);
+        reply.text = std::move(bytes);
+        reply.headers.emplace_back("Cache-Control", "no-cache");
+      }
+    }
     auto response = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(reply.status), 11);
     response->set(http::field::server, "rotafabd");
-    response->set(http::field::content_type, "application/json");
-    response->body() = reply.text.empty() ? reply.body.dump(-1, ' ', false, json::error_handler_t::replace) + "\n"
-                                          : std::move(reply.text);
+    response->set(http::field::content_type, reply.contentType.empty() ? "application/json" : reply.contentType);
+    for (const auto& [field, value] : reply.headers) response->set(field, value);
+    response->body() = reply.text.empty() && reply.contentType.empty()
+                           ? reply.body.dump(-1, ' ', false, json::error_handler_t::replace) + "\n"
+                           : std::move(reply.text);
     const bool keep = keepAlive_ && request_.keep_alive() && reply.status < 400;
     response->keep_alive(keep);
     response->prepare_payload();
@@ -591,7 +846,17 @@ void HttpServer::listen() {
         const asio::ip::tcp::endpoint endpoint(asio::ip::make_address(host), port);
         acceptor->open(endpoint.protocol());
         acceptor->set_option(asio::socket_base::reuse_address(true));
-        acceptor->bind(endpoint);
+        beast::error_code bindError;
+        acceptor->bind(endpoint, bindError);
+        if (bindError == asio::error::address_in_use && impl_->service.config().defaultListen) {
+          // The default port taken (another daemon, another program): any
+          // free one, which rotafabd.json records and `rotafab dashboard` reads.
+          impl_->log->warn("{}: the port is in use; the page is on another port (rotafabd.json, rotafab dashboard)",
+                           address);
+          bindError = {};
+          acceptor->bind(asio::ip::tcp::endpoint(endpoint.address(), 0), bindError);
+        }
+        if (bindError) throw boost::system::system_error(bindError);
         acceptor->listen(asio::socket_base::max_listen_connections);
         const auto local = acceptor->local_endpoint();
         impl_->bound.push_back(fmt::format("tcp://{}:{}", local.address().to_string(), local.port()));

@@ -9,8 +9,10 @@
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <future>
+#include <regex>
 #include <set>
 #include <thread>
 
@@ -24,6 +26,7 @@
 #include "geometry/PolygonMesh.h"
 #include "jobs/JobSheets.h"
 #include "jobs/ManifestFile.h"
+#include "jobs/Toolpath.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::service {
@@ -33,6 +36,29 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
 namespace {
+
+// A sheet's toolpath for people (docs/API.md, GET /api/jobs/ID/sheets/N): every
+// stroke in the order the laser burns it, so that the stroke a cut's
+// progress counts is the stroke at that index; to a thousandth of an inch.
+json toolpathJson(const jobs::Toolpath& path) {
+  const auto rounded = [](double value) { return std::round(value * 1000) / 1000; };
+  json strokes = json::array();
+  for (const jobs::ToolpathStroke& stroke : path.strokes) {
+    json points = json::array();
+    for (const auto& point : stroke.points) points.push_back({rounded(point.x()), rounded(point.y())});
+    strokes.push_back({{"operation", profiles::operationName(stroke.operation)},
+                       {"pass", stroke.pass},
+                       {"power", rounded(stroke.power)},
+                       {"points", std::move(points)}});
+  }
+  return {{"sheet", path.sheet},
+          {"width", path.width},
+          {"height", path.height},
+          {"seconds", std::round(path.seconds * 10) / 10},
+          {"burn_length", rounded(path.burnLength)},
+          {"travel_length", rounded(path.travelLength)},
+          {"strokes", std::move(strokes)}};
+}
 
 std::string isoTime(double unixSeconds) {
   const auto seconds = static_cast<std::time_t>(unixSeconds);
@@ -1293,6 +1319,67 @@ void Service::manifest(JobId id, ReplyHandler done) {
     json manifest = json::parse(in, nullptr, false);
     if (manifest.is_discarded()) throw ApiError(500, fmt::format("job {}: its manifest.json cannot be read", id));
     return Reply{200, manifest};
+  });
+}
+
+void Service::file(JobId id, const std::string& name, ReplyHandler done) {
+  impl_->answer(std::move(done), [this, id, name] {
+    const JobRecord job = impl_->jobOrThrow(id);
+    // Only what a planned job's folder holds for people to look at, by its own names.
+    static const std::regex kShown(R"((sheet-\d{3,}\.(svg|preview\.svg))|structure\.obj|manifest\.txt|manifest\.json)");
+    if (!std::regex_match(name, kShown)) {
+      throw ApiError(404, fmt::format("no file {} (sheet-NNN.preview.svg, sheet-NNN.svg, structure.obj, "
+                                      "manifest.txt, manifest.json)",
+                                      name));
+    }
+    if (job.sheets == 0) {
+      throw ApiError(409, fmt::format("job {} is {}: it has no files until it is planned", id, stateName(job.state)));
+    }
+    const fs::path path = impl_->plannedFolder(job) / name;
+    std::error_code error;
+    if (!fs::is_regular_file(path, error)) throw ApiError(404, fmt::format("job {} has no {}", id, name));
+    Reply reply;
+    reply.file = path;
+    return reply;
+  });
+}
+
+void Service::sheet(JobId id, int sheet, ReplyHandler done) {
+  // The job and its device's profiles on the strand; the toolpath, which may
+  // take a while on a sheet of thousands of strokes, on the workers.
+  impl_->onStrand([this, id, sheet, done = std::move(done)]() mutable {
+    std::function<Reply()> work;
+    const Reply refused = impl_->guarded([&] {
+      const JobRecord job = impl_->jobOrThrow(id);
+      if (job.sheets == 0) {
+        throw ApiError(409,
+                       fmt::format("job {} is {}: it has no sheets until it is planned", id, stateName(job.state)));
+      }
+      if (sheet < 1 || sheet > job.sheets) {
+        throw ApiError(404, fmt::format("job {} has sheets 1 to {}, not {}", id, job.sheets, sheet));
+      }
+      const Impl::Device* device = impl_->deviceNamed(job.device);
+      if (!device) throw ApiError(409, fmt::format("job {} has no device to plan its strokes for", id));
+      work = [folder = impl_->plannedFolder(job), machine = device->machine, material = device->material, sheet, id] {
+        const std::vector<jobs::JobSheet> drawn = jobs::readJobSheets(folder, std::optional<int>(sheet));
+        if (drawn.empty()) throw ApiError(404, fmt::format("job {} has no sheet {}", id, sheet));
+        const jobs::Toolpath path =
+            jobs::planToolpath(drawn.front().drawing, machine, material, jobs::profileMotion(machine));
+        json answer = toolpathJson(path);
+        // Each operation in its colour of the machine's table (fig. 65), as the sheet files draw it.
+        json colours = json::object();
+        for (profiles::Operation operation : profiles::kAllOperations) {
+          const profiles::Rgb rgb = machine.settingFor(operation).rgb;
+          colours[std::string(profiles::operationName(operation))] =
+              fmt::format("#{:02x}{:02x}{:02x}", rgb.r, rgb.g, rgb.b);
+        }
+        answer["colours"] = std::move(colours);
+        return Reply{200, std::move(answer)};
+      };
+      return Reply{0, nullptr};
+    });
+    if (refused.status != 0) return done(refused);
+    asio::post(impl_->workers, [this, work = std::move(work), done = std::move(done)] { done(impl_->guarded(work)); });
   });
 }
 

@@ -61,7 +61,10 @@ struct Reply {
   Reply(int status, nlohmann::json body) : status(status), body(std::move(body)) {}
   int status = 200;
   nlohmann::json body;
-  std::string text;  // the body already written as JSON (a long list, built a row at a time); else `body`
+  std::string text;            // the body already written as JSON (a long list, built a row at a time); else `body`
+  std::filesystem::path file;  // or a file's bytes as the body (its type from its name)
+  std::string contentType;     // of `text` when it is not JSON
+  std::vector<std::pair<std::string, std::string>> headers;  // more header fields (Set-Cookie, Location)
 };
 using ReplyHandler = std::function<void(Reply)>;
 
@@ -92,6 +95,12 @@ class Service {
   void status(JobId id, ReplyHandler done);
   void manifest(JobId id, ReplyHandler done);
   void devices(ReplyHandler done);
+  // A planned job's file for people to look at: a sheet's preview or cut
+  // SVG, structure.obj, manifest.txt or manifest.json (Reply::file).
+  void file(JobId id, const std::string& name, ReplyHandler done);
+  // Sheet `sheet` (from 1) as its device's laser would burn it: the strokes
+  // in order, each with its operation and pass, and the time it takes.
+  void sheet(JobId id, int sheet, ReplyHandler done);
   // cancel, pause, resume, start, next, move; `arguments`: resume's
   // from_sheet, move's before or priority; `who` for the record.
   void act(JobId id, const std::string& action, const nlohmann::json& arguments, const std::string& who,

@@ -1,0 +1,766 @@
+// The workshop page (docs/PAGE.md): the queue, the machines, the sheets and
+// the assembly guide, over the daemon's documented API (docs/API.md) and its
+// event stream. Every button calls the API; a refusal shows the API's own words.
+'use strict';
+
+(() => {
+  const $ = (id) => document.getElementById(id);
+  const state = {
+    jobs: [],
+    devices: [],
+    progress: new Map(),  // job id -> its last progress event
+    sheets: { job: null, sheet: 1, path: null, lines: [] },
+    guide: null,
+    tab: 'queue',
+  };
+
+  // ---- the API ----
+
+  class Refused extends Error {}
+
+  async function api(method, path, body) {
+    const init = { method, credentials: 'same-origin', headers: {} };
+    if (body instanceof FormData) {
+      init.body = body;
+    } else if (body !== undefined) {
+      init.body = JSON.stringify(body);
+      init.headers['Content-Type'] = 'application/json';
+    }
+    let response;
+    try {
+      response = await fetch(path, init);
+    } catch (failure) {
+      throw new Refused(`the daemon does not answer (${failure.message}): is rotafabd running?`);
+    }
+    const type = response.headers.get('Content-Type') || '';
+    const data = type.includes('json') ? await response.json().catch(() => ({})) : await response.text();
+    if (!response.ok) {
+      const words = data && data.error ? data.error : `${response.status} ${response.statusText}`;
+      throw new Refused(words);
+    }
+    return data;
+  }
+
+  function showError(text) {
+    $('error-text').textContent = text;
+    $('error').hidden = false;
+  }
+  function clearError() {
+    $('error').hidden = true;
+    $('error-text').textContent = '';
+  }
+  $('error-close').addEventListener('click', clearError);
+
+  // Runs an action; a refusal is shown as the API said it.
+  async function attempt(work) {
+    try {
+      clearError();
+      return await work();
+    } catch (failure) {
+      showError(failure instanceof Refused ? failure.message : String(failure));
+      return undefined;
+    }
+  }
+
+  // ---- words ----
+
+  function duration(seconds) {
+    if (seconds === undefined || seconds === null || !isFinite(seconds)) return '–';
+    seconds = Math.max(0, Math.round(seconds));
+    if (seconds < 60) return `${seconds} s`;
+    const minutes = Math.floor(seconds / 60);
+    if (minutes < 60) return `${minutes} min ${seconds % 60} s`;
+    return `${Math.floor(minutes / 60)} h ${minutes % 60} min`;
+  }
+
+  function sheetsDone(job) {
+    if (!job.sheets) return '–';
+    if (job.state === 'done') return `${job.sheets}/${job.sheets}`;
+    if (['running', 'paused', 'interrupted', 'failed'].includes(job.state)) {
+      return `${Math.max(0, (job.sheet || 0) - 1)}/${job.sheets}`;
+    }
+    return `0/${job.sheets}`;
+  }
+
+  function timeLeft(job) {
+    const progress = state.progress.get(job.id) || job.progress;
+    if (progress && progress.phase === 'cutting' && progress.seconds_left !== undefined) {
+      return duration(progress.seconds_left);
+    }
+    if (progress && progress.phase && progress.total) {
+      return `planning ${Math.round((100 * progress.done) / progress.total)}%`;
+    }
+    const cost = job.summary && job.summary.cost;
+    if (cost && ['ready', 'queued'].includes(job.state)) return duration(cost.cutting_seconds);
+    if (cost && ['interrupted', 'failed', 'paused'].includes(job.state) && cost.sheet_cutting_seconds) {
+      return duration(cost.sheet_cutting_seconds.slice(Math.max(0, job.sheet - 1)).reduce((a, b) => a + b, 0));
+    }
+    return job.state === 'done' ? '0 s' : '–';
+  }
+
+  function element(tag, attributes = {}, ...children) {
+    const node = document.createElement(tag);
+    for (const [key, value] of Object.entries(attributes)) {
+      if (key === 'class') node.className = value;
+      else if (key.startsWith('on')) node.addEventListener(key.slice(2), value);
+      else if (value !== undefined && value !== null && value !== false) node.setAttribute(key, value === true ? '' : value);
+    }
+    for (const child of children) {
+      if (child !== null && child !== undefined) node.append(child);
+    }
+    return node;
+  }
+
+  // ---- the queue ----
+
+  function actionsOf(job) {
+    const buttons = [];
+    const act = (label, action, body, extra = {}) =>
+      buttons.push(element('button', {
+        type: 'button', 'data-action': action, ...extra,
+        onclick: () => attempt(async () => {
+          const arguments_ = typeof body === 'function' ? body() : body;
+          if (arguments_ === null) return;
+          await api('POST', `/api/jobs/${job.id}/${action}`, arguments_ || {});
+          await refreshJobs();
+        }),
+      }, label));
+    switch (job.state) {
+      case 'ready':
+        act('Start', 'start', {}, { class: 'primary' });
+        break;
+      case 'running':
+        if (job.waiting_for_next) act('Next sheet loaded', 'next', {}, { class: 'primary' });
+        act('Pause', 'pause');
+        break;
+      case 'paused':
+        act('Resume', 'resume', {}, { class: 'primary' });
+        break;
+      case 'interrupted':
+      case 'failed':
+        act('Resume from sheet…', 'resume', () => {
+          const answer = window.prompt(`Cut again from which sheet (1 to ${job.sheets})? Load it fresh first.`,
+                                       String(Math.max(1, job.sheet || 1)));
+          return answer === null ? null : { from_sheet: Number(answer) };
+        });
+        break;
+      default:
+        break;
+    }
+    if (!['done', 'cancelled'].includes(job.state)) act('Cancel', 'cancel', {}, { class: 'danger' });
+    if (job.sheets) {
+      buttons.push(element('button', { type: 'button', 'data-action': 'sheets', onclick: () => showSheets(job.id) }, 'Sheets'));
+      buttons.push(element('button', { type: 'button', 'data-action': 'guide', onclick: () => showGuide(job.id) }, 'Guide'));
+    }
+    return buttons;
+  }
+
+  function renderJobs() {
+    const body = $('jobs-body');
+    body.replaceChildren();
+    for (const job of state.jobs) {
+      const row = element('tr', { 'data-job': job.id, draggable: 'true', 'data-state': job.state },
+        element('td', {}, String(job.id)),
+        element('td', {}, job.source || ''),
+        element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
+                element('span', { class: 'message' }, job.message || '')),
+        element('td', {}, job.owner || ''),
+        element('td', {}, job.device || '–'),
+        element('td', { class: 'sheets' }, sheetsDone(job)),
+        element('td', { class: 'time-left' }, timeLeft(job)),
+        element('td', { class: 'actions' }, ...actionsOf(job)));
+      row.addEventListener('dragstart', (event) => {
+        event.dataTransfer.setData('text/plain', String(job.id));
+        event.dataTransfer.effectAllowed = 'move';
+      });
+      row.addEventListener('dragover', (event) => { event.preventDefault(); row.classList.add('drag-over'); });
+      row.addEventListener('dragleave', () => row.classList.remove('drag-over'));
+      row.addEventListener('drop', (event) => {
+        event.preventDefault();
+        row.classList.remove('drag-over');
+        const moved = Number(event.dataTransfer.getData('text/plain'));
+        if (!moved || moved === job.id) return;
+        attempt(async () => {
+          await api('POST', `/api/jobs/${moved}/move`, { before: job.id });
+          await refreshJobs();
+        });
+      });
+      body.append(row);
+    }
+    $('jobs-empty').hidden = state.jobs.length > 0;
+    fillJobChoices();
+  }
+
+  async function refreshJobs() {
+    const answer = await api('GET', '/api/jobs');
+    state.jobs = answer.jobs || [];
+    renderJobs();
+  }
+
+  // Job transitions come by the event stream; the queue is read again at
+  // most once a second however many come.
+  let jobsTimer = null;
+  let jobsRead = 0;
+  function jobsChanged() {
+    if (jobsTimer) return;
+    const wait = Math.max(0, 1000 - (Date.now() - jobsRead));
+    jobsTimer = setTimeout(() => {
+      jobsTimer = null;
+      jobsRead = Date.now();
+      refreshJobs().catch((failure) => showError(failure.message));
+    }, wait);
+  }
+
+  // ---- the machines ----
+
+  function renderDevices() {
+    const cards = $('devices');
+    cards.replaceChildren();
+    for (const device of state.devices) {
+      const progress = device.job ? state.progress.get(device.job) : null;
+      const cutting = progress && progress.phase === 'cutting';
+      const fraction = cutting && progress.strokes ? progress.stroke / progress.strokes : null;
+      cards.append(element('article', { class: 'device', 'data-device': device.name, 'data-state': device.state },
+        element('h3', {}, device.name, element('span', { class: `state ${device.state}` }, device.state)),
+        element('p', {}, `${device.machine || '?'} · ${device.material || ''} · ${device.uri}`),
+        device.message ? element('p', { class: 'device-message' }, device.message) : null,
+        device.job ? element('p', {}, `job ${device.job}` + (cutting ? `, sheet ${progress.sheet} of ${progress.sheets}` : '')) : null,
+        fraction !== null
+          ? element('progress', { max: '1', value: String(fraction), 'data-percent': String(Math.round(fraction * 100)) })
+          : null,
+        cutting ? element('p', { class: 'progress-text' },
+          `${Math.round(fraction * 100)}% of the sheet · ${duration(progress.seconds_left)} left`) : null));
+    }
+    const choose = $('opt-device');
+    const chosen = choose.value;
+    choose.replaceChildren(element('option', { value: '' }, 'any that fits'));
+    for (const device of state.devices) {
+      choose.append(element('option', { value: device.name }, `${device.name} (${device.machine})`));
+    }
+    choose.value = chosen;
+  }
+
+  async function refreshDevices() {
+    const answer = await api('GET', '/api/devices');
+    state.devices = answer.devices || [];
+    renderDevices();
+  }
+
+  // ---- submitting a mesh ----
+
+  const dropZone = $('drop-zone');
+  const meshInput = $('mesh-file');
+  let dropped = null;
+  function meshChosen(file) {
+    dropped = file;
+    $('drop-text').textContent = file ? `${file.name} (${Math.ceil(file.size / 1024)} KB)` : 'Drop a mesh here or choose one';
+  }
+  meshInput.addEventListener('change', () => meshChosen(meshInput.files[0] || null));
+  for (const type of ['dragenter', 'dragover']) {
+    dropZone.addEventListener(type, (event) => { event.preventDefault(); dropZone.classList.add('over'); });
+  }
+  dropZone.addEventListener('dragleave', () => dropZone.classList.remove('over'));
+  dropZone.addEventListener('drop', (event) => {
+    event.preventDefault();
+    dropZone.classList.remove('over');
+    if (event.dataTransfer.files.length) meshChosen(event.dataTransfer.files[0]);
+  });
+
+  $('submit-form').addEventListener('submit', (event) => {
+    event.preventDefault();
+    attempt(async () => {
+      const file = dropped || meshInput.files[0];
+      if (!file) throw new Refused('choose a mesh first (drop it on the box, or click it)');
+      const options = { structure: $('opt-structure').value };
+      if ($('opt-size').value.trim()) options.size = $('opt-size').value.trim();
+      if ($('opt-panels').value.trim()) options.panels = $('opt-panels').value.trim();
+      if ($('opt-material').value.trim()) options.material = $('opt-material').value.trim();
+      const form = new FormData();
+      form.append('file', file, file.name);
+      form.append('options', JSON.stringify(options));
+      if ($('opt-device').value) form.append('device', $('opt-device').value);
+      $('submit-button').disabled = true;
+      try {
+        const job = await api('POST', '/api/jobs', form);
+        meshChosen(null);
+        meshInput.value = '';
+        state.jobs = state.jobs.filter((known) => known.id !== job.id).concat([job]);
+        renderJobs();
+        jobsChanged();
+      } finally {
+        $('submit-button').disabled = false;
+      }
+    });
+  });
+
+  // ---- the sheets ----
+
+  function plannedJobs() {
+    return state.jobs.filter((job) => job.sheets > 0);
+  }
+
+  function fillJobChoices() {
+    for (const id of ['sheets-job-select', 'guide-job-select']) {
+      const select = $(id);
+      const chosen = select.value;
+      select.replaceChildren(element('option', { value: '' }, 'choose a planned job'));
+      for (const job of plannedJobs()) {
+        select.append(element('option', { value: String(job.id) }, `${job.id}: ${job.source} (${job.sheets} sheets)`));
+      }
+      select.value = chosen;
+    }
+  }
+
+  function showTab(name) {
+    state.tab = name;
+    for (const tab of document.querySelectorAll('.tab')) {
+      tab.setAttribute('aria-selected', String(tab.dataset.tab === name));
+    }
+    for (const page of document.querySelectorAll('.tab-page')) page.hidden = page.id !== `tab-${name}`;
+    if (state.guide) state.guide.visible(name === 'guide');
+  }
+  for (const tab of document.querySelectorAll('.tab')) tab.addEventListener('click', () => showTab(tab.dataset.tab));
+
+  function showSheets(jobId) {
+    showTab('sheets');
+    $('sheets-job-select').value = String(jobId);
+    openSheets(jobId, 1);
+  }
+  $('sheets-job-select').addEventListener('change', () => {
+    const id = Number($('sheets-job-select').value);
+    if (id) openSheets(id, 1);
+  });
+
+  async function openSheets(jobId, sheet) {
+    const job = state.jobs.find((known) => known.id === jobId);
+    if (!job) return;
+    state.sheets.job = jobId;
+    const buttons = $('sheet-buttons');
+    buttons.replaceChildren();
+    const perSheet = (job.summary && job.summary.cost && job.summary.cost.sheet_cutting_seconds) || [];
+    for (let n = 1; n <= job.sheets; n += 1) {
+      buttons.append(element('button', {
+        type: 'button', 'data-sheet': n, 'aria-pressed': String(n === sheet),
+        title: perSheet[n - 1] !== undefined ? `about ${duration(perSheet[n - 1])} to cut` : '',
+        onclick: () => openSheets(jobId, n),
+      }, `Sheet ${n}`));
+    }
+    await attempt(() => drawSheet(jobId, sheet));
+  }
+
+  async function drawSheet(jobId, sheet) {
+    const path = await api('GET', `/api/jobs/${jobId}/sheets/${sheet}`);
+    state.sheets = { job: jobId, sheet, path, lines: [] };
+    const svgNS = 'http://www.w3.org/2000/svg';
+    const svg = document.createElementNS(svgNS, 'svg');
+    svg.setAttribute('viewBox', `0 0 ${path.width} ${path.height}`);
+    svg.setAttribute('data-job', jobId);
+    svg.setAttribute('data-sheet', sheet);
+    const bed = document.createElementNS(svgNS, 'rect');
+    Object.entries({ x: 0, y: 0, width: path.width, height: path.height, fill: '#fbfaf7', stroke: '#999', 'stroke-width': 0.02 })
+      .forEach(([k, v]) => bed.setAttribute(k, v));
+    svg.append(bed);
+    // Sheet coordinates have y up.
+    const flip = document.createElementNS(svgNS, 'g');
+    flip.setAttribute('transform', `translate(0 ${path.height}) scale(1 -1)`);
+    path.strokes.forEach((stroke, index) => {
+      const line = document.createElementNS(svgNS, 'polyline');
+      line.setAttribute('points', stroke.points.map((p) => `${p[0]},${p[1]}`).join(' '));
+      line.setAttribute('fill', 'none');
+      line.setAttribute('stroke', path.colours[stroke.operation] || '#000');
+      // Visible on a screen, unlike the cut file's hairlines: 1.5 px whatever the zoom.
+      line.setAttribute('stroke-width', '1.5');
+      line.setAttribute('vector-effect', 'non-scaling-stroke');
+      line.setAttribute('data-stroke', index);
+      line.setAttribute('data-operation', stroke.operation);
+      flip.append(line);
+      state.sheets.lines.push(line);
+    });
+    svg.append(flip);
+    $('sheet-view').replaceChildren(svg);
+    $('sheet-info').textContent =
+      `Sheet ${sheet}: ${path.strokes.length} strokes, ${path.burn_length.toFixed(0)} in burnt, about ${duration(path.seconds)} to cut.`;
+    const legend = $('sheet-legend');
+    legend.replaceChildren();
+    for (const [operation, colour] of Object.entries(path.colours)) {
+      if (!path.strokes.some((stroke) => stroke.operation === operation)) continue;
+      legend.append(element('span', {}, element('span', { class: 'swatch', style: `background:${colour}` }), ` ${operation}`));
+    }
+    highlightStroke();
+  }
+
+  // The stroke being cut (progress counts those finished), the ones before it faded.
+  function highlightStroke() {
+    const { job, sheet, lines } = state.sheets;
+    const progress = state.progress.get(job);
+    const jobNow = state.jobs.find((known) => known.id === job);
+    let done = 0;
+    let current = -1;
+    if (progress && progress.phase === 'cutting' && progress.sheet === sheet) {
+      done = progress.stroke;
+      current = progress.stroke < progress.strokes ? progress.stroke : -1;
+    } else if (jobNow && (jobNow.state === 'done' || (jobNow.sheet > sheet))) {
+      done = lines.length;
+    }
+    lines.forEach((line, index) => {
+      line.classList.toggle('done', index < done);
+      line.setAttribute('stroke-opacity', index < done ? '0.35' : '1');
+      if (index === current) {
+        line.setAttribute('stroke-width', '5');
+        line.setAttribute('data-current', 'true');
+      } else if (line.hasAttribute('data-current')) {
+        line.setAttribute('stroke-width', '1.5');
+        line.removeAttribute('data-current');
+      }
+    });
+    const view = $('sheet-view').firstElementChild;
+    if (view) view.setAttribute('data-current-stroke', String(current));
+  }
+
+  // ---- the event stream ----
+
+  function listen() {
+    const events = new EventSource('/api/events');
+    const status = $('connection');
+    events.onopen = () => {
+      status.textContent = 'live';
+      status.className = 'connection live';
+      // What happened while the stream was down.
+      refreshJobs().catch((failure) => showError(failure.message));
+      refreshDevices().catch((failure) => showError(failure.message));
+    };
+    events.onerror = () => {
+      status.textContent = 'reconnecting…';
+      status.className = 'connection lost';
+    };
+    events.addEventListener('job', (event) => {
+      const job = JSON.parse(event.data);
+      if (!['running', 'paused'].includes(job.state)) state.progress.delete(job.id);
+      const known = state.jobs.findIndex((other) => other.id === job.id);
+      if (known >= 0) state.jobs[known] = { ...state.jobs[known], ...job };
+      renderJobs();
+      jobsChanged();
+    });
+    events.addEventListener('progress', (event) => {
+      const progress = JSON.parse(event.data);
+      state.progress.set(progress.job, progress);
+      const row = document.querySelector(`tr[data-job="${progress.job}"]`);
+      const job = state.jobs.find((known) => known.id === progress.job);
+      if (row && job) {
+        if (progress.phase === 'cutting') job.sheet = progress.sheet;
+        row.querySelector('.time-left').textContent = timeLeft(job);
+        row.querySelector('.sheets').textContent = sheetsDone(job);
+      }
+      renderDevices();
+      if (state.sheets.job === progress.job && progress.phase === 'cutting') {
+        if (progress.sheet !== state.sheets.sheet && state.tab === 'sheets') {
+          openSheets(progress.job, progress.sheet);
+        } else {
+          highlightStroke();
+        }
+      }
+    });
+    events.addEventListener('device', (event) => {
+      const device = JSON.parse(event.data);
+      const known = state.devices.findIndex((other) => other.name === device.name);
+      if (known >= 0) state.devices[known] = device;
+      else state.devices.push(device);
+      renderDevices();
+    });
+  }
+
+  // ---- the assembly guide ----
+
+  function showGuide(jobId) {
+    showTab('guide');
+    $('guide-job-select').value = String(jobId);
+    attempt(() => openGuide(jobId));
+  }
+  $('guide-job-select').addEventListener('change', () => {
+    const id = Number($('guide-job-select').value);
+    if (id) attempt(() => openGuide(id));
+  });
+
+  // structure.obj: each panel's vertices, then its faces under `g panel-N`.
+  function parseStructure(text) {
+    const positions = [];
+    const index = [];
+    const ranges = new Map();  // panel id -> [first vertex, end vertex)
+    let panel = null;
+    let panelFirst = 0;
+    let lineStart = 0;
+    let vertices = 0;
+    while (lineStart < text.length) {
+      let lineEnd = text.indexOf('\n', lineStart);
+      if (lineEnd < 0) lineEnd = text.length;
+      const line = text.slice(lineStart, lineEnd);
+      lineStart = lineEnd + 1;
+      if (line.startsWith('v ')) {
+        if (panel !== null) {
+          ranges.set(panel, [panelFirst, vertices]);
+          panel = null;
+          panelFirst = vertices;
+        }
+        const parts = line.split(' ');
+        positions.push(Number(parts[1]), Number(parts[2]), Number(parts[3]));
+        vertices += 1;
+      } else if (line.startsWith('g panel-')) {
+        panel = Number(line.slice(8));
+      } else if (line.startsWith('f ')) {
+        const corners = line.split(' ').slice(1).map((word) => Number(word.split('/')[0]) - 1);
+        for (let k = 1; k + 1 < corners.length; k += 1) index.push(corners[0], corners[k], corners[k + 1]);
+      }
+    }
+    if (panel !== null) ranges.set(panel, [panelFirst, vertices]);
+    return { positions, index, ranges };
+  }
+
+  const colours = {
+    placed: [0.79, 0.66, 0.42],
+    next: [1.0, 0.42, 0.0],
+    later: [0.89, 0.9, 0.92],
+  };
+
+  class Guide {
+    constructor(container) {
+      this.container = container;
+      this.renderer = new THREE.WebGLRenderer({ antialias: true });
+      this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+      this.renderer.setClearColor(0xf0f2f4);
+      container.append(this.renderer.domElement);
+      this.scene = new THREE.Scene();
+      this.camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1e5);
+      this.controls = new THREE.OrbitControls(this.camera, this.renderer.domElement);
+      this.controls.enableDamping = true;
+      this.scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 0.8));
+      this.light = new THREE.DirectionalLight(0xffffff, 0.6);
+      this.scene.add(this.light);
+      this.mesh = null;
+      this.showing = false;
+      this.frames = 0;
+      this.spin = 0;
+      new ResizeObserver(() => this.resize()).observe(container);
+      this.loop = this.loop.bind(this);
+    }
+
+    resize() {
+      const width = this.container.clientWidth;
+      const height = this.container.clientHeight;
+      if (!width || !height) return;
+      this.renderer.setSize(width, height);
+      this.camera.aspect = width / height;
+      this.camera.updateProjectionMatrix();
+    }
+
+    visible(on) {
+      const was = this.showing;
+      this.showing = on;
+      if (on && !was) {
+        this.resize();
+        requestAnimationFrame(this.loop);
+      }
+    }
+
+    loop() {
+      if (!this.showing) return;
+      if (this.spin) {
+        // For the frame-rate measure: orbit without a hand on the mouse.
+        this.controls.autoRotate = true;
+        this.controls.autoRotateSpeed = this.spin;
+      }
+      this.controls.update();
+      this.light.position.copy(this.camera.position);
+      this.renderer.render(this.scene, this.camera);
+      this.frames += 1;
+      requestAnimationFrame(this.loop);
+    }
+
+    load(structure, manifest) {
+      if (this.mesh) {
+        this.scene.remove(this.mesh);
+        this.mesh.geometry.dispose();
+      }
+      const geometry = new THREE.BufferGeometry();
+      const vertexCount = structure.positions.length / 3;
+      const IndexArray = vertexCount > 65535 ? Uint32Array : Uint16Array;
+      geometry.setIndex(new THREE.BufferAttribute(new IndexArray(structure.index), 1));
+      geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(structure.positions), 3));
+      this.colour = new Float32Array(vertexCount * 3);
+      geometry.setAttribute('color', new THREE.BufferAttribute(this.colour, 3));
+      geometry.computeVertexNormals();
+      geometry.computeBoundingSphere();
+      const material = new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide });
+      this.mesh = new THREE.Mesh(geometry, material);
+      this.scene.add(this.mesh);
+      this.ranges = structure.ranges;
+      const sphere = geometry.boundingSphere;
+      this.controls.target.copy(sphere.center);
+      this.camera.near = sphere.radius / 100;
+      this.camera.far = sphere.radius * 100;
+      this.camera.position.copy(sphere.center).add(new THREE.Vector3(0.4, 0.5, 1).normalize().multiplyScalar(sphere.radius * 3));
+      this.camera.updateProjectionMatrix();
+      this.controls.update();
+      // Assembly order: the manifest's `order`, else the panels' own.
+      this.panels = [...manifest.panels].sort((a, b) => (a.order || a.id) - (b.order || b.id));
+      this.byId = new Map(manifest.panels.map((panel) => [panel.id, panel]));
+      this.step = 0;
+      this.paint(0, this.panels.length, 'later');
+      this.goTo(1);
+    }
+
+    // Colours the panels at steps [from, to) (0-based) as `kind`.
+    paint(from, to, kind) {
+      const [r, g, b] = colours[kind];
+      for (let k = from; k < to; k += 1) {
+        const range = this.ranges.get(this.panels[k].id);
+        if (!range) continue;
+        for (let v = range[0]; v < range[1]; v += 1) {
+          this.colour[3 * v] = r;
+          this.colour[3 * v + 1] = g;
+          this.colour[3 * v + 2] = b;
+        }
+      }
+    }
+
+    goTo(step) {
+      step = Math.max(1, Math.min(this.panels.length, step));
+      const before = this.step;
+      // Only the panels whose colour changes are painted again.
+      if (step > before) {
+        this.paint(Math.max(0, before - 1), step - 1, 'placed');
+      } else if (before > 0) {
+        this.paint(step, before, 'later');
+      }
+      this.paint(step - 1, step, 'next');
+      this.step = step;
+      this.mesh.geometry.attributes.color.needsUpdate = true;
+      this.describe();
+    }
+
+    describe() {
+      const panel = this.panels[this.step - 1];
+      $('guide-step').textContent = String(this.step);
+      $('guide-steps').textContent = String(this.panels.length);
+      $('guide-panel-number').textContent = String(panel.id);
+      $('guide-panel-sheet').textContent = panel.sheet ? String(panel.sheet) : '–';
+      const placedBefore = (other) => (other.order || other.id) < (panel.order || panel.id);
+      const neighbours = (panel.neighbors || []).map((id) => this.byId.get(id)).filter(Boolean);
+      $('guide-panel-neighbours').textContent = neighbours.length
+        ? neighbours.map((other) => `${other.id}${placedBefore(other) ? ' (placed)' : ''}`).join(', ')
+        : '–';
+      const holes = $('guide-panel-holes');
+      holes.replaceChildren();
+      for (const other of neighbours) {
+        const shared = sharedHoles(panel, other);
+        if (!shared.length) continue;
+        holes.append(element('li', {}, `with ${other.id}: ${shared.map((s) => `edge ${s.edge} (${s.count} hole${s.count === 1 ? '' : 's'})`).join(', ')}`));
+      }
+      this.renderer.domElement.setAttribute('data-highlighted', String(panel.id));
+    }
+
+    // The panel whose vertices are painted as the next one, read from what is drawn.
+    highlighted() {
+      const [r, g, b] = colours.next;
+      const found = [];
+      for (const [id, range] of this.ranges) {
+        const v = range[0];
+        if (range[1] > v && this.colour[3 * v] === Math.fround(r) && this.colour[3 * v + 1] === Math.fround(g) &&
+            this.colour[3 * v + 2] === Math.fround(b)) {
+          found.push(id);
+        }
+      }
+      return found;
+    }
+
+    // Frames drawn per second over `milliseconds`, orbiting.
+    measure(milliseconds) {
+      return new Promise((resolve) => {
+        this.spin = 30;
+        const start = performance.now();
+        const frames = this.frames;
+        setTimeout(() => {
+          const rate = ((this.frames - frames) * 1000) / (performance.now() - start);
+          this.spin = 0;
+          this.controls.autoRotate = false;
+          resolve(rate);
+        }, milliseconds);
+      });
+    }
+  }
+
+  // The holes two panels share: by edge, those on both.
+  function sharedHoles(panel, other) {
+    const count = (holes) => {
+      const counts = new Map();
+      for (const hole of holes || []) {
+        if (hole.edge !== undefined) counts.set(hole.edge, (counts.get(hole.edge) || 0) + 1);
+      }
+      return counts;
+    };
+    const mine = count(panel.holes);
+    const theirs = count(other.holes);
+    const shared = [];
+    for (const [edge, n] of mine) {
+      if (theirs.has(edge)) shared.push({ edge, count: Math.min(n, theirs.get(edge)) });
+    }
+    return shared;
+  }
+
+  async function openGuide(jobId) {
+    if (typeof THREE === 'undefined') throw new Refused('the 3D view needs three.js (Debian package libjs-three)');
+    const [manifest, text] = await Promise.all([
+      api('GET', `/api/jobs/${jobId}/manifest`),
+      api('GET', `/api/jobs/${jobId}/files/structure.obj`),
+    ]);
+    if (!state.guide) state.guide = new Guide($('guide-view'));
+    state.guide.load(parseStructure(text), manifest);
+    state.guide.job = jobId;
+    state.guide.visible(state.tab === 'guide');
+    const steps = $('guide-print-steps');
+    steps.replaceChildren();
+    for (const panel of state.guide.panels) {
+      const neighbours = (panel.neighbors || []).map((id) => state.guide.byId.get(id)).filter(Boolean);
+      const joins = neighbours
+        .filter((other) => (other.order || other.id) < (panel.order || panel.id))
+        .map((other) => `${other.id} (${sharedHoles(panel, other).map((s) => `edge ${s.edge}`).join(', ') || 'no holes'})`);
+      steps.append(element('li', {}, `Panel ${panel.id}, sheet ${panel.sheet}` + (joins.length ? `: joins ${joins.join('; ')}` : ': the first')));
+    }
+    window.rotafabGuide = {
+      job: jobId,
+      step: () => state.guide.step,
+      panel: () => state.guide.panels[state.guide.step - 1].id,
+      highlighted: () => state.guide.highlighted(),
+      fps: (milliseconds) => state.guide.measure(milliseconds || 2000),
+      panels: state.guide.panels.length,
+    };
+  }
+
+  const stepBy = (delta) => { if (state.guide) state.guide.goTo(state.guide.step + delta); };
+  $('guide-first').addEventListener('click', () => state.guide && state.guide.goTo(1));
+  $('guide-prev').addEventListener('click', () => stepBy(-1));
+  $('guide-next').addEventListener('click', () => stepBy(1));
+  $('guide-last').addEventListener('click', () => state.guide && state.guide.goTo(state.guide.panels.length));
+  document.addEventListener('keydown', (event) => {
+    if (state.tab !== 'guide' || event.target.closest('input, select')) return;
+    if (event.key === 'ArrowRight') stepBy(1);
+    if (event.key === 'ArrowLeft') stepBy(-1);
+  });
+  $('guide-find').addEventListener('submit', (event) => {
+    event.preventDefault();
+    attempt(async () => {
+      if (!state.guide) throw new Refused('choose a job first');
+      const id = Number($('guide-find-number').value);
+      const step = state.guide.panels.findIndex((panel) => panel.id === id);
+      if (step < 0) throw new Refused(`there is no panel ${id} in job ${state.guide.job} (1 to ${state.guide.panels.length})`);
+      state.guide.goTo(step + 1);
+    });
+  });
+  $('guide-print').addEventListener('click', () => window.print());
+
+  // ---- start ----
+
+  attempt(async () => {
+    await Promise.all([refreshDevices(), refreshJobs()]);
+    listen();
+  });
+})();
