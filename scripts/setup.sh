@@ -17,12 +17,16 @@ packages=(
   libsqlite3-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
   libopenmesh-dev
   hershey-fonts-data libumockdev-dev umockdev
+  # the workshop page's 3D view, served from Debian's path
+  libjs-three
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev ghostscript hyperfine
   # the nesting benchmark's baseline: the same parts through libnest2d
   libnest2d-dev libnlopt-cxx-dev
   # real tools that read our SVG and DXF sheets in the tests
   librsvg2-bin libxml2-utils python3-ezdxf inkscape
+  # a real browser for the workshop page's tests (headless, over DevTools)
+  chromium
   # meshes other people made, read by the tests where these packages install
   # them (tests/data/external/README.md)
   assimp-testmodels geomview openscad-testing-data libcgal-demo
