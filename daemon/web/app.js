@@ -363,6 +363,19 @@
     // Sheet coordinates have y up.
     const flip = document.createElementNS(svgNS, 'g');
     flip.setAttribute('transform', `translate(0 ${path.height}) scale(1 -1)`);
+    // A group per operation (the strokes come operation by operation), so
+    // that a pale colour can be edged as a whole.
+    const groups = new Map();
+    const groupOf = (operation) => {
+      if (!groups.has(operation)) {
+        const group = document.createElementNS(svgNS, 'g');
+        group.setAttribute('data-operation', operation);
+        if (pale(path.colours[operation] || '#000')) group.setAttribute('class', 'pale');
+        flip.append(group);
+        groups.set(operation, group);
+      }
+      return groups.get(operation);
+    };
     path.strokes.forEach((stroke, index) => {
       const line = document.createElementNS(svgNS, 'polyline');
       line.setAttribute('points', stroke.points.map((p) => `${p[0]},${p[1]}`).join(' '));
@@ -373,7 +386,7 @@
       line.setAttribute('vector-effect', 'non-scaling-stroke');
       line.setAttribute('data-stroke', index);
       line.setAttribute('data-operation', stroke.operation);
-      flip.append(line);
+      groupOf(stroke.operation).append(line);
       state.sheets.lines.push(line);
     });
     svg.append(flip);
@@ -387,6 +400,15 @@
       legend.append(element('span', {}, element('span', { class: 'swatch', style: `background:${colour}` }), ` ${operation}`));
     }
     highlightStroke();
+  }
+
+  // Whether a colour "#rrggbb" is too light to see on the bed as it is.
+  function pale(colour) {
+    const value = parseInt(colour.slice(1), 16);
+    const r = (value >> 16) & 255;
+    const g = (value >> 8) & 255;
+    const b = value & 255;
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b > 160;
   }
 
   // The stroke being cut (progress counts those finished), the ones before it faded.
@@ -486,32 +508,126 @@
     const positions = [];
     const index = [];
     const ranges = new Map();  // panel id -> [first vertex, end vertex)
+    const triangles = new Map();  // panel id -> [first index, end index)
     let panel = null;
     let panelFirst = 0;
+    let trianglesFirst = 0;
     let lineStart = 0;
     let vertices = 0;
+    const close = () => {
+      ranges.set(panel, [panelFirst, vertices]);
+      triangles.set(panel, [trianglesFirst, index.length]);
+      panel = null;
+      panelFirst = vertices;
+    };
     while (lineStart < text.length) {
       let lineEnd = text.indexOf('\n', lineStart);
       if (lineEnd < 0) lineEnd = text.length;
       const line = text.slice(lineStart, lineEnd);
       lineStart = lineEnd + 1;
       if (line.startsWith('v ')) {
-        if (panel !== null) {
-          ranges.set(panel, [panelFirst, vertices]);
-          panel = null;
-          panelFirst = vertices;
-        }
+        if (panel !== null) close();
         const parts = line.split(' ');
         positions.push(Number(parts[1]), Number(parts[2]), Number(parts[3]));
         vertices += 1;
       } else if (line.startsWith('g panel-')) {
+        if (panel !== null) close();
         panel = Number(line.slice(8));
+        trianglesFirst = index.length;
       } else if (line.startsWith('f ')) {
         const corners = line.split(' ').slice(1).map((word) => Number(word.split('/')[0]) - 1);
         for (let k = 1; k + 1 < corners.length; k += 1) index.push(corners[0], corners[k], corners[k + 1]);
       }
     }
-    if (panel !== null) ranges.set(panel, [panelFirst, vertices]);
+    if (panel !== null) close();
+    return { positions, index, ranges, triangles };
+  }
+
+  // A panel drawn coarsely while the view moves: its outline, simplified by
+  // Douglas-Peucker to a tenth of its size, as a fan from its middle. A
+  // browser without a graphics card (software WebGL) draws the bunny's
+  // 180,000 triangles a few times a second; these, many times fewer, fast.
+  function coarseStructure(structure) {
+    const positions = [];
+    const index = [];
+    const ranges = new Map();
+    const point = (v) => [structure.positions[3 * v], structure.positions[3 * v + 1], structure.positions[3 * v + 2]];
+    const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    const offLine = (p, a, b) => {
+      const ab = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+      const ap = [p[0] - a[0], p[1] - a[1], p[2] - a[2]];
+      const length = Math.hypot(...ab);
+      if (length === 0) return Math.hypot(...ap);
+      const cross = [ab[1] * ap[2] - ab[2] * ap[1], ab[2] * ap[0] - ab[0] * ap[2], ab[0] * ap[1] - ab[1] * ap[0]];
+      return Math.hypot(...cross) / length;
+    };
+    const simplify = (loop, from, to, tolerance, kept) => {
+      let worst = -1;
+      let far = 0;
+      for (let k = from + 1; k < to; k += 1) {
+        const d = offLine(loop[k], loop[from], loop[to % loop.length]);
+        if (d > far) {
+          far = d;
+          worst = k;
+        }
+      }
+      if (worst < 0 || far <= tolerance) return;
+      simplify(loop, from, worst, tolerance, kept);
+      kept.push(worst);
+      simplify(loop, worst, to, tolerance, kept);
+    };
+    for (const [id, [first, end]] of structure.triangles) {
+      const [v0, v1] = structure.ranges.get(id);
+      const count = v1 - v0;
+      // The boundary: the edges of one triangle only, in the triangles' direction.
+      const used = new Map();
+      for (let t = first; t < end; t += 3) {
+        for (let k = 0; k < 3; k += 1) {
+          const a = structure.index[t + k] - v0;
+          const b = structure.index[t + ((k + 1) % 3)] - v0;
+          const key = Math.min(a, b) * count + Math.max(a, b);
+          used.set(key, used.has(key) ? null : [a, b]);
+        }
+      }
+      const next = new Map();
+      for (const edge of used.values()) if (edge) next.set(edge[0], edge[1]);
+      let longest = [];
+      const seen = new Set();
+      for (const start of next.keys()) {
+        if (seen.has(start)) continue;
+        const loop = [];
+        for (let v = start; v !== undefined && !seen.has(v); v = next.get(v)) {
+          seen.add(v);
+          loop.push(v);
+        }
+        if (loop.length > longest.length) longest = loop;
+      }
+      if (longest.length < 3) continue;
+      const loop = longest.map((v) => point(v + v0));
+      let size = 0;
+      let opposite = 0;
+      for (let k = 1; k < loop.length; k += 1) {
+        const d = distance(loop[0], loop[k]);
+        if (d > size) {
+          size = d;
+          opposite = k;
+        }
+      }
+      const kept = [0];
+      simplify(loop, 0, opposite, size / 6, kept);
+      kept.push(opposite);
+      simplify(loop, opposite, loop.length, size / 6, kept);
+      if (kept.length < 3) continue;
+      const firstVertex = positions.length / 3;
+      const middle = [0, 0, 0];
+      for (const k of kept) for (let axis = 0; axis < 3; axis += 1) middle[axis] += loop[k][axis] / kept.length;
+      positions.push(...middle);
+      for (const k of kept) positions.push(...loop[k]);
+      for (let k = 0; k < kept.length; k += 1) {
+        index.push(firstVertex, firstVertex + 1 + k, firstVertex + 1 + ((k + 1) % kept.length));
+      }
+      ranges.set(id, [firstVertex, positions.length / 3]);
+    }
     return { positions, index, ranges };
   }
 
@@ -524,8 +640,7 @@
   class Guide {
     constructor(container) {
       this.container = container;
-      this.renderer = new THREE.WebGLRenderer({ antialias: true });
-      this.renderer.setPixelRatio(Math.min(window.devicePixelRatio || 1, 2));
+      this.renderer = new THREE.WebGLRenderer({ antialias: false });
       this.renderer.setClearColor(0xf0f2f4);
       container.append(this.renderer.domElement);
       this.scene = new THREE.Scene();
@@ -535,7 +650,7 @@
       this.scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 0.8));
       this.light = new THREE.DirectionalLight(0xffffff, 0.6);
       this.scene.add(this.light);
-      this.mesh = null;
+      this.views = [];
       this.showing = false;
       this.frames = 0;
       this.spin = 0;
@@ -550,6 +665,7 @@
       this.renderer.setSize(width, height);
       this.camera.aspect = width / height;
       this.camera.updateProjectionMatrix();
+      this.dirty = true;
     }
 
     visible(on) {
@@ -563,37 +679,66 @@
 
     loop() {
       if (!this.showing) return;
+      requestAnimationFrame(this.loop);
       if (this.spin) {
         // For the frame-rate measure: orbit without a hand on the mouse.
         this.controls.autoRotate = true;
         this.controls.autoRotateSpeed = this.spin;
       }
-      this.controls.update();
+      if (this.goal) {
+        // Towards the next panel, a fifth of the way each frame.
+        this.controls.target.lerp(this.goal.target, 0.2);
+        this.camera.position.lerp(this.goal.position, 0.2);
+        if (this.camera.position.distanceTo(this.goal.position) < this.goal.near) this.goal = null;
+      }
+      const moved = this.controls.update();
+      // Coarse while the view moves and a few frames after; the panels
+      // themselves once it rests. Nothing is drawn while nothing changes.
+      if (moved) this.moving = 6;
+      const inMotion = this.moving > 0;
+      const coarse = inMotion && this.views.length > 1;
+      if (this.moving > 0) this.moving -= 1;
+      if (!moved && !this.dirty && !inMotion && this.drewFull) return;
+      // Half the pixels each way while it moves (software WebGL fills
+      // pixels slowly), all of them once it rests.
+      const ratio = (window.devicePixelRatio || 1) * (inMotion ? 0.5 : 1);
+      if (this.renderer.getPixelRatio() !== ratio) this.renderer.setPixelRatio(ratio);
+      this.views.forEach((view, k) => { view.mesh.visible = k === (coarse ? 1 : 0); });
       this.light.position.copy(this.camera.position);
       this.renderer.render(this.scene, this.camera);
       this.frames += 1;
-      requestAnimationFrame(this.loop);
+      this.drewFull = !inMotion;
+      this.dirty = false;
     }
 
-    load(structure, manifest) {
-      if (this.mesh) {
-        this.scene.remove(this.mesh);
-        this.mesh.geometry.dispose();
-      }
+    // A mesh of the structure, its colours kept per vertex and its panels' vertex ranges.
+    makeView(structure) {
       const geometry = new THREE.BufferGeometry();
       const vertexCount = structure.positions.length / 3;
       const IndexArray = vertexCount > 65535 ? Uint32Array : Uint16Array;
       geometry.setIndex(new THREE.BufferAttribute(new IndexArray(structure.index), 1));
       geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(structure.positions), 3));
-      this.colour = new Float32Array(vertexCount * 3);
-      geometry.setAttribute('color', new THREE.BufferAttribute(this.colour, 3));
+      const colour = new Float32Array(vertexCount * 3);
+      geometry.setAttribute('color', new THREE.BufferAttribute(colour, 3));
       geometry.computeVertexNormals();
       geometry.computeBoundingSphere();
       const material = new THREE.MeshLambertMaterial({ vertexColors: THREE.VertexColors, side: THREE.DoubleSide });
-      this.mesh = new THREE.Mesh(geometry, material);
-      this.scene.add(this.mesh);
-      this.ranges = structure.ranges;
-      const sphere = geometry.boundingSphere;
+      const mesh = new THREE.Mesh(geometry, material);
+      this.scene.add(mesh);
+      return { mesh, colour, ranges: structure.ranges };
+    }
+
+    load(structure, manifest) {
+      for (const view of this.views) {
+        this.scene.remove(view.mesh);
+        view.mesh.geometry.dispose();
+      }
+      this.views = [this.makeView(structure)];
+      // Small structures are drawn whole even while they move.
+      if (structure.index.length / 3 > 20000) this.views.push(this.makeView(coarseStructure(structure)));
+      this.colour = this.views[0].colour;
+      this.ranges = this.views[0].ranges;
+      const sphere = this.views[0].mesh.geometry.boundingSphere;
       this.controls.target.copy(sphere.center);
       this.camera.near = sphere.radius / 100;
       this.camera.far = sphere.radius * 100;
@@ -608,18 +753,22 @@
       this.goTo(1);
     }
 
-    // Colours the panels at steps [from, to) (0-based) as `kind`.
+    // Colours the panels at steps [from, to) (0-based) as `kind`, in every view.
     paint(from, to, kind) {
       const [r, g, b] = colours[kind];
-      for (let k = from; k < to; k += 1) {
-        const range = this.ranges.get(this.panels[k].id);
-        if (!range) continue;
-        for (let v = range[0]; v < range[1]; v += 1) {
-          this.colour[3 * v] = r;
-          this.colour[3 * v + 1] = g;
-          this.colour[3 * v + 2] = b;
+      for (const view of this.views) {
+        for (let k = from; k < to; k += 1) {
+          const range = view.ranges.get(this.panels[k].id);
+          if (!range) continue;
+          for (let v = range[0]; v < range[1]; v += 1) {
+            view.colour[3 * v] = r;
+            view.colour[3 * v + 1] = g;
+            view.colour[3 * v + 2] = b;
+          }
         }
+        view.mesh.geometry.attributes.color.needsUpdate = true;
       }
+      this.dirty = true;
     }
 
     goTo(step) {
@@ -633,8 +782,41 @@
       }
       this.paint(step - 1, step, 'next');
       this.step = step;
-      this.mesh.geometry.attributes.color.needsUpdate = true;
+      if ($('guide-follow').checked) this.focusOn(this.panels[step - 1].id);
       this.describe();
+    }
+
+    // The view turned to face the panel from outside the structure, close
+    // enough to see it and its neighbours.
+    focusOn(id) {
+      const range = this.ranges.get(id);
+      if (!range) return;
+      const geometry = this.views[0].mesh.geometry;
+      const position = geometry.attributes.position.array;
+      const normal = geometry.attributes.normal.array;
+      const centre = new THREE.Vector3();
+      const facing = new THREE.Vector3();
+      for (let v = range[0]; v < range[1]; v += 1) {
+        centre.x += position[3 * v];
+        centre.y += position[3 * v + 1];
+        centre.z += position[3 * v + 2];
+        facing.x += normal[3 * v];
+        facing.y += normal[3 * v + 1];
+        facing.z += normal[3 * v + 2];
+      }
+      centre.divideScalar(range[1] - range[0]);
+      let size = 0;
+      for (let v = range[0]; v < range[1]; v += 1) {
+        size = Math.max(size, centre.distanceTo(new THREE.Vector3(position[3 * v], position[3 * v + 1], position[3 * v + 2])));
+      }
+      const sphere = geometry.boundingSphere;
+      const outwards = centre.clone().sub(sphere.center);
+      if (facing.lengthSq() === 0) facing.copy(outwards);
+      if (facing.dot(outwards) < 0) facing.negate();
+      facing.normalize();
+      const distance = Math.min(Math.max(size * 12, sphere.radius * 0.5), sphere.radius * 3);
+      this.goal = { target: centre, position: centre.clone().addScaledVector(facing, distance), near: distance / 200 };
+      this.dirty = true;
     }
 
     describe() {
@@ -732,6 +914,7 @@
       highlighted: () => state.guide.highlighted(),
       fps: (milliseconds) => state.guide.measure(milliseconds || 2000),
       panels: state.guide.panels.length,
+      triangles: state.guide.views.map((view) => view.mesh.geometry.index.count / 3),
     };
   }
 

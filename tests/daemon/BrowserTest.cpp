@@ -1,0 +1,201 @@
+// The workshop page in a real browser: Debian's Chromium, headless, driven
+// over its DevTools protocol (support/Browser.h), against the built daemon
+// and its simulated GRBL. What a newcomer does: sign in with the link of
+// `rotafab dashboard`, drop a mesh, watch it plan, start it, watch the cut
+// reach 100%, look at the sheet, and step through the assembly in 3D. Each
+// page is kept as a screenshot in the build tree (test-artefacts/page/), and
+// the page must have reported no error at all.
+
+#include <gtest/gtest.h>
+#include <pwd.h>
+
+#include <algorithm>
+
+#include "daemon/DaemonSupport.h"
+#include "support/Browser.h"
+
+namespace rotafab::test {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+fs::path artefacts() {
+  const fs::path folder = fs::path(ROTAFAB_BUILD_DIR) / "test-artefacts/page";
+  fs::create_directories(folder);
+  return folder;
+}
+
+std::string loginLink(const Daemon& daemon) {
+  const CommandResult link = daemon.client("dashboard --url");
+  EXPECT_EQ(link.status, 0) << link.err;
+  return link.out.substr(0, link.out.find('\n'));
+}
+
+// A page's JavaScript for a string: the text quoted as JSON.
+std::string js(const std::string& text) { return json(text).dump(); }
+
+void click(testing::Browser& browser, const std::string& selector) {
+  const json clicked = browser.evaluate(
+      fmt::format("(() => {{ const b = document.querySelector({}); if (!b) return false; b.click(); return true; }})()",
+                  js(selector)));
+  ASSERT_EQ(clicked, true) << "nothing to click at " << selector;
+}
+
+std::string rowState(testing::Browser& browser, long long job) {
+  const json state = browser.evaluate(
+      fmt::format("(document.querySelector('tr[data-job=\"{}\"]') || {{dataset: {{}}}}).dataset.state || ''", job));
+  return state.is_string() ? state.get<std::string>() : "";
+}
+
+void expectNoErrors(const testing::Browser& browser) {
+  const auto errors = browser.errors();
+  EXPECT_TRUE(errors.empty()) << fmt::format("{} error(s) in the page, the first: {}", errors.size(),
+                                             errors.empty() ? "" : errors.front());
+}
+
+TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
+  TempDir root;
+  // A simulated GRBL 100 times faster than the machine: the cube's sheet in about 2 s.
+  Daemon daemon(root.path(), "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=100\"}]\n");
+  daemon.start();
+  testing::Browser browser;
+  browser.navigate(loginLink(daemon));
+  ASSERT_TRUE(
+      browser.waitFor("document.querySelector('#connection.live') && "
+                      "document.querySelector('.device[data-device=\"laser1\"][data-state=\"idle\"]')",
+                      20s))
+      << browser.evaluate("document.body.innerText");
+
+  // Drop the cube (the file input the drop box stands for), band, submit.
+  browser.setFiles("#mesh-file", {kSource / "examples/cube.obj"});
+  browser.evaluate("document.getElementById('opt-structure').value = 'band'");
+  click(browser, "#submit-button");
+  ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"]')", 10s));
+  ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"ready\"]')", 60s))
+      << rowState(browser, 1) << ": " << daemon.job(1).dump();
+  // The page's session is the user's who asked for the link.
+  EXPECT_EQ(daemon.job(1)["owner"], ::getpwuid(::getuid())->pw_name);
+  browser.screenshot(artefacts() / "queue.png");
+
+  // The sheet on the screen while it is cut: every percentage the
+  // machine's card shows, and every stroke the sheet highlights.
+  click(browser, "tr[data-job=\"1\"] button[data-action=\"sheets\"]");
+  ASSERT_TRUE(browser.waitFor("document.querySelectorAll('#sheet-view polyline').length > 0", 20s));
+  browser.evaluate(R"(window.percents = []; window.highlighted = [];
+    new MutationObserver(() => {
+      for (const bar of document.querySelectorAll('.device progress')) window.percents.push(Number(bar.dataset.percent));
+    }).observe(document.getElementById('devices'), {childList: true, subtree: true});
+    new MutationObserver(() => {
+      const current = document.querySelector('#sheet-view polyline[data-current]');
+      if (current) window.highlighted.push(Number(current.dataset.stroke));
+    }).observe(document.getElementById('sheet-view'), {attributes: true, subtree: true});)");
+  click(browser, "tr[data-job=\"1\"] button[data-action=\"start\"]");
+  ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"done\"]')", 60s))
+      << rowState(browser, 1) << ": " << daemon.job(1).dump();
+  const json percents = browser.evaluate("window.percents");
+  ASSERT_TRUE(percents.is_array() && !percents.empty()) << "no progress was shown during the cut";
+  EXPECT_EQ(percents.back(), 100) << percents.dump();
+  EXPECT_LT(percents.front().get<int>(), 100) << percents.dump();
+  EXPECT_EQ(browser.evaluate("document.querySelector('tr[data-job=\"1\"] .sheets').textContent"), "1/1");
+  const json job = daemon.job(1);
+  // The strokes highlighted in the order they were cut, up to the last.
+  const json highlighted = browser.evaluate("window.highlighted");
+  ASSERT_TRUE(highlighted.is_array() && highlighted.size() >= 2) << highlighted.dump();
+  EXPECT_TRUE(std::is_sorted(highlighted.begin(), highlighted.end())) << highlighted.dump();
+  EXPECT_GT(highlighted.back().get<int>(), 0);
+  EXPECT_LT(highlighted.back().get<int>(), job["strokes"].get<int>());
+  EXPECT_EQ(browser.evaluate("document.querySelector('#sheet-view polyline[data-current]')"), nullptr);
+
+  // The sheet as it was burnt: every stroke drawn, all of them cut.
+  EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline').length"), job["strokes"]);
+  EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline.done').length"), job["strokes"]);
+  EXPECT_EQ(browser.evaluate("getComputedStyle(document.querySelector('#sheet-view polyline')).strokeWidth"), "1.5px");
+  browser.screenshot(artefacts() / "sheet.png");
+
+  // The assembly guide, stepped to panel 3.
+  click(browser, "tr[data-job=\"1\"] button[data-action=\"guide\"]");
+  ASSERT_TRUE(browser.waitFor("window.rotafabGuide && window.rotafabGuide.job === 1", 20s));
+  const json manifest = daemon.get("/api/jobs/1/manifest").body;
+  ASSERT_EQ(browser.evaluate("window.rotafabGuide.panels"), manifest["panels"].size());
+  for (int press = 0;
+       press < 10 && browser.evaluate("document.getElementById('guide-panel-number').textContent") != "3"; ++press) {
+    click(browser, "#guide-next");
+  }
+  ASSERT_EQ(browser.evaluate("document.getElementById('guide-panel-number').textContent"), "3");
+  // What is drawn as the next panel is panel 3 alone, at the step the manifest gives it.
+  EXPECT_EQ(browser.evaluate("window.rotafabGuide.highlighted()"), json::array({3}));
+  const int step = browser.evaluate("window.rotafabGuide.step()").get<int>();
+  json three;
+  for (const json& panel : manifest["panels"]) {
+    if (panel["id"] == 3) three = panel;
+  }
+  ASSERT_TRUE(three.is_object());
+  EXPECT_EQ(three["order"], step);
+  // Its sheet and neighbours as the manifest says.
+  EXPECT_EQ(browser.evaluate("document.getElementById('guide-panel-sheet').textContent"),
+            std::to_string(three["sheet"].get<int>()));
+  const std::string neighbours =
+      browser.evaluate("document.getElementById('guide-panel-neighbours').textContent").get<std::string>();
+  for (const json& id : three["neighbors"]) {
+    EXPECT_NE(neighbours.find(std::to_string(id.get<int>())), std::string::npos) << neighbours;
+  }
+  // A panel found by its number.
+  browser.evaluate("document.getElementById('guide-find-number').value = '5'");
+  click(browser, "#guide-find button[type=submit]");
+  ASSERT_TRUE(browser.waitFor("document.getElementById('guide-panel-number').textContent === '5'", 5s));
+  EXPECT_EQ(browser.evaluate("window.rotafabGuide.highlighted()"), json::array({5}));
+  browser.screenshot(artefacts() / "guide.png");
+  expectNoErrors(browser);
+}
+
+TEST(Browser, ARefusedActionShowsTheDaemonsOwnWords) {
+  TempDir root;
+  // A cutter that is not plugged in: jobs are planned for it, and starting one is refused.
+  Daemon daemon(root.path(),
+                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"grbl:///dev/rotafab-no-such-port\"}]\n");
+  daemon.start();
+  const CommandResult submitted =
+      daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --evaluations 1");
+  ASSERT_EQ(submitted.status, 0) << submitted.err;
+  ASSERT_EQ(daemon.waitForJob(1, [](const json& job) { return job["state"] == "ready"; })["state"], "ready");
+  testing::Browser browser;
+  browser.navigate(loginLink(daemon));
+  ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"ready\"]')", 20s));
+  ASSERT_TRUE(browser.waitFor("document.querySelector('.device[data-state=\"offline\"]')", 20s))
+      << browser.evaluate("document.getElementById('devices').innerText");
+  // What the API says to the same request.
+  const RawReply refused = daemon.post("/api/jobs/1/start", "{}");
+  ASSERT_EQ(refused.status, 409) << refused.text;
+  const std::string words = refused.body["error"];
+  click(browser, "tr[data-job=\"1\"] button[data-action=\"start\"]");
+  ASSERT_TRUE(browser.waitFor("!document.getElementById('error').hidden", 10s));
+  EXPECT_EQ(browser.evaluate("document.getElementById('error-text').textContent"), words);
+  EXPECT_EQ(daemon.job(1)["state"], "ready");
+  browser.screenshot(artefacts() / "refused.png");
+  // The browser logs the 409 of the request; nothing else went wrong.
+  for (const std::string& error : browser.errors()) {
+    EXPECT_NE(error.find("status of 409"), std::string::npos) << error;
+  }
+}
+
+TEST(Browser, OnATabletThePageFitsTheScreen) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  testing::Browser browser;
+  browser.setViewport(820, 1180, true, 2);
+  browser.navigate(loginLink(daemon));
+  ASSERT_TRUE(browser.waitFor("document.querySelector('#connection.live') && document.querySelector('.device')", 20s));
+  EXPECT_EQ(browser.evaluate("document.documentElement.scrollWidth <= window.innerWidth"), true)
+      << browser.evaluate("[document.documentElement.scrollWidth, window.innerWidth]").dump();
+  // The buttons are large enough to press with a finger.
+  EXPECT_EQ(browser.evaluate("[...document.querySelectorAll('button:not([hidden])')].filter(b => b.offsetParent)"
+                             ".every(b => b.getBoundingClientRect().height >= 30)"),
+            true);
+  browser.screenshot(artefacts() / "tablet.png");
+  expectNoErrors(browser);
+}
+
+}  // namespace
+}  // namespace rotafab::test
