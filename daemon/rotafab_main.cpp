@@ -23,9 +23,6 @@
 
 namespace {
 
-// The commands of SPEC's command line that are not built yet: the workshop page's.
-constexpr std::string_view kDaemonVerbs[] = {"dashboard"};
-
 size_t editDistance(std::string_view a, std::string_view b) {
   std::vector<size_t> row(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
@@ -79,11 +76,6 @@ int main(int argc, char** argv) {
     const std::string_view word = argv[1];
     if (std::find(verbs.begin(), verbs.end(), word) != verbs.end()) {
       verb = word;
-    } else if (std::find(std::begin(kDaemonVerbs), std::end(kDaemonVerbs), word) != std::end(kDaemonVerbs)) {
-      return usageError(fmt::format("`rotafab {}` is a command of the workshop page, which is not built yet; "
-                                    "`rotafab jobs` and `rotafab status JOB --follow` show the queue",
-                                    word),
-                        "rotafab --help");
     } else {
       std::string nearest = verbs.front();
       for (const std::string& candidate : verbs) {

@@ -24,16 +24,13 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
   expectUsage("bake " + cube, "bake is not a rotafab command; did you mean `rotafab make`?", "rotafab --help");
   expectUsage("fabricate " + cube,
               "fabricate is not a rotafab command (the commands: inspect, make, manifest, nest, profiles, devices, "
-              "run, submit, jobs, status, cancel, pause, resume, start, next, move)",
+              "run, submit, jobs, status, cancel, pause, resume, start, next, move, dashboard)",
               "rotafab --help");
   expectUsage("",
               "give a command: inspect, make, manifest, nest, profiles, devices, run, submit, jobs, status, cancel, "
-              "pause, resume, start, next, move",
+              "pause, resume, start, next, move, dashboard",
               "rotafab --help");
-  expectUsage("dashboard",
-              "`rotafab dashboard` is a command of the workshop page, which is not built yet; `rotafab jobs` and "
-              "`rotafab status JOB --follow` show the queue",
-              "rotafab --help");
+  expectUsage("dashbord", "dashbord is not a rotafab command; did you mean `rotafab dashboard`?", "rotafab --help");
   // A mesh is planned by the daemon with `make`'s options, --structure first.
   expectUsage("submit " + cube, "--structure is required to plan a mesh (band or weave)", "rotafab submit --help");
   expectUsage("make " + cube + " --structure band --width 0.5",
