@@ -48,15 +48,22 @@ HttpReply overTcp(int port, const std::string& method, const std::string& target
   return reply;
 }
 
-// The port of the daemon's loopback TCP listener, as rotafabd.json records it.
+// The port of the daemon's loopback TCP listener, as rotafabd.json records
+// it (written just after the socket answers: waited for).
 int pagePort(const Daemon& daemon) {
-  const json where = json::parse(readFile(daemon.stateDir() / "rotafabd.json"), nullptr, false);
-  if (!where.is_object()) return 0;
-  for (const json& address : where["listen"]) {
-    const std::string text = address.get<std::string>();
-    if (text.starts_with("tcp://127.0.0.1:")) return std::stoi(text.substr(16));
-  }
-  return 0;
+  int port = 0;
+  eventually(
+      [&] {
+        const json where = json::parse(readFile(daemon.stateDir() / "rotafabd.json"), nullptr, false);
+        if (!where.is_object()) return false;
+        for (const json& address : where["listen"]) {
+          const std::string text = address.get<std::string>();
+          if (text.starts_with("tcp://127.0.0.1:")) port = std::stoi(text.substr(16));
+        }
+        return port > 0;
+      },
+      10);
+  return port;
 }
 
 // The session cookie a login link gives ("rotafab_session=..."), or "".
