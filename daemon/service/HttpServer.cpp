@@ -42,13 +42,11 @@ struct Identity {
   bool allowed = false;
   std::string name;  // the owner of what they submit
   std::string refusal;
-  bool bySession = false;  // a browser's session cookie: its actions must come from the page's own origin
+  bool bySession = false;  // a browser's session: it may not ask for login links
 };
 
 using Clock = std::chrono::steady_clock;
 
-// The name of the browser's session cookie.
-constexpr std::string_view kSessionCookie = "rotafab_session";
 // A login link works once, within this time; a session lasts this long unused.
 constexpr auto kLoginLinkLasts = std::chrono::minutes(5);
 constexpr auto kSessionLasts = std::chrono::hours(24 * 7);
@@ -60,20 +58,6 @@ std::string randomSecret() {
   std::string text;
   for (unsigned char byte : bytes) text += fmt::format("{:02x}", byte);
   return text;
-}
-
-std::string cookieValue(std::string_view header, std::string_view name) {
-  while (!header.empty()) {
-    const size_t semicolon = header.find(';');
-    std::string_view pair = header.substr(0, semicolon);
-    while (pair.starts_with(' ')) pair.remove_prefix(1);
-    if (pair.starts_with(name) && pair.size() > name.size() && pair[name.size()] == '=') {
-      return std::string(pair.substr(name.size() + 1));
-    }
-    if (semicolon == std::string_view::npos) break;
-    header = header.substr(semicolon + 1);
-  }
-  return "";
 }
 
 // The page's files (HTML, CSS, JavaScript): PREFIX/share/rotafab/web once
@@ -105,22 +89,6 @@ std::string contentTypeOf(const fs::path& file) {
   if (extension == ".png") return "image/png";
   if (extension == ".json") return "application/json";
   return "text/plain; charset=utf-8";
-}
-
-// What a browser without a session is shown: how to get one.
-std::string signInPage(const std::string& why) {
-  return fmt::format(R"(<!doctype html>
-<html lang="en"><head><meta charset="utf-8"><meta name="viewport" content="width=device-width, initial-scale=1">
-<title>Rotafab: sign in</title>
-<style>body{{font:16px/1.5 system-ui,sans-serif;max-width:36em;margin:3em auto;padding:0 1em}}code{{background:#eee;padding:.1em .3em}}</style>
-</head><body><h1>Rotafab workshop</h1>
-<p>{}</p>
-<p>On the machine where <code>rotafabd</code> runs, as the user who runs it, type</p>
-<p><code>rotafab dashboard</code></p>
-<p>It opens this page signed in (or prints the link with <code>--url</code>). A link works once, for five minutes.</p>
-</body></html>
-)",
-                     why);
 }
 
 std::optional<std::string> accountName(uid_t uid) {
@@ -253,37 +221,48 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
     return {true, known->second.first, ""};
   }
 
-  // Over TCP nobody gets in without a token of the configuration or a
-  // session of a browser that came by a one-time login link.
+  // Over TCP nobody gets in without a token of the configuration or the
+  // secret of a browser's session, which a one-time login link gave the page
+  // (it keeps it in its origin's storage, which no other port's page reads,
+  // and sends it as a bearer token; the event stream, which cannot send a
+  // header, as `?session=`). No cookie: nothing a browser sends by itself.
   template <typename Request>
   Identity identify(asio::ip::tcp::socket&, const Request& request) {
     const auto& tokens = service.config().tokens;
     const auto header = request[http::field::authorization];
     const std::string_view value(header.data(), header.size());
+    std::string secret;
     if (value.starts_with("Bearer ")) {
-      const std::string token(value.substr(7));
-      for (const TokenConfig& configured : tokens) {
-        if (tokenMatches(token, configured.hash)) return {true, configured.name, "", false};
+      secret = std::string(value.substr(7));
+    } else {
+      const std::string_view target(request.target().data(), request.target().size());
+      if (target.starts_with("/api/events")) {
+        std::string query;
+        pathParts(target, query);
+        secret = queryValue(query, "session");
       }
-      return {false, "", "the token is not one this daemon knows"};
     }
-    const auto cookies = request[http::field::cookie];
-    const std::string session = cookieValue(std::string_view(cookies.data(), cookies.size()), kSessionCookie);
-    if (!session.empty()) {
-      const auto found = sessions.find(session);
-      const auto now = Clock::now();
-      if (found != sessions.end() && now - found->second.second < kSessionLasts) {
+    if (secret.empty()) {
+      return {false, "",
+              tokens.empty() ? "this listener needs a session: run `rotafab dashboard` on the daemon's machine for a "
+                               "login link"
+                             : "this listener needs a token: send `Authorization: Bearer TOKEN` (rotafab --token T), "
+                               "or a session from `rotafab dashboard`"};
+    }
+    const auto now = Clock::now();
+    if (const auto found = sessions.find(secret); found != sessions.end()) {
+      if (now - found->second.second < kSessionLasts) {
         found->second.second = now;
         return {true, found->second.first, "", true};
       }
-      if (found != sessions.end()) sessions.erase(found);
-      return {false, "", "the session has ended (or the daemon started again): run `rotafab dashboard` for a new link"};
+      sessions.erase(found);
+    }
+    for (const TokenConfig& configured : tokens) {
+      if (tokenMatches(secret, configured.hash)) return {true, configured.name, "", false};
     }
     return {false, "",
-            tokens.empty() ? "this listener needs a session: run `rotafab dashboard` on the daemon's machine for a "
-                             "login link"
-                           : "this listener needs a token: send `Authorization: Bearer TOKEN` (rotafab --token T), "
-                             "or a browser's session from `rotafab dashboard`"};
+            "the token or session is not one this daemon knows (a session ends when the daemon starts again): run "
+            "`rotafab dashboard` for a new link"};
   }
 
   // One-time login links (code -> who, until when) and the sessions they
@@ -387,26 +366,11 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
                                    server_->service.config().connectionLimit));
     }
     if constexpr (std::is_same_v<Protocol, asio::ip::tcp>) identity_ = server_->identify(stream_.socket(), request);
+    // The page's own files are the same for everyone and hold nothing of
+    // the queue: served to anyone who reaches the listener; the API is not.
     const std::string_view path(request.target().data(), request.target().size());
     const bool page = !path.starts_with("/api");
-    if (!identity_.allowed && !(page && path.starts_with("/login"))) {
-      if (!page) return fail(401, identity_.refusal);
-      Reply signIn{401, nullptr};
-      signIn.text = signInPage(identity_.refusal);
-      signIn.contentType = "text/html; charset=utf-8";
-      keepAlive_ = false;
-      return respond(std::move(signIn));
-    }
-    // A browser's session acts only from the page itself: a request another
-    // site makes the browser send says so in its Origin.
-    if (identity_.bySession && request.method() != http::verb::get) {
-      const auto origin = request[http::field::origin];
-      const auto host = request[http::field::host];
-      if (!origin.empty() &&
-          std::string_view(origin.data(), origin.size()) != "http://" + std::string(host.data(), host.size())) {
-        return fail(403, "a session's actions come from the workshop page itself, not from another site");
-      }
-    }
+    if (!identity_.allowed && !page) return fail(401, identity_.refusal);
     if (request.has_content_length() && *header_->content_length() > server_->service.config().uploadLimit) {
       return fail(413, fmt::format("the body is {} bytes; the daemon takes at most {}", *header_->content_length(),
                                    server_->service.config().uploadLimit));
@@ -538,22 +502,19 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
                                        std::string(request_.target())));
     };
     if (parts.size() == 1 && parts[0] == "login") {
+      // The secret goes to the page in the fragment, which the browser
+      // never sends to a server; the page keeps it and clears the address.
       const auto secret = server_->openSession(queryValue(query, "code"));
-      if (!secret) {
-        Reply refused{401, nullptr};
-        refused.text = signInPage("That login link has been used already, or is more than five minutes old.");
-        refused.contentType = "text/html; charset=utf-8";
-        return respond(std::move(refused));
-      }
-      Reply signedIn{303, nullptr};
-      signedIn.text = "signed in\n";
-      signedIn.contentType = "text/plain; charset=utf-8";
-      // HttpOnly: no script reads it; SameSite=Strict: no other site's page sends it.
-      signedIn.headers = {
-          {"Set-Cookie", fmt::format("{}={}; Path=/; HttpOnly; SameSite=Strict; Max-Age={}", kSessionCookie, *secret,
-                                     std::chrono::seconds(kSessionLasts).count())},
-          {"Location", "/"}};
-      return respond(std::move(signedIn));
+      Reply landing{303, nullptr};
+      landing.text = "to the workshop page\n";
+      landing.contentType = "text/plain; charset=utf-8";
+      landing.headers = {{"Location", secret ? "/#session=" + *secret : "/#signin=used"}};
+      return respond(std::move(landing));
+    }
+    if (parts.size() == 1 && parts[0] == "favicon.ico") {
+      Reply none{204, nullptr};  // no icon: asked for by every browser of its own accord
+      none.contentType = "image/x-icon";
+      return respond(std::move(none));
     }
     Reply file;
     if (parts.empty()) {
@@ -680,6 +641,12 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     }
     auto response = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(reply.status), 11);
     response->set(http::field::server, "rotafabd");
+    // No other page may frame this one (clicks through a frame would act
+    // with the page's session), nor a file be read as another type.
+    response->set("X-Frame-Options", "DENY");
+    response->set("Content-Security-Policy", "frame-ancestors 'none'");
+    response->set("X-Content-Type-Options", "nosniff");
+    response->set("Referrer-Policy", "no-referrer");
     response->set(http::field::content_type, reply.contentType.empty() ? "application/json" : reply.contentType);
     for (const auto& [field, value] : reply.headers) response->set(field, value);
     response->body() = reply.text.empty() && reply.contentType.empty()

@@ -17,9 +17,23 @@
   // ---- the API ----
 
   class Refused extends Error {}
+  class SignedOut extends Refused {}
+
+  // The session a login link gave this page, kept in this origin's storage
+  // (no other port's page reads it) and sent as a bearer token.
+  const kSessionKey = 'rotafab-session';
+  let linkUsed = false;
+  {
+    const hash = new URLSearchParams(window.location.hash.slice(1));
+    if (hash.get('session')) localStorage.setItem(kSessionKey, hash.get('session'));
+    linkUsed = hash.get('signin') === 'used';
+    if (window.location.hash) history.replaceState(null, '', window.location.pathname);
+  }
+  const session = () => localStorage.getItem(kSessionKey) || '';
 
   async function api(method, path, body) {
-    const init = { method, credentials: 'same-origin', headers: {} };
+    const init = { method, headers: {} };
+    if (session()) init.headers.Authorization = `Bearer ${session()}`;
     if (body instanceof FormData) {
       init.body = body;
     } else if (body !== undefined) {
@@ -36,9 +50,25 @@
     const data = type.includes('json') ? await response.json().catch(() => ({})) : await response.text();
     if (!response.ok) {
       const words = data && data.error ? data.error : `${response.status} ${response.statusText}`;
+      if (response.status === 401) {
+        signedOut(words);
+        throw new SignedOut(words);
+      }
       throw new Refused(words);
     }
     return data;
+  }
+
+  // Without a session (none yet, or the daemon started again): what to do,
+  // in place of a page that would look live and is not.
+  function signedOut(why) {
+    $('signed-out-why').textContent = linkUsed && !session()
+      ? 'That login link has been used already, or is more than five minutes old.'
+      : why;
+    $('signed-out').hidden = false;
+    document.body.classList.add('signed-out');
+    $('connection').textContent = 'signed out';
+    $('connection').className = 'connection lost';
   }
 
   function showError(text) {
@@ -57,7 +87,7 @@
       clearError();
       return await work();
     } catch (failure) {
-      showError(failure instanceof Refused ? failure.message : String(failure));
+      if (!(failure instanceof SignedOut)) showError(failure instanceof Refused ? failure.message : String(failure));
       return undefined;
     }
   }
@@ -82,18 +112,28 @@
     return `0/${job.sheets}`;
   }
 
+  // Each sheet's estimate in real time: the profile's estimates scaled as
+  // the device's own estimate of the sheet being cut is (a simulator runs
+  // faster than the machine it stands for).
+  const realTimeScale = new Map();  // job id -> seconds on the device per estimated second
+
   function timeLeft(job) {
     const progress = state.progress.get(job.id) || job.progress;
-    if (progress && progress.phase === 'cutting' && progress.seconds_left !== undefined) {
-      return duration(progress.seconds_left);
-    }
-    if (progress && progress.phase && progress.total) {
-      return `planning ${Math.round((100 * progress.done) / progress.total)}%`;
-    }
     const cost = job.summary && job.summary.cost;
+    const perSheet = (cost && cost.sheet_cutting_seconds) || [];
+    if (progress && progress.phase === 'cutting' && progress.seconds_left !== undefined) {
+      const scale = realTimeScale.get(job.id) || 1;
+      const later = perSheet.slice(progress.sheet).reduce((a, b) => a + b, 0) * scale;
+      return duration(progress.seconds_left + later);
+    }
+    if (progress && progress.phase && ['queued', 'planning'].includes(job.state)) {
+      const part = progress.total && progress.done < progress.total
+        ? ` ${Math.round((100 * progress.done) / progress.total)}%` : '';
+      return `planning: ${progress.step || progress.phase}${part}`;
+    }
     if (cost && ['ready', 'queued'].includes(job.state)) return duration(cost.cutting_seconds);
-    if (cost && ['interrupted', 'failed', 'paused'].includes(job.state) && cost.sheet_cutting_seconds) {
-      return duration(cost.sheet_cutting_seconds.slice(Math.max(0, job.sheet - 1)).reduce((a, b) => a + b, 0));
+    if (['interrupted', 'failed', 'paused'].includes(job.state) && perSheet.length) {
+      return duration(perSheet.slice(Math.max(0, job.sheet - 1)).reduce((a, b) => a + b, 0));
     }
     return job.state === 'done' ? '0 s' : '–';
   }
@@ -138,6 +178,8 @@
         break;
       case 'interrupted':
       case 'failed':
+        // Only a cut that was under way goes on; a plan that failed has no sheets.
+        if (!job.sheets || !job.sheet) break;
         act('Resume from sheet…', 'resume', () => {
           const answer = window.prompt(`Cut again from which sheet (1 to ${job.sheets})? Load it fresh first.`,
                                        String(Math.max(1, job.sheet || 1)));
@@ -147,7 +189,11 @@
       default:
         break;
     }
-    if (!['done', 'cancelled'].includes(job.state)) act('Cancel', 'cancel', {}, { class: 'danger' });
+    if (!['done', 'cancelled', 'failed'].includes(job.state)) {
+      // A cancelled job cannot be taken back: asked first.
+      act('Cancel', 'cancel', () => (window.confirm(`Cancel job ${job.id} (${job.source})? It cannot be taken back.`)
+        ? {} : null), { class: 'danger' });
+    }
     if (job.sheets) {
       buttons.push(element('button', { type: 'button', 'data-action': 'sheets', onclick: () => showSheets(job.id) }, 'Sheets'));
       buttons.push(element('button', { type: 'button', 'data-action': 'guide', onclick: () => showGuide(job.id) }, 'Guide'));
@@ -163,12 +209,14 @@
         element('td', {}, String(job.id)),
         element('td', {}, job.source || ''),
         element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
-                element('span', { class: 'message' }, job.message || '')),
+                element('span', { class: 'message' }, job.waiting_for_next
+                  ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}, then press “Next sheet loaded”`
+                  : job.message || '')),
         element('td', {}, job.owner || ''),
         element('td', {}, job.device || '–'),
         element('td', { class: 'sheets' }, sheetsDone(job)),
         element('td', { class: 'time-left' }, timeLeft(job)),
-        element('td', { class: 'actions' }, ...actionsOf(job)));
+        element('td', {}, element('div', { class: 'actions' }, ...actionsOf(job))));
       row.addEventListener('dragstart', (event) => {
         event.dataTransfer.setData('text/plain', String(job.id));
         event.dataTransfer.effectAllowed = 'move';
@@ -189,6 +237,7 @@
     }
     $('jobs-empty').hidden = state.jobs.length > 0;
     fillJobChoices();
+    renderDevices();  // a device's card says when its job waits for the next sheet
   }
 
   async function refreshJobs() {
@@ -213,6 +262,12 @@
 
   // ---- the machines ----
 
+  // The job on a device that waits between sheets for the operator, if any.
+  function waitingJob(device) {
+    const job = device.job ? state.jobs.find((known) => known.id === device.job) : null;
+    return job && job.waiting_for_next ? job : null;
+  }
+
   function renderDevices() {
     const cards = $('devices');
     cards.replaceChildren();
@@ -225,6 +280,8 @@
         element('p', {}, `${device.machine || '?'} · ${device.material || ''} · ${device.uri}`),
         device.message ? element('p', { class: 'device-message' }, device.message) : null,
         device.job ? element('p', {}, `job ${device.job}` + (cutting ? `, sheet ${progress.sheet} of ${progress.sheets}` : '')) : null,
+        waitingJob(device) ? element('p', { class: 'waiting' },
+          `waiting for sheet ${waitingJob(device).sheet + 1} to be loaded`) : null,
         fraction !== null
           ? element('progress', { max: '1', value: String(fraction), 'data-percent': String(Math.round(fraction * 100)) })
           : null,
@@ -253,7 +310,8 @@
   let dropped = null;
   function meshChosen(file) {
     dropped = file;
-    $('drop-text').textContent = file ? `${file.name} (${Math.ceil(file.size / 1024)} KB)` : 'Drop a mesh here or choose one';
+    $('drop-text').textContent = file ? `${file.name} (${Math.ceil(file.size / 1024)} KB)`
+      : 'Drop a mesh here (OBJ, OFF, PLY, STL, …) or choose one';
   }
   meshInput.addEventListener('change', () => meshChosen(meshInput.files[0] || null));
   for (const type of ['dragenter', 'dragover']) {
@@ -313,6 +371,15 @@
 
   function showTab(name) {
     state.tab = name;
+    if (name === 'sheets' && !state.sheets.job) {
+      // The job being cut, else the last one planned.
+      const job = state.jobs.find((known) => known.state === 'running' && known.sheets)
+        || plannedJobs()[plannedJobs().length - 1];
+      if (job) {
+        $('sheets-job-select').value = String(job.id);
+        openSheets(job.id, Math.max(1, job.state === 'running' ? job.sheet : 1));
+      }
+    }
     for (const tab of document.querySelectorAll('.tab')) {
       tab.setAttribute('aria-selected', String(tab.dataset.tab === name));
     }
@@ -442,7 +509,7 @@
   // ---- the event stream ----
 
   function listen() {
-    const events = new EventSource('/api/events');
+    const events = new EventSource(`/api/events?session=${encodeURIComponent(session())}`);
     const status = $('connection');
     events.onopen = () => {
       status.textContent = 'live';
@@ -454,6 +521,16 @@
     events.onerror = () => {
       status.textContent = 'reconnecting…';
       status.className = 'connection lost';
+      if (events.readyState !== EventSource.CLOSED) return;  // the browser tries again itself
+      // Refused (a session the daemon no longer knows) or gone: asked once
+      // every 3 s which, and the stream opened again when it answers.
+      setTimeout(() => {
+        api('GET', '/api/jobs').then(() => listen(), (failure) => {
+          if (failure instanceof SignedOut) return;
+          status.textContent = 'the daemon does not answer; trying again';
+          events.onerror();
+        });
+      }, 3000);
     };
     events.addEventListener('job', (event) => {
       const job = JSON.parse(event.data);
@@ -466,6 +543,11 @@
     events.addEventListener('progress', (event) => {
       const progress = JSON.parse(event.data);
       state.progress.set(progress.job, progress);
+      const cutting = state.jobs.find((known) => known.id === progress.job);
+      const estimates = cutting && cutting.summary && cutting.summary.cost && cutting.summary.cost.sheet_cutting_seconds;
+      if (progress.phase === 'cutting' && progress.stroke === 0 && estimates && estimates[progress.sheet - 1] > 0) {
+        realTimeScale.set(progress.job, progress.seconds_left / estimates[progress.sheet - 1]);
+      }
       const row = document.querySelector(`tr[data-job="${progress.job}"]`);
       const job = state.jobs.find((known) => known.id === progress.job);
       if (row && job) {
@@ -634,13 +716,27 @@
   const colours = {
     placed: [0.79, 0.66, 0.42],
     next: [1.0, 0.42, 0.0],
-    later: [0.89, 0.9, 0.92],
+    later: [0.78, 0.8, 0.83],
   };
 
   class Guide {
     constructor(container) {
       this.container = container;
-      this.renderer = new THREE.WebGLRenderer({ antialias: false });
+      this.views = [];
+      this.showing = false;
+      this.frames = 0;
+      this.spin = 0;
+      this.loop = this.loop.bind(this);
+      // Without WebGL (or three.js) the steps are still told, in words.
+      try {
+        if (typeof THREE === 'undefined') throw new Error('three.js is not installed (Debian package libjs-three)');
+        this.renderer = new THREE.WebGLRenderer({ antialias: false });
+      } catch (failure) {
+        this.renderer = null;
+        container.replaceChildren(element('p', { class: 'no-3d' },
+          `No 3D view in this browser (${failure.message || failure}); the steps, panels and holes are told beside it.`));
+        return;
+      }
       this.renderer.setClearColor(0xf0f2f4);
       container.append(this.renderer.domElement);
       this.scene = new THREE.Scene();
@@ -650,12 +746,7 @@
       this.scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 0.8));
       this.light = new THREE.DirectionalLight(0xffffff, 0.6);
       this.scene.add(this.light);
-      this.views = [];
-      this.showing = false;
-      this.frames = 0;
-      this.spin = 0;
       new ResizeObserver(() => this.resize()).observe(container);
-      this.loop = this.loop.bind(this);
     }
 
     resize() {
@@ -669,6 +760,7 @@
     }
 
     visible(on) {
+      if (!this.renderer) return;
       const was = this.showing;
       this.showing = on;
       if (on && !was) {
@@ -729,6 +821,14 @@
     }
 
     load(structure, manifest) {
+      // Assembly order: the manifest's `order`, else the panels' own.
+      this.panels = [...manifest.panels].sort((a, b) => (a.order || a.id) - (b.order || b.id));
+      this.byId = new Map(manifest.panels.map((panel) => [panel.id, panel]));
+      this.step = 0;
+      if (!this.renderer) {
+        this.goTo(1);
+        return;
+      }
       for (const view of this.views) {
         this.scene.remove(view.mesh);
         view.mesh.geometry.dispose();
@@ -745,10 +845,6 @@
       this.camera.position.copy(sphere.center).add(new THREE.Vector3(0.4, 0.5, 1).normalize().multiplyScalar(sphere.radius * 3));
       this.camera.updateProjectionMatrix();
       this.controls.update();
-      // Assembly order: the manifest's `order`, else the panels' own.
-      this.panels = [...manifest.panels].sort((a, b) => (a.order || a.id) - (b.order || b.id));
-      this.byId = new Map(manifest.panels.map((panel) => [panel.id, panel]));
-      this.step = 0;
       this.paint(0, this.panels.length, 'later');
       this.goTo(1);
     }
@@ -782,7 +878,7 @@
       }
       this.paint(step - 1, step, 'next');
       this.step = step;
-      if ($('guide-follow').checked) this.focusOn(this.panels[step - 1].id);
+      if (this.renderer && $('guide-follow').checked) this.focusOn(this.panels[step - 1].id);
       this.describe();
     }
 
@@ -837,11 +933,12 @@
         if (!shared.length) continue;
         holes.append(element('li', {}, `with ${other.id}: ${shared.map((s) => `edge ${s.edge} (${s.count} hole${s.count === 1 ? '' : 's'})`).join(', ')}`));
       }
-      this.renderer.domElement.setAttribute('data-highlighted', String(panel.id));
+      if (this.renderer) this.renderer.domElement.setAttribute('data-highlighted', String(panel.id));
     }
 
     // The panel whose vertices are painted as the next one, read from what is drawn.
     highlighted() {
+      if (!this.renderer) return [];
       const [r, g, b] = colours.next;
       const found = [];
       for (const [id, range] of this.ranges) {
@@ -889,23 +986,26 @@
   }
 
   async function openGuide(jobId) {
-    if (typeof THREE === 'undefined') throw new Refused('the 3D view needs three.js (Debian package libjs-three)');
     const [manifest, text] = await Promise.all([
       api('GET', `/api/jobs/${jobId}/manifest`),
       api('GET', `/api/jobs/${jobId}/files/structure.obj`),
     ]);
     if (!state.guide) state.guide = new Guide($('guide-view'));
-    state.guide.load(parseStructure(text), manifest);
+    state.guide.load(state.guide.renderer ? parseStructure(text) : null, manifest);
     state.guide.job = jobId;
     state.guide.visible(state.tab === 'guide');
     const steps = $('guide-print-steps');
     steps.replaceChildren();
+    const job = state.jobs.find((known) => known.id === jobId);
+    $('guide-print-title').textContent = `Assembly of job ${jobId}${job ? `, ${job.source}` : ''}: ${manifest.panels.length} panels in order`;
     for (const panel of state.guide.panels) {
       const neighbours = (panel.neighbors || []).map((id) => state.guide.byId.get(id)).filter(Boolean);
       const joins = neighbours
         .filter((other) => (other.order || other.id) < (panel.order || panel.id))
         .map((other) => `${other.id} (${sharedHoles(panel, other).map((s) => `edge ${s.edge}`).join(', ') || 'no holes'})`);
-      steps.append(element('li', {}, `Panel ${panel.id}, sheet ${panel.sheet}` + (joins.length ? `: joins ${joins.join('; ')}` : ': the first')));
+      const first = panel === state.guide.panels[0];
+      steps.append(element('li', {}, `Panel ${panel.id}, sheet ${panel.sheet}` + (joins.length ? `: joins ${joins.join('; ')}`
+        : first ? ': the first' : ': joins no panel placed yet (a new piece, joined to the rest later)')));
     }
     window.rotafabGuide = {
       job: jobId,
@@ -942,8 +1042,12 @@
 
   // ---- start ----
 
-  attempt(async () => {
-    await Promise.all([refreshDevices(), refreshJobs()]);
-    listen();
-  });
+  if (!session()) {
+    signedOut('This browser has no session with the daemon yet.');
+  } else {
+    attempt(async () => {
+      await Promise.all([refreshDevices(), refreshJobs()]);
+      listen();
+    });
+  }
 })();

@@ -6,7 +6,9 @@
 // page is kept as a screenshot in the build tree (test-artefacts/page/), and
 // the page must have reported no error at all.
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <pwd.h>
 
 #include <algorithm>
@@ -46,6 +48,13 @@ std::string rowState(testing::Browser& browser, long long job) {
   const json state = browser.evaluate(
       fmt::format("(document.querySelector('tr[data-job=\"{}\"]') || {{dataset: {{}}}}).dataset.state || ''", job));
   return state.is_string() ? state.get<std::string>() : "";
+}
+
+// Errors but those the browser logs for a refusal the test asked for.
+void expectNoErrorsBut(const testing::Browser& browser, const std::string& expected) {
+  for (const std::string& error : browser.errors()) {
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
 }
 
 void expectNoErrors(const testing::Browser& browser) {
@@ -174,9 +183,58 @@ TEST(Browser, ARefusedActionShowsTheDaemonsOwnWords) {
   EXPECT_EQ(daemon.job(1)["state"], "ready");
   browser.screenshot(artefacts() / "refused.png");
   // The browser logs the 409 of the request; nothing else went wrong.
-  for (const std::string& error : browser.errors()) {
-    EXPECT_NE(error.find("status of 409"), std::string::npos) << error;
-  }
+  expectNoErrorsBut(browser, "status of 409");
+}
+
+// A port nobody listens on now, for a daemon to take again after a restart.
+int freePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  socklen_t size = sizeof address;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
+
+TEST(Browser, WithoutASessionThePageSaysHowToGetOneAndSoItDoesWhenTheDaemonStartsAgain) {
+  TempDir root;
+  const int port = freePort();
+  Daemon daemon(root.path(), fmt::format("listen: [unix:{}, tcp://127.0.0.1:{}]\n",
+                                         (root.path() / "run/rotafab/rotafabd.sock").string(), port));
+  daemon.start();
+  testing::Browser browser;
+  // No session yet: the page says what to do, and shows no queue.
+  browser.navigate(fmt::format("http://127.0.0.1:{}/", port));
+  ASSERT_TRUE(browser.waitFor("!document.getElementById('signed-out').hidden", 10s));
+  EXPECT_NE(
+      browser.evaluate("document.getElementById('signed-out').innerText").get<std::string>().find("rotafab dashboard"),
+      std::string::npos);
+  EXPECT_EQ(browser.evaluate("document.querySelector('main').offsetParent"), nullptr);
+  // Signed in by a link; the secret does not stay in the address, and a reload keeps the session.
+  const std::string link = loginLink(daemon);
+  browser.navigate(link);
+  ASSERT_TRUE(browser.waitFor("document.querySelector('#connection.live')", 20s));
+  EXPECT_EQ(browser.evaluate("location.href"), fmt::format("http://127.0.0.1:{}/", port));
+  browser.navigate(fmt::format("http://127.0.0.1:{}/", port));
+  ASSERT_TRUE(browser.waitFor("document.querySelector('#connection.live')", 20s));
+  EXPECT_EQ(browser.evaluate("document.getElementById('signed-out').hidden"), true);
+  // The same link again, in another tab of the same browser, still signed in.
+  browser.navigate(link);
+  ASSERT_TRUE(browser.waitFor("document.querySelector('#connection.live')", 20s));
+  // The daemon started again: sessions end, and the open page says so by itself.
+  daemon.signal(SIGTERM);
+  ASSERT_EQ(daemon.wait(), 0);
+  daemon.start();
+  ASSERT_TRUE(browser.waitFor("!document.getElementById('signed-out').hidden", 20s))
+      << browser.evaluate("document.getElementById('connection').textContent");
+  EXPECT_NE(
+      browser.evaluate("document.getElementById('signed-out-why').textContent").get<std::string>().find("starts again"),
+      std::string::npos);
+  browser.screenshot(artefacts() / "signed-out.png");
+  expectNoErrorsBut(browser, "status of 401");
 }
 
 TEST(Browser, OnATabletThePageFitsTheScreen) {

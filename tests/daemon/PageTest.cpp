@@ -66,7 +66,8 @@ int pagePort(const Daemon& daemon) {
   return port;
 }
 
-// The session cookie a login link gives ("rotafab_session=..."), or "".
+// The session secret a login link gives the page (in the address's
+// fragment, which a browser never sends), or "".
 std::string signIn(const Daemon& daemon, int port) {
   const CommandResult link = daemon.client("dashboard --url");
   EXPECT_EQ(link.status, 0) << link.err;
@@ -75,68 +76,76 @@ std::string signIn(const Daemon& daemon, int port) {
   const std::string target = link.out.substr(prefix.size(), link.out.find('\n') - prefix.size());
   const HttpReply landed = overTcp(port, "GET", target);
   EXPECT_EQ(landed.status, 303) << landed.head;
-  EXPECT_EQ(landed.header("Location"), "/");
-  const std::string cookie = landed.header("Set-Cookie");
-  EXPECT_NE(cookie.find("HttpOnly"), std::string::npos) << cookie;
-  EXPECT_NE(cookie.find("SameSite=Strict"), std::string::npos) << cookie;
-  // The same link again opens nothing.
+  const std::string location = landed.header("Location");
+  EXPECT_TRUE(location.starts_with("/#session=")) << location;
+  EXPECT_EQ(landed.header("Set-Cookie"), "");  // nothing a browser would send by itself
+  // The same link again opens nothing: the page is told so.
   const HttpReply again = overTcp(port, "GET", target);
-  EXPECT_EQ(again.status, 401);
-  EXPECT_NE(again.body.find("used already"), std::string::npos) << again.body;
-  return cookie.substr(0, cookie.find(';'));
+  EXPECT_EQ(again.status, 303);
+  EXPECT_EQ(again.header("Location"), "/#signin=used");
+  return location.starts_with("/#session=") ? location.substr(10) : "";
 }
 
-TEST(Page, TheDefaultDaemonServesThePageOnLoopbackToASessionOnly) {
+TEST(Page, TheDefaultDaemonServesThePageOnLoopbackAndItsQueueToASessionOnly) {
   TempDir root;
   Daemon daemon(root.path());
   daemon.start();
   const int port = pagePort(daemon);
   ASSERT_GT(port, 0) << readFile(daemon.stateDir() / "rotafabd.json");
-  // Nobody gets in without a token or a session: the page says how to get one, the API in its JSON.
-  const HttpReply page = overTcp(port, "GET", "/");
-  EXPECT_EQ(page.status, 401);
-  EXPECT_NE(page.header("Content-Type").find("text/html"), std::string::npos);
-  EXPECT_NE(page.body.find("rotafab dashboard"), std::string::npos) << page.body;
+  // The page's files are the same for everyone; no other page may frame them.
+  const HttpReply index = overTcp(port, "GET", "/");
+  EXPECT_EQ(index.status, 200);
+  EXPECT_NE(index.header("Content-Type").find("text/html"), std::string::npos);
+  EXPECT_NE(index.body.find("/app/app.js"), std::string::npos);
+  EXPECT_NE(index.body.find("rotafab dashboard"), std::string::npos);  // what to do without a session
+  EXPECT_EQ(index.header("X-Frame-Options"), "DENY");
+  EXPECT_EQ(index.header("Content-Security-Policy"), "frame-ancestors 'none'");
+  EXPECT_EQ(index.header("X-Content-Type-Options"), "nosniff");
+  for (const char* file : {"/app/app.js", "/app/style.css", "/lib/three/build/three.min.js",
+                           "/lib/three/examples/js/controls/OrbitControls.js"}) {
+    const HttpReply served = overTcp(port, "GET", file);
+    EXPECT_EQ(served.status, 200) << file << ": " << served.body.substr(0, 200);
+    EXPECT_GT(served.body.size(), 1000u) << file;
+  }
+  EXPECT_NE(overTcp(port, "GET", "/app/app.js").header("Content-Type").find("javascript"), std::string::npos);
+  EXPECT_EQ(overTcp(port, "GET", "/favicon.ico").status, 204);
+  // Nothing beyond the page's own files and the three.js it loads.
+  for (const char* outside : {"/app/../../CMakeLists.txt", "/lib/three/../../jquery/jquery.js", "/etc/passwd",
+                              "/lib/three/package.json", "/app/.hidden.js"}) {
+    EXPECT_EQ(overTcp(port, "GET", outside).status, 404) << outside;
+  }
+  // Nobody reaches the queue without a token or a session.
   const HttpReply api = overTcp(port, "GET", "/api/jobs");
   EXPECT_EQ(api.status, 401);
   EXPECT_NE(json::parse(api.body, nullptr, false).value("error", "").find("rotafab dashboard"), std::string::npos)
       << api.body;
-  EXPECT_EQ(overTcp(port, "GET", "/app/app.js").status, 401);
-  EXPECT_EQ(overTcp(port, "GET", "/api/jobs", "Cookie: rotafab_session=forged\r\n").status, 401);
-  EXPECT_EQ(overTcp(port, "GET", "/login?code=guessed").status, 401);
+  EXPECT_EQ(overTcp(port, "GET", "/api/jobs", "Authorization: Bearer forged\r\n").status, 401);
+  EXPECT_EQ(overTcp(port, "GET", "/api/events?session=forged").status, 401);
 
-  const std::string cookie = signIn(daemon, port);
-  ASSERT_TRUE(cookie.starts_with("rotafab_session=")) << cookie;
-  const std::string withSession = "Cookie: " + cookie + "\r\n";
-  const HttpReply index = overTcp(port, "GET", "/", withSession);
-  EXPECT_EQ(index.status, 200);
-  EXPECT_NE(index.body.find("/app/app.js"), std::string::npos);
-  for (const char* file : {"/app/app.js", "/app/style.css", "/lib/three/build/three.min.js",
-                           "/lib/three/examples/js/controls/OrbitControls.js"}) {
-    const HttpReply served = overTcp(port, "GET", file, withSession);
-    EXPECT_EQ(served.status, 200) << file << ": " << served.body.substr(0, 200);
-    EXPECT_GT(served.body.size(), 1000u) << file;
-  }
-  EXPECT_NE(overTcp(port, "GET", "/app/app.js", withSession).header("Content-Type").find("javascript"),
-            std::string::npos);
-  // Nothing beyond the page's own files and the three.js it loads.
-  for (const char* outside : {"/app/../../CMakeLists.txt", "/lib/three/../../jquery/jquery.js", "/etc/passwd",
-                              "/lib/three/package.json", "/app/.hidden.js"}) {
-    EXPECT_EQ(overTcp(port, "GET", outside, withSession).status, 404) << outside;
-  }
-  const HttpReply jobs = overTcp(port, "GET", "/api/jobs", withSession);
+  const std::string secret = signIn(daemon, port);
+  ASSERT_EQ(secret.size(), 64u) << secret;
+  const std::string bearer = "Authorization: Bearer " + secret + "\r\n";
+  const HttpReply jobs = overTcp(port, "GET", "/api/jobs", bearer);
   EXPECT_EQ(jobs.status, 200);
   EXPECT_TRUE(json::parse(jobs.body, nullptr, false).contains("jobs")) << jobs.body;
-  // A session's action sent by another site's page is refused; the page's own goes through.
-  const HttpReply forged =
-      overTcp(port, "POST", "/api/jobs/1/cancel", withSession + "Origin: http://evil.example\r\n", "{}");
-  EXPECT_EQ(forged.status, 403);
-  EXPECT_NE(forged.body.find("not from another site"), std::string::npos) << forged.body;
-  const HttpReply own = overTcp(port, "POST", "/api/jobs/1/cancel",
-                                withSession + fmt::format("Origin: http://127.0.0.1:{}\r\n", port), "{}");
-  EXPECT_EQ(own.status, 404) << own.body;  // no job 1: refused by the queue, not the guard
+  // A cookie carrying the secret is not a way in: a browser would send it to any port of this host.
+  EXPECT_EQ(overTcp(port, "GET", "/api/jobs", "Cookie: rotafab_session=" + secret + "\r\n").status, 401);
+  // The event stream, which cannot send a header, takes it in its address.
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address), 0);
+  const std::string request =
+      fmt::format("GET /api/events?session={} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\n\r\n", secret, port);
+  ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+  char head[64] = {};
+  EXPECT_GT(::recv(fd, head, sizeof head - 1, 0), 12);
+  EXPECT_TRUE(std::string(head).starts_with("HTTP/1.1 200")) << head;
+  ::close(fd);
   // A session cannot mint further links; a login link is for this machine's user or a token's holder.
-  EXPECT_EQ(overTcp(port, "POST", "/api/sessions", withSession, "{}").status, 403);
+  EXPECT_EQ(overTcp(port, "POST", "/api/sessions", bearer, "{}").status, 403);
 }
 
 TEST(Page, TwoDaemonsWithTheDefaultsBothServeThePage) {
