@@ -228,8 +228,16 @@
         row.classList.remove('drag-over');
         const moved = Number(event.dataTransfer.getData('text/plain'));
         if (!moved || moved === job.id) return;
+        // Dragged up, it goes before the row it is dropped on; down, after it
+        // (before the next, or below the last at a lower priority).
+        const from = state.jobs.findIndex((known) => known.id === moved);
+        const to = state.jobs.findIndex((known) => known.id === job.id);
+        const next = state.jobs[to + 1];
+        const place = from > to ? { before: job.id }
+          : next ? (next.id === moved ? null : { before: next.id }) : { priority: (job.priority || 0) - 1 };
+        if (!place) return;
         attempt(async () => {
-          await api('POST', `/api/jobs/${moved}/move`, { before: job.id });
+          await api('POST', `/api/jobs/${moved}/move`, place);
           await refreshJobs();
         });
       });

@@ -186,6 +186,51 @@ TEST(Browser, ARefusedActionShowsTheDaemonsOwnWords) {
   expectNoErrorsBut(browser, "status of 409");
 }
 
+// The queue's order as the API gives it.
+std::vector<int> queueOrder(const Daemon& daemon) {
+  std::vector<int> order;
+  const json queue = daemon.clientJson("jobs");
+  for (const json& job : queue["jobs"]) order.push_back(job["id"].get<int>());
+  return order;
+}
+
+TEST(Browser, TheQueueIsReorderedByDraggingItsRowsUpAndDown) {
+  TempDir root;
+  // A cutter that is not plugged in: nothing starts while the rows are moved.
+  Daemon daemon(root.path(),
+                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"grbl:///dev/rotafab-no-such-port\"}]\n");
+  daemon.start();
+  for (int n = 0; n < 3; ++n) {
+    ASSERT_EQ(
+        daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --evaluations 1").status,
+        0);
+  }
+  testing::Browser browser;
+  browser.navigate(loginLink(daemon));
+  ASSERT_TRUE(browser.waitFor("document.querySelectorAll('#jobs-body tr').length === 3", 20s));
+  // A drag as the browser delivers one: dragstart on a row, drop on another.
+  const auto drag = [&](int job, int onto) {
+    browser.evaluate(fmt::format(R"((() => {{
+      const data = new DataTransfer();
+      document.querySelector('tr[data-job="{}"]').dispatchEvent(new DragEvent('dragstart', {{dataTransfer: data, bubbles: true}}));
+      document.querySelector('tr[data-job="{}"]').dispatchEvent(new DragEvent('drop', {{dataTransfer: data, bubbles: true, cancelable: true}}));
+    }})())",
+                                 job, onto));
+  };
+  drag(1, 3);  // down, below the last
+  ASSERT_TRUE(browser.waitFor(
+      "[...document.querySelectorAll('#jobs-body tr')].map(r => r.dataset.job).join() === '2,3,1'", 10s));
+  EXPECT_EQ(queueOrder(daemon), (std::vector<int>{2, 3, 1}));
+  drag(2, 3);  // down, onto the next
+  ASSERT_TRUE(browser.waitFor(
+      "[...document.querySelectorAll('#jobs-body tr')].map(r => r.dataset.job).join() === '3,2,1'", 10s));
+  drag(1, 3);  // up, to the top
+  ASSERT_TRUE(browser.waitFor(
+      "[...document.querySelectorAll('#jobs-body tr')].map(r => r.dataset.job).join() === '1,3,2'", 10s));
+  EXPECT_EQ(queueOrder(daemon), (std::vector<int>{1, 3, 2}));
+  expectNoErrors(browser);
+}
+
 // A port nobody listens on now, for a daemon to take again after a restart.
 int freePort() {
   const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
