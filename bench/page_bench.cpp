@@ -15,7 +15,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -110,7 +112,11 @@ int main(int argc, char** argv) {
     std::this_thread::sleep_for(std::chrono::seconds(1));
     const char* shots = std::getenv("ROTAFAB_PAGE_SHOTS");  // a folder for the guide at rest and in motion
     if (shots) browser.screenshot(fs::path(shots) / "guide-at-rest.png");
+    // Orbiting close to the first panel (where the guide turns to), then the whole structure in view.
     const double fps = browser.evaluate(fmt::format("window.rotafabGuide.fps({})", seconds * 1000)).get<double>();
+    browser.evaluate("window.rotafabGuide.whole()");
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+    const double wholeFps = browser.evaluate(fmt::format("window.rotafabGuide.fps({})", seconds * 1000)).get<double>();
     if (shots) {
       browser.evaluate("window.rotafabGuide.fps(300).then(() => 0)");
       browser.evaluate("(() => { window.rotafabGuide.fps(2000); return new Promise(r => setTimeout(r, 500)); })()");
@@ -127,11 +133,12 @@ int main(int argc, char** argv) {
                       {"panels", browser.evaluate("window.rotafabGuide.panels")},
                       {"triangles", browser.evaluate("window.rotafabGuide.triangles")},
                       {"guide_opened_s", std::round(opened * 100) / 100},
-                      {"fps", std::round(fps * 10) / 10},
+                      {"fps_at_a_panel", std::round(fps * 10) / 10},
+                      {"fps_whole", std::round(wholeFps * 10) / 10},
                       {"step_ms", std::round(stepping) / 100},
                       {"errors", browser.errors().size()}};
     std::printf("%s\n", result.dump().c_str());
-    status = fps >= 30 && browser.errors().empty() ? 0 : 1;
+    status = std::min(fps, wholeFps) >= 30 && browser.errors().empty() ? 0 : 1;
   } catch (const std::exception& error) {
     std::fprintf(stderr, "page bench: %s\n", error.what());
     status = 2;

@@ -850,7 +850,7 @@
       this.controls.target.copy(sphere.center);
       this.camera.near = sphere.radius / 100;
       this.camera.far = sphere.radius * 100;
-      this.camera.position.copy(sphere.center).add(new THREE.Vector3(0.4, 0.5, 1).normalize().multiplyScalar(sphere.radius * 3));
+      this.camera.position.copy(this.wholeView().position);
       this.camera.updateProjectionMatrix();
       this.controls.update();
       this.paint(0, this.panels.length, 'later');
@@ -888,6 +888,20 @@
       this.step = step;
       if (this.renderer && $('guide-follow').checked) this.focusOn(this.panels[step - 1].id);
       this.describe();
+    }
+
+    // The whole structure in view, from the front and a little above.
+    wholeView() {
+      const sphere = this.views[0].mesh.geometry.boundingSphere;
+      const position = sphere.center.clone()
+        .add(new THREE.Vector3(0.4, 0.5, 1).normalize().multiplyScalar(sphere.radius * 3));
+      return { target: sphere.center.clone(), position, near: sphere.radius / 100 };
+    }
+
+    showWhole() {
+      if (!this.renderer || !this.views.length) return;
+      this.goal = this.wholeView();
+      this.dirty = true;
     }
 
     // The view turned to face the panel from outside the structure, close
@@ -1021,6 +1035,7 @@
       panel: () => state.guide.panels[state.guide.step - 1].id,
       highlighted: () => state.guide.highlighted(),
       fps: (milliseconds) => state.guide.measure(milliseconds || 2000),
+      whole: () => state.guide.showWhole(),
       panels: state.guide.panels.length,
       triangles: state.guide.views.map((view) => view.mesh.geometry.index.count / 3),
     };
@@ -1047,6 +1062,7 @@
     });
   });
   $('guide-print').addEventListener('click', () => window.print());
+  $('guide-whole').addEventListener('click', () => state.guide && state.guide.showWhole());
 
   // ---- start ----
 
