@@ -116,13 +116,22 @@ std::string inSubmittersWords(std::string message, const fs::path& folder, const
 // spool), in the daemon's log as "job N: bunny.obj: ...".
 class JobNotesSink : public spdlog::sinks::base_sink<std::mutex> {
  public:
-  JobNotesSink(std::shared_ptr<spdlog::logger> log, const fs::path& folder, std::string job)
-      : log_(std::move(log)), folder_(folder), job_(std::move(job)) {}
+  // What a plan said, kept for its summary as `make --json` keeps it.
+  struct Said {
+    std::vector<std::string> notes, warnings;
+  };
+  JobNotesSink(std::shared_ptr<spdlog::logger> log, const fs::path& folder, std::string job, std::shared_ptr<Said> said)
+      : log_(std::move(log)), folder_(folder), job_(std::move(job)), said_(std::move(said)) {}
 
  protected:
   void sink_it_(const spdlog::details::log_msg& message) override {
-    const std::string text(message.payload.data(), message.payload.size());
-    log_->log(message.level, "{}: {}", job_, inSubmittersWords(text, folder_));
+    const std::string text = inSubmittersWords(std::string(message.payload.data(), message.payload.size()), folder_);
+    log_->log(message.level, "{}: {}", job_, text);
+    if (message.level >= spdlog::level::warn) {
+      said_->warnings.push_back(text);
+    } else if (message.level == spdlog::level::info) {
+      said_->notes.push_back(text);
+    }
   }
   void flush_() override { log_->flush(); }
 
@@ -130,6 +139,7 @@ class JobNotesSink : public spdlog::sinks::base_sink<std::mutex> {
   std::shared_ptr<spdlog::logger> log_;
   fs::path folder_;
   std::string job_;
+  std::shared_ptr<Said> said_;
 };
 
 std::string sheetWhere(int sheet, int sheets, int64_t stroke, int64_t strokes) {
@@ -609,6 +619,7 @@ struct Service::Impl {
         request.formats->svg = true;
         const JobId id = job.id;
         auto last = std::make_shared<Clock::time_point>();
+        auto said = std::make_shared<JobNotesSink::Said>();
         const core::WorkContext context(
             *executor, *cancel,
             [this, id, last](const core::Progress& progress) {
@@ -627,7 +638,7 @@ struct Service::Impl {
               });
             },
             std::make_shared<spdlog::logger>(
-                "plan", std::make_shared<JobNotesSink>(log, folder, fmt::format("job {}", job.id))));
+                "plan", std::make_shared<JobNotesSink>(log, folder, fmt::format("job {}", job.id), said)));
         jobs::PlannedJob planned = jobs::makeJob(request, folder / "planned", context);
         syncFolder(folder / "planned");
         syncFolder(folder);
@@ -635,6 +646,9 @@ struct Service::Impl {
         summary = jobs::summaryJson(planned);
         summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
         summary["cost"] = jobs::costJson(planned.cost);
+        // What the plan said on the way, for the people at the machine (the page shows them).
+        summary["notes"] = said->notes;
+        summary["warnings"] = said->warnings;
       }
     } catch (const core::Cancelled&) {
       cancelled = true;

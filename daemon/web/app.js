@@ -201,6 +201,15 @@
     return buttons;
   }
 
+  // What the plan warned of (narrow bands, glued crossings, ...), folded under the state.
+  function warningsOf(job) {
+    const warnings = (job.summary && job.summary.warnings) || [];
+    if (!warnings.length) return null;
+    return element('details', { class: 'warnings' },
+      element('summary', {}, `${warnings.length} warning${warnings.length === 1 ? '' : 's'} from planning`),
+      element('ul', {}, ...warnings.map((text) => element('li', {}, text))));
+  }
+
   function renderJobs() {
     const body = $('jobs-body');
     body.replaceChildren();
@@ -211,7 +220,8 @@
         element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
                 element('span', { class: 'message' }, job.waiting_for_next
                   ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}, then press “Next sheet loaded”`
-                  : job.message || '')),
+                  : job.message || ''),
+                warningsOf(job)),
         element('td', {}, job.owner || ''),
         element('td', {}, job.device || '–'),
         element('td', { class: 'sheets' }, sheetsDone(job)),

@@ -85,6 +85,9 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
       << rowState(browser, 1) << ": " << daemon.job(1).dump();
   // The page's session is the user's who asked for the link.
   EXPECT_EQ(daemon.job(1)["owner"], ::getpwuid(::getuid())->pw_name);
+  // The plan's warning, folded under the row's state.
+  EXPECT_EQ(browser.evaluate("document.querySelector('tr[data-job=\"1\"] .warnings summary').textContent"),
+            "1 warning from planning");
   browser.screenshot(artefacts() / "queue.png");
 
   // The sheet on the screen while it is cut: every percentage the

@@ -184,6 +184,10 @@ TEST(Page, ASheetIsItsStrokesInTheOrderTheLaserBurnsThem) {
   const json ready =
       daemon.waitForJob(id, [](const json& job) { return job["state"] != "queued" && job["state"] != "planning"; });
   ASSERT_EQ(ready["state"], "ready") << ready.dump();
+  // What the plan warned of is the job's, as `make --json` gives it, in the submitter's words.
+  ASSERT_EQ(ready["summary"]["warnings"].size(), 1u) << ready.dump();
+  EXPECT_TRUE(ready["summary"]["warnings"][0].get<std::string>().starts_with("cube.obj: 12 bands are too narrow"))
+      << ready["summary"]["warnings"][0];
   const RawReply sheet = daemon.get(fmt::format("/api/jobs/{}/sheets/1", id));
   ASSERT_EQ(sheet.status, 200) << sheet.text;
   const json& strokes = sheet.body["strokes"];
