@@ -81,7 +81,6 @@ const std::set<std::string>& threeFiles() {
 
 std::string contentTypeOf(const fs::path& file) {
   const std::string extension = file.extension().string();
-  const std::string name = file.filename().string();
   if (extension == ".html") return "text/html; charset=utf-8";
   if (extension == ".js") return "text/javascript; charset=utf-8";
   if (extension == ".css") return "text/css; charset=utf-8";

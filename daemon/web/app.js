@@ -854,8 +854,6 @@
       this.views = [this.makeView(structure)];
       // Small structures are drawn whole even while they move.
       if (structure.index.length / 3 > 20000) this.views.push(this.makeView(coarseStructure(structure)));
-      this.colour = this.views[0].colour;
-      this.ranges = this.views[0].ranges;
       const sphere = this.views[0].mesh.geometry.boundingSphere;
       this.controls.target.copy(sphere.center);
       this.camera.near = sphere.radius / 100;
@@ -917,7 +915,7 @@
     // The view turned to face the panel from outside the structure, close
     // enough to see it and its neighbours.
     focusOn(id) {
-      const range = this.ranges.get(id);
+      const range = this.views[0].ranges.get(id);
       if (!range) return;
       const geometry = this.views[0].mesh.geometry;
       const position = geometry.attributes.position.array;
@@ -973,10 +971,11 @@
       if (!this.renderer) return [];
       const [r, g, b] = colours.next;
       const found = [];
-      for (const [id, range] of this.ranges) {
+      const { colour, ranges } = this.views[0];
+      for (const [id, range] of ranges) {
         const v = range[0];
-        if (range[1] > v && this.colour[3 * v] === Math.fround(r) && this.colour[3 * v + 1] === Math.fround(g) &&
-            this.colour[3 * v + 2] === Math.fround(b)) {
+        if (range[1] > v && colour[3 * v] === Math.fround(r) && colour[3 * v + 1] === Math.fround(g) &&
+            colour[3 * v + 2] === Math.fround(b)) {
           found.push(id);
         }
       }
