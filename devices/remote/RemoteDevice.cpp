@@ -40,10 +40,18 @@ void RemoteDevice::start() {
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, sockets[1], STDIN_FILENO);
   posix_spawn_file_actions_adddup2(&actions, sockets[1], STDOUT_FILENO);
+  // The helper leads a process group of its own, so that ending it ends
+  // whatever it started too (a shell's children would otherwise live on,
+  // holding our standard error open).
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
   std::vector<char*> args;
   for (std::string& arg : argv_) args.push_back(arg.data());
   args.push_back(nullptr);
-  const int spawned = ::posix_spawnp(&child_, argv_[0].c_str(), &actions, nullptr, args.data(), environ);
+  const int spawned = ::posix_spawnp(&child_, argv_[0].c_str(), &actions, &attributes, args.data(), environ);
+  posix_spawnattr_destroy(&attributes);
   posix_spawn_file_actions_destroy(&actions);
   ::close(sockets[1]);
   if (spawned != 0) {
@@ -65,12 +73,13 @@ void RemoteDevice::stop() noexcept {
   int status = 0;
   while (::waitpid(child_, &status, WNOHANG) == 0) {
     if (Clock::now() > deadline) {
-      ::kill(child_, SIGKILL);
+      ::kill(-child_, SIGKILL);
       ::waitpid(child_, &status, 0);
       break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
+  ::kill(-child_, SIGKILL);  // what the helper left behind when it went
   child_ = -1;
 }
 

@@ -4,11 +4,15 @@
 // turns a helper that dies or falls silent into a typed fault, never a hang.
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <string>
 #include <thread>
 
 #include "devices/grbl/GCode.h"
@@ -187,10 +191,20 @@ TEST(RemoteDevice, ASilentHelperTimesOutAndACancelIsPassedOn) {
     EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
   }
   // A helper that answers the connect, then falls silent in the run (no word
-  // that it is alive): a timeout, not a hang, the laser not confirmed off.
+  // that it is alive): a timeout, not a hang, the laser not confirmed off;
+  // and what the helper started (here `sleep`) ends with it.
   {
-    Remote device({"/bin/sh", "-c", R"(read l; echo '{"ok":true,"identity":"fake","id":1}'; sleep 30)"}, quick);
+    const std::string pidFile = "/tmp/rotafab-test-helper-" + std::to_string(::getpid());
+    Remote device({"/bin/sh", "-c",
+                   "echo $$ > " + pidFile + R"(; read l; echo '{"ok":true,"identity":"fake","id":1}'; sleep 30)"},
+                  quick);
     device.connect();
+    std::ifstream pidText(pidFile);
+    pid_t helper = 0;
+    pidText >> helper;
+    std::remove(pidFile.c_str());
+    ASSERT_GT(helper, 0);
+    EXPECT_EQ(::kill(-helper, 0), 0) << "the helper leads a process group of its own";
     const core::Cancellation never;
     const auto start = std::chrono::steady_clock::now();
     try {
@@ -201,6 +215,10 @@ TEST(RemoteDevice, ASilentHelperTimesOutAndACancelIsPassedOn) {
       EXPECT_FALSE(fault.laserOffConfirmed);
     }
     EXPECT_LT(std::chrono::steady_clock::now() - start, 3s);
+    // (Killed, the orphaned `sleep` is gone once the system has reaped it.)
+    const auto killed = std::chrono::steady_clock::now();
+    while (::kill(-helper, 0) == 0 && std::chrono::steady_clock::now() - killed < 2s) std::this_thread::sleep_for(10ms);
+    EXPECT_NE(::kill(-helper, 0), 0) << "the helper's `sleep` outlived it";
   }
   // A helper that answers a cancel with the driver's fault: the cancel reaches it.
   Remote device(
