@@ -135,11 +135,18 @@ TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
   EXPECT_EQ(summary.at("panels"), 90);
   EXPECT_EQ(summary.at("fasteners"), 180);
   // The ribbons narrowed where at the default width they would pass
-  // through each other: a note, in the summary as on standard error.
-  ASSERT_EQ(summary.at("notes").size(), 1U) << made.err;
-  const std::string note = summary.at("notes")[0];
-  EXPECT_TRUE(note.starts_with(std::string(kSource / "examples/soccer-ball.obj") + ": ribbons narrowed at 90 of 90 "))
-      << note;
+  // through each other: a note, in the summary as on standard error. (On a
+  // loaded machine a second note may say the nesting's second ran out.)
+  const std::string narrowed = std::string(kSource / "examples/soccer-ball.obj") + ": ribbons narrowed at 90 of 90 ";
+  std::string note;
+  for (const auto& line : summary.at("notes")) {
+    if (line.get<std::string>().starts_with(narrowed)) {
+      note = line;
+    } else {
+      EXPECT_NE(line.get<std::string>().find("the time budget ran out"), std::string::npos) << line;
+    }
+  }
+  ASSERT_NE(note, "") << made.err;
   EXPECT_NE(made.err.find("note: " + note + "\n"), std::string::npos) << made.err;
   EXPECT_TRUE(summary.at("warnings").empty()) << made.err;
   const auto m = nlohmann::json::parse(readFile(out / "manifest.json"));
