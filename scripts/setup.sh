@@ -14,7 +14,7 @@ packages=(
   # libraries (see README "Dependencies" for what each is for)
   libassimp-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
   libspdlog-dev libfmt-dev libyaml-cpp-dev libboost-dev libboost-system-dev
-  libsqlite3-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
+  libsqlite3-dev libpq-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
   libopenmesh-dev
   hershey-fonts-data libumockdev-dev umockdev
   # the workshop page's 3D view, served from Debian's path
@@ -27,6 +27,8 @@ packages=(
   librsvg2-bin libxml2-utils python3-ezdxf inkscape
   # a real browser for the workshop page's tests (headless, over DevTools)
   chromium
+  # a real PostgreSQL server for the job store's tests (scripts/test-postgres.sh)
+  postgresql-15
   # meshes other people made, read by the tests where these packages install
   # them (tests/data/external/README.md)
   assimp-testmodels geomview openscad-testing-data libcgal-demo

@@ -106,10 +106,12 @@ DaemonConfig loadConfig(const fs::path& file) {
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
     if (root["store"]) {
       const std::string store = reader.text(root["store"], "store");
-      if (store.starts_with("postgresql://")) {
-        reader.fail(root["store"], "store", "a PostgreSQL store is not built yet; use sqlite");
+      if (store.starts_with("postgresql://") || store.starts_with("postgres://")) {
+        config.store = store;
+      } else if (store != "sqlite") {
+        reader.fail(root["store"], "store",
+                    fmt::format("expected sqlite or postgresql://USER@HOST:PORT/DB, found '{}'", store));
       }
-      if (store != "sqlite") reader.fail(root["store"], "store", fmt::format("expected sqlite, found '{}'", store));
     }
     if (root["host"]) config.host = reader.text(root["host"], "host");
     if (const YAML::Node listen = root["listen"]) {

@@ -31,6 +31,9 @@ struct TokenConfig {
 struct DaemonConfig {
   std::filesystem::path file;  // the file it was read from; empty: the defaults
   std::filesystem::path stateDir;
+  // Where the jobs are kept: empty for SQLite in stateDir (the default), or
+  // a PostgreSQL URI (postgresql://USER@HOST:PORT/DB).
+  std::string store;
   std::string host;  // this daemon's name (default: the host name)
   // "unix:PATH" and "tcp://HOST:PORT"; the first Unix one is where `rotafab` looks.
   std::vector<std::string> listen;

@@ -1,10 +1,10 @@
 #pragma once
 // Where the daemon keeps its jobs (SPEC, "Daemon"): jobs, every transition
 // of each with its time and reason, and events. A small interface of its
-// own so that another engine can stand behind it (a store shared by several
-// hosts); SqliteStore.h is the one there is. Every call is one transaction:
-// when it returns, what it wrote survives a kill of the process and a loss
-// of power (the engine syncs before it returns). Calls come from one thread
+// own so that another engine can stand behind it: SQLite (SqliteStore.cpp)
+// or PostgreSQL (PostgresStore.cpp), a store several hosts share. Every call
+// is one transaction: when it returns, what it wrote survives a kill of the
+// process and a loss of power (the engine syncs before it returns). Calls come from one thread
 // at a time (the daemon's state strand).
 
 #include <cstdint>
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "daemon/service/JobState.h"
+#include "daemon/service/StoreSchema.h"
 
 namespace rotafab::service {
 
@@ -93,6 +94,23 @@ class StoreError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// What both engines' stores share: the time a change is recorded at (Unix
+// seconds), and the check, before anything is written, that each new job's
+// first steps are allowed (TransitionRefused naming the job's source).
+double unixSeconds();
+void checkFirstSteps(const std::vector<NewJob>& jobs);
+// What an engine's store writes, in its own SQL, within the caller's transaction.
+struct JobRows {
+  std::function<JobId(const NewJob& job, double position, double at)> insert;  // the new job's number
+  std::function<void(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason)> record;
+  std::function<void(JobId id, JobState from, JobState to, double at, std::string_view reason)> move;
+  std::function<void(JobId id, const JobChange& change)> apply;
+};
+// New jobs after the one at `lastPosition`: each inserted, its submission
+// recorded, then its first steps and its change; their numbers, in order.
+std::vector<JobId> addJobRows(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons,
+                              double lastPosition, const JobRows& rows);
+
 class JobStore {
  public:
   virtual ~JobStore() = default;
@@ -132,7 +150,17 @@ class JobStore {
 // (for the tests of each one). Throws StoreError.
 std::unique_ptr<JobStore> openSqliteStore(const std::filesystem::path& file,
                                           std::optional<int> upToVersion = std::nullopt);
-// The newest schema version this program knows.
-int newestSchemaVersion();
+
+// PostgreSQL at `uri` (postgresql://USER@HOST:PORT/DB, libpq's form), a
+// store several daemons share; migrated as the SQLite one, by one daemon at a
+// time. Every transaction is committed with the server's synchronous commit.
+// Throws StoreError naming the URI without its password. `exclusive`: the
+// store is this daemon's alone while it is open (a second daemon on it is
+// refused), until the hosts that share one store claim their work from it.
+std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion = std::nullopt,
+                                            bool exclusive = false);
+
+// The URI as it may be shown: any password in it replaced by ***.
+std::string uriWithoutPassword(const std::string& uri);
 
 }  // namespace rotafab::service

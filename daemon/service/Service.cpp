@@ -346,7 +346,8 @@ struct Service::Impl {
       throw StoreError(
           fmt::format("{}: cannot create the state directory: {}", config.stateDir.string(), error.message()));
     }
-    store = openSqliteStore(config.stateDir / "jobs.sqlite3");
+    store = config.store.empty() ? openSqliteStore(config.stateDir / "jobs.sqlite3")
+                                 : openPostgresStore(config.store, std::nullopt, true);
     spool = std::make_unique<Spool>(config.stateDir / "spool");
     catalogue = profiles::loadProfiles(profiles::profileSearchPath());
     const std::string where = config.file.empty() ? std::string("the default configuration") : config.file.string();

@@ -14,58 +14,10 @@
 #include <utility>
 
 #include "daemon/service/JobStore.h"
+#include "daemon/service/StoreSchema.h"
 
 namespace rotafab::service {
 namespace {
-
-// Each migration takes the schema from its index to the next version.
-constexpr const char* kMigrations[] = {
-    // 1: jobs and their transitions.
-    R"(CREATE TABLE jobs (
-         id INTEGER PRIMARY KEY AUTOINCREMENT,
-         state TEXT NOT NULL,
-         kind TEXT NOT NULL,
-         source TEXT NOT NULL,
-         owner TEXT NOT NULL,
-         device TEXT NOT NULL,
-         priority INTEGER NOT NULL,
-         position REAL NOT NULL,
-         options TEXT NOT NULL,
-         spool TEXT NOT NULL,
-         submitted REAL NOT NULL,
-         updated REAL NOT NULL,
-         sheets INTEGER NOT NULL DEFAULT 0,
-         summary TEXT NOT NULL DEFAULT '',
-         sheet INTEGER NOT NULL DEFAULT 0,
-         stroke INTEGER NOT NULL DEFAULT 0,
-         strokes INTEGER NOT NULL DEFAULT 0,
-         message TEXT NOT NULL DEFAULT '');
-       CREATE TABLE transitions (
-         id INTEGER PRIMARY KEY AUTOINCREMENT,
-         job INTEGER NOT NULL REFERENCES jobs(id),
-         from_state TEXT,
-         to_state TEXT NOT NULL,
-         at REAL NOT NULL,
-         reason TEXT NOT NULL);)",
-    // 2: events, and the indexes the queue and a job's history are read by.
-    R"(CREATE TABLE events (
-         id INTEGER PRIMARY KEY AUTOINCREMENT,
-         job INTEGER REFERENCES jobs(id),
-         at REAL NOT NULL,
-         kind TEXT NOT NULL,
-         text TEXT NOT NULL);
-       CREATE INDEX jobs_queue ON jobs(priority DESC, position);
-       CREATE INDEX transitions_job ON transitions(job, id);
-       CREATE INDEX events_job ON events(job, id);)",
-    // 3: the jobs the scheduler looks for (queued, ready) found without reading every job.
-    R"(CREATE INDEX jobs_state ON jobs(state, priority DESC, position);)",
-    // 4: the end of the queue, where a new job goes, found without reading
-    // every job (MAX over jobs_queue's second column reads the whole index).
-    R"(CREATE INDEX jobs_position ON jobs(position);)",
-};
-constexpr int kNewest = static_cast<int>(std::size(kMigrations));
-
-double now() { return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count(); }
 
 // The store's statements, each prepared once: preparing took more of a
 // submission's time on the store than the insert it prepared.
@@ -249,7 +201,7 @@ class SqliteStore final : public JobStore {
       execute(db_, "PRAGMA journal_mode=WAL", doing("set WAL mode").c_str());
       execute(db_, "PRAGMA synchronous=FULL", doing("set synchronous=FULL").c_str());
       execute(db_, "PRAGMA foreign_keys=ON", doing("turn on foreign keys").c_str());
-      migrate(upTo.value_or(kNewest));
+      migrate(upTo.value_or(newestSchemaVersion()));
       statements_.emplace(db_);
     } catch (...) {
       sqlite3_close(db_);
@@ -266,51 +218,38 @@ class SqliteStore final : public JobStore {
   }
 
   std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) override {
-    // Each job's first steps checked before anything is written.
-    for (const NewJob& job : jobs) {
-      JobState state = JobState::Queued;
-      for (const FirstStep& step : job.then) {
-        if (!allowedTransition(state, step.to)) {
-          throw TransitionRefused(
-              fmt::format("a new job of {} cannot go from {} to {}", job.source, stateName(state), stateName(step.to)));
-        }
-        state = step.to;
-      }
-    }
+    checkFirstSteps(jobs);
     Transaction transaction(db_);
     Statement last(*statements_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
     last.step();
-    double position = last.real(0);
-    const double at = now();
     Statement insert(*statements_,
                      "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
                      "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    std::vector<JobId> ids;
-    for (size_t i = 0; i < jobs.size(); ++i) {
-      const NewJob& job = jobs[i];
+    JobRows rows;
+    rows.insert = [&](const NewJob& job, double position, double at) {
       insert.bind(1, stateName(JobState::Queued))
           .bind(2, kindName(job.kind))
           .bind(3, job.source)
           .bind(4, job.owner)
           .bind(5, job.device)
           .bind(6, static_cast<int64_t>(job.priority))
-          .bind(7, ++position)
+          .bind(7, position)
           .bind(8, job.options)
           .bind(9, job.spool)
           .bind(10, at)
           .bind(11, at);
       insert.step();
       insert.reset();
-      ids.push_back(sqlite3_last_insert_rowid(db_));
-      record(ids.back(), std::nullopt, JobState::Queued, at, reasons.at(i));
-      JobState state = JobState::Queued;
-      for (size_t step = 0; step < job.then.size(); ++step) {
-        const auto& reason = job.then[step].reason;
-        move(ids.back(), state, job.then[step].to, at, reason ? reason(ids.back()) : std::string());
-        state = job.then[step].to;
-      }
-      if (!job.then.empty()) apply(ids.back(), job.change);
-    }
+      return static_cast<JobId>(sqlite3_last_insert_rowid(db_));
+    };
+    rows.record = [&](JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+      record(id, from, to, at, reason);
+    };
+    rows.move = [&](JobId id, JobState from, JobState to, double at, std::string_view reason) {
+      move(id, from, to, at, reason);
+    };
+    rows.apply = [&](JobId id, const JobChange& change) { apply(id, change); };
+    const std::vector<JobId> ids = addJobRows(jobs, reasons, last.real(0), rows);
     transaction.commit();
     std::vector<JobRecord> added;
     for (JobId id : ids) added.push_back(*this->job(id));
@@ -355,7 +294,7 @@ class SqliteStore final : public JobStore {
     Transaction transaction(db_);
     const auto current = job(id);
     if (!current) throw TransitionRefused(fmt::format("there is no job {}", id));
-    move(id, current->state, to, now(), reason);
+    move(id, current->state, to, unixSeconds(), reason);
     apply(id, change);
     transaction.commit();
     return *job(id);
@@ -370,7 +309,7 @@ class SqliteStore final : public JobStore {
   void reorder(JobId id, int priority, double position) override {
     Transaction transaction(db_);
     Statement set(*statements_, "UPDATE jobs SET priority = ?, position = ?, updated = ? WHERE id = ?");
-    set.bind(1, static_cast<int64_t>(priority)).bind(2, position).bind(3, now()).bind(4, id);
+    set.bind(1, static_cast<int64_t>(priority)).bind(2, position).bind(3, unixSeconds()).bind(4, id);
     set.step();
     transaction.commit();
   }
@@ -399,7 +338,7 @@ class SqliteStore final : public JobStore {
     } else {
       insert.bindNull(1);
     }
-    insert.bind(2, now()).bind(3, kind).bind(4, text);
+    insert.bind(2, unixSeconds()).bind(3, kind).bind(4, text);
     insert.step();
   }
 
@@ -433,7 +372,13 @@ class SqliteStore final : public JobStore {
     Statement check(db_, "PRAGMA integrity_check");
     std::string result;
     while (check.step()) result += (result.empty() ? "" : "; ") + check.text(0);
-    return result;
+    if (result != "ok") return result;
+    result.clear();
+    for (const std::string& query : consistencyQueries()) {
+      Statement faults(db_, query.c_str());
+      while (faults.step()) result += (result.empty() ? "" : "; ") + faults.text(0);
+    }
+    return result.empty() ? "ok" : result;
   }
 
  private:
@@ -441,15 +386,16 @@ class SqliteStore final : public JobStore {
 
   void migrate(int upTo) {
     const int found = schemaVersion();
-    if (found > kNewest) {
+    if (found > newestSchemaVersion()) {
       throw StoreError(
           fmt::format("{}: the job store has schema version {}, made by a newer rotafabd (this one "
                       "knows up to {}); run that version, or give this one another state directory",
-                      file_.string(), found, kNewest));
+                      file_.string(), found, newestSchemaVersion()));
     }
     for (int version = found; version < upTo; ++version) {
       Transaction transaction(db_);
-      execute(db_, kMigrations[version], doing(fmt::format("migrate the schema to version {}", version + 1)).c_str());
+      execute(db_, migrationSql(version, StoreEngine::Sqlite).c_str(),
+              doing(fmt::format("migrate the schema to version {}", version + 1)).c_str());
       execute(db_, fmt::format("PRAGMA user_version = {}", version + 1).c_str(),
               doing("record the schema version").c_str());
       transaction.commit();
@@ -508,12 +454,8 @@ class SqliteStore final : public JobStore {
 
 }  // namespace
 
-std::string_view kindName(JobKind kind) { return kind == JobKind::Planned ? "planned" : "mesh"; }
-
 std::unique_ptr<JobStore> openSqliteStore(const std::filesystem::path& file, std::optional<int> upToVersion) {
   return std::make_unique<SqliteStore>(file, upToVersion);
 }
-
-int newestSchemaVersion() { return kNewest; }
 
 }  // namespace rotafab::service

@@ -16,6 +16,7 @@
 #include "daemon/DaemonSupport.h"
 #include "daemon/service/DaemonConfig.h"
 #include "daemon/service/JobStore.h"
+#include "support/TestDatabase.h"
 
 namespace rotafab::test {
 namespace {
@@ -38,6 +39,18 @@ const fs::path& threeSheets() {
 }
 
 std::string state(const json& job) { return job.is_object() ? job.value("state", "") : ""; }
+
+// Submits the three sheets, starts them once planned, and returns the job's
+// number once its cut has reached its third stroke (an empty id on failure).
+long long cuttingThreeSheets(Daemon& daemon) {
+  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
+  EXPECT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+  EXPECT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  const json cutting =
+      daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+  EXPECT_GE(cutting.value("/progress/stroke"_json_pointer, 0), 3) << cutting.dump();
+  return ::testing::Test::HasFailure() ? 0 : id;
+}
 
 TEST(Daemon, AMeshIsSubmittedPlannedStartedAndCutToItsEndThroughTheClient) {
   TempDir root;
@@ -210,12 +223,8 @@ TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
                                          "\"sim:grbl?speed=5&witness={}\"}}]\n",
                                          witness.string()));
   daemon.start();
-  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
-  ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
-  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
-  const json cutting =
-      daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
-  ASSERT_GE(cutting["progress"]["stroke"].get<int>(), 3) << cutting.dump();
+  const long long id = cuttingThreeSheets(daemon);
+  ASSERT_NE(id, 0);
   daemon.signal(SIGTERM);
   EXPECT_EQ(daemon.wait(30), 0) << readFile(daemon.log());
   // The simulated controller saw its laser lit, then off, and nothing after.
@@ -536,6 +545,36 @@ TEST(Daemon, OneDaemonPerStateDirectoryAndAConfigMistakeIsOneLine) {
       << readFile(daemon.log());
   // Still serving.
   EXPECT_EQ(daemon.get("/api").status, 200);
+}
+
+// `store: postgresql://...`: the same daemon on a PostgreSQL server. A job
+// is planned and cut, a kill mid-cut leaves it interrupted (resumed only by
+// an operator), and a second daemon on the store is refused in one line.
+TEST(Daemon, OnAPostgresStoreAKillMidCutLeavesTheJobInterruptedAndASecondDaemonIsRefused) {
+  test::TestDatabase database;
+  TempDir root, otherRoot;
+  const std::string config =
+      "store: " + database.uri() + "\ndevices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=5\"}]\n";
+  Daemon daemon(root.path(), config);
+  daemon.start();
+  const long long id = cuttingThreeSheets(daemon);
+  ASSERT_NE(id, 0);
+
+  Daemon second(otherRoot.path(), config);
+  EXPECT_EQ(second.runToEnd({"--config", (otherRoot.path() / "rotafabd.yaml").string()}), 1);
+  EXPECT_NE(readFile(second.log()).find(": another rotafabd uses this job store"), std::string::npos)
+      << readFile(second.log());
+
+  daemon.kill9();
+  daemon.start();
+  const json job = daemon.job(id);
+  EXPECT_EQ(state(job), "interrupted") << job.dump();
+  EXPECT_NE(job.value("message", "").find("the daemon stopped while it cut"), std::string::npos) << job.dump();
+  // The store agrees with itself: every job in one state, every transition recorded once.
+  EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
+  std::vector<std::string> states;
+  for (const json& t : job["transitions"]) states.push_back(t["to"]);
+  EXPECT_EQ(states, (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
 }
 
 TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {

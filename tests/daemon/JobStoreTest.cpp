@@ -1,12 +1,19 @@
-// The job store (daemon/service/JobStore.h) on a real SQLite file: the
-// table of transitions enforced and every move recorded, the queue's order,
-// what survives closing the file, and the schema migrated from its first
-// version up.
+// The job store (daemon/service/JobStore.h) on both engines, a real SQLite
+// file and a real PostgreSQL server: the table of transitions enforced and
+// every move recorded, the queue's order, what survives closing the store,
+// and the schema migrated from its first version up.
 
 #include <gtest/gtest.h>
 #include <sqlite3.h>
 
+#include <fmt/format.h>
+
+#include <memory>
+#include <set>
+#include <thread>
+
 #include "daemon/service/JobStore.h"
+#include "support/TestDatabase.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::service {
@@ -25,6 +32,44 @@ NewJob meshJob(const std::string& source, int priority = 0) {
   return job;
 }
 
+// Each test on each engine: a new, empty store, opened again as often as the test asks.
+class Stores : public ::testing::TestWithParam<StoreEngine> {
+ protected:
+  // The store made last (a new one with fresh()), opened; migrated up to `upTo`.
+  std::unique_ptr<JobStore> open(std::optional<int> upTo = std::nullopt) {
+    if (!made_) fresh();
+    if (GetParam() == StoreEngine::Sqlite) return openSqliteStore(file(), upTo);
+    return openPostgresStore(databases_.back()->uri(), upTo);
+  }
+  // A new store to open, with nothing in it.
+  void fresh() {
+    made_ = true;
+    ++count_;
+    if (GetParam() == StoreEngine::Postgres) databases_.push_back(std::make_unique<test::TestDatabase>());
+  }
+  [[nodiscard]] std::filesystem::path file() const {
+    return dir_.path() / ("jobs-" + std::to_string(count_) + ".sqlite3");
+  }
+  // SQL on the store made last, outside the store.
+  void sql(const std::string& statement);
+
+ private:
+  TempDir dir_;
+  std::vector<std::unique_ptr<test::TestDatabase>> databases_;
+  bool made_ = false;
+  int count_ = 0;
+};
+
+}  // namespace
+
+// How a test's name shows its engine (ctest's list: "... # GetParam() = Postgres").
+void PrintTo(StoreEngine engine, std::ostream* out) { *out << (engine == StoreEngine::Sqlite ? "Sqlite" : "Postgres"); }
+
+namespace {
+
+INSTANTIATE_TEST_SUITE_P(Engines, Stores, ::testing::Values(StoreEngine::Sqlite, StoreEngine::Postgres),
+                         [](const auto& info) { return info.param == StoreEngine::Sqlite ? "Sqlite" : "Postgres"; });
+
 void sql(const std::filesystem::path& file, const std::string& statement) {
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
@@ -34,9 +79,16 @@ void sql(const std::filesystem::path& file, const std::string& statement) {
   sqlite3_close(db);
 }
 
-TEST(JobStore, TheTableOfTransitionsIsEnforcedAndEveryMoveRecorded) {
-  TempDir dir;
-  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+void Stores::sql(const std::string& statement) {
+  if (GetParam() == StoreEngine::Sqlite) {
+    service::sql(file(), statement);
+  } else {
+    test::serverSql(statement, databases_.back()->uri());
+  }
+}
+
+TEST_P(Stores, TheTableOfTransitionsIsEnforcedAndEveryMoveRecorded) {
+  auto store = open();
   const JobRecord job = store->addJob(meshJob("cube.obj"), "submitted by alice");
   EXPECT_EQ(job.state, JobState::Queued);
   // A queued job cannot be cut before it is planned.
@@ -71,9 +123,8 @@ TEST(JobStore, TheTableOfTransitionsIsEnforcedAndEveryMoveRecorded) {
   EXPECT_THROW(store->transition(99, JobState::Planning, "x"), TransitionRefused);
 }
 
-TEST(JobStore, AJobsFirstStepsAreRecordedWithItsSubmissionOrNotAtAll) {
-  TempDir dir;
-  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+TEST_P(Stores, AJobsFirstStepsAreRecordedWithItsSubmissionOrNotAtAll) {
+  auto store = open();
   store->addJob(meshJob("first"), "submitted by alice");
   // A planned folder checked while it was submitted: queued, planning and ready in one commit.
   NewJob planned = meshJob("soccer");
@@ -127,9 +178,8 @@ TEST(JobStore, FinalStatesAreFinalAndOnlyRunningOrPausedJobsHoldADevice) {
   }
 }
 
-TEST(JobStore, TheQueueIsInPriorityThenSubmissionOrderAndCanBeReordered) {
-  TempDir dir;
-  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+TEST_P(Stores, TheQueueIsInPriorityThenSubmissionOrderAndCanBeReordered) {
+  auto store = open();
   const JobId a = store->addJob(meshJob("a"), "s").id;
   const JobId b = store->addJob(meshJob("b"), "s").id;
   const JobId c = store->addJob(meshJob("c", 5), "s").id;
@@ -156,9 +206,8 @@ TEST(JobStore, TheQueueIsInPriorityThenSubmissionOrderAndCanBeReordered) {
 // The store's statements are prepared once and kept: a visit that asks the
 // store again, even the same question, gets answers of its own; a new job
 // goes after the last one, wherever a reorder put it.
-TEST(JobStore, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
-  TempDir dir;
-  auto store = openSqliteStore(dir.path() / "jobs.sqlite3");
+TEST_P(Stores, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
+  auto store = open();
   const JobId a = store->addJob(meshJob("a"), "s").id;
   const JobId b = store->addJob(meshJob("b"), "s").id;
   std::vector<std::pair<JobId, JobId>> pairs;
@@ -170,10 +219,11 @@ TEST(JobStore, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
 
   store->reorder(a, 0, 100.0);
   const JobRecord c = store->addJob(meshJob("c"), "s");
-  // Found by an index, not by reading every job (schema version 4).
-  {
+  // Found by an index, not by reading every job (schema version 4). (Shown
+  // for SQLite; PostgreSQL's planner reads a table this small whole.)
+  if (GetParam() == StoreEngine::Sqlite) {
     sqlite3* db = nullptr;
-    ASSERT_EQ(sqlite3_open((dir.path() / "jobs.sqlite3").c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_open(file().c_str(), &db), SQLITE_OK);
     sqlite3_stmt* plan = nullptr;
     ASSERT_EQ(
         sqlite3_prepare_v2(db, "EXPLAIN QUERY PLAN SELECT COALESCE(MAX(position), 0) FROM jobs", -1, &plan, nullptr),
@@ -190,12 +240,10 @@ TEST(JobStore, AVisitMayQueryTheStoreAgainAndANewJobGoesLast) {
   EXPECT_EQ(order, (std::vector<JobId>{b, a, c.id}));
 }
 
-TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {
-  TempDir dir;
-  const auto file = dir.path() / "jobs.sqlite3";
+TEST_P(Stores, WhatWasWrittenIsThereAfterTheStoreIsOpenedAgain) {
   JobId id = 0;
   {
-    auto store = openSqliteStore(file);
+    auto store = open();
     id = store->addJob(meshJob("bunny.obj"), "submitted").id;
     store->transition(id, JobState::Planning, "planning");
     JobChange progress;
@@ -205,7 +253,7 @@ TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {
     store->update(id, progress);
     store->addEvent(id, "sheet", "sheet 2 of 3 started");
   }
-  auto store = openSqliteStore(file);
+  auto store = open();
   const auto job = store->job(id);
   ASSERT_TRUE(job);
   EXPECT_EQ(job->state, JobState::Planning);
@@ -215,9 +263,10 @@ TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {
   ASSERT_EQ(store->events(id, 10).size(), 1u);
   EXPECT_EQ(store->events(id, 10)[0].text, "sheet 2 of 3 started");
   EXPECT_EQ(store->integrityCheck(), "ok");
+  if (GetParam() == StoreEngine::Postgres) return;
   // WAL mode, synchronous FULL: what the issue asks of the store's durability.
   sqlite3* db = nullptr;
-  ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_open(file().c_str(), &db), SQLITE_OK);
   sqlite3_stmt* mode = nullptr;
   sqlite3_prepare_v2(db, "PRAGMA journal_mode", -1, &mode, nullptr);
   ASSERT_EQ(sqlite3_step(mode), SQLITE_ROW);
@@ -226,17 +275,34 @@ TEST(JobStore, WhatWasWrittenIsThereAfterTheFileIsOpenedAgain) {
   sqlite3_close(db);
 }
 
-TEST(JobStore, TheSchemaIsMigratedFromEachVersionUp) {
+// A store whose jobs and transitions disagree is found out, in words that name the job.
+TEST_P(Stores, TheIntegrityCheckFindsAJobWhoseHistoryDisagreesWithIt) {
+  auto store = open();
+  const JobId a = store->addJob(meshJob("a"), "s").id;
+  const JobId b = store->addJob(meshJob("b"), "s").id;
+  store->transition(b, JobState::Planning, "planning");
+  EXPECT_EQ(store->integrityCheck(), "ok");
+  sql(fmt::format("UPDATE jobs SET state = 'running' WHERE id = {}", a));
+  sql(
+      fmt::format("INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES ({}, NULL, 'queued', 0, "
+                  "'again')",
+                  b));
+  EXPECT_EQ(store->integrityCheck(), fmt::format("job {} is running but its last transition ended in queued; job {} is "
+                                                 "planning but its last transition ended in queued; job {} was "
+                                                 "submitted 2 times",
+                                                 a, b, b));
+}
+
+TEST_P(Stores, TheSchemaIsMigratedFromEachVersionUp) {
   for (int from = 0; from <= newestSchemaVersion(); ++from) {
-    TempDir dir;
-    const auto file = dir.path() / "jobs.sqlite3";
+    fresh();
     JobId id = 0;
     {
-      auto old = openSqliteStore(file, from);
+      auto old = open(from);
       EXPECT_EQ(old->schemaVersion(), from);
       if (from >= 1) id = old->addJob(meshJob("kept.obj"), "submitted before the migration").id;
     }
-    auto store = openSqliteStore(file);
+    auto store = open();
     EXPECT_EQ(store->schemaVersion(), newestSchemaVersion());
     EXPECT_EQ(store->integrityCheck(), "ok");
     if (id != 0) {
@@ -249,18 +315,21 @@ TEST(JobStore, TheSchemaIsMigratedFromEachVersionUp) {
   }
 }
 
-TEST(JobStore, AStoreOfANewerSchemaOrNotADatabaseIsRefusedInOneLine) {
-  TempDir dir;
-  const auto newer = dir.path() / "newer.sqlite3";
-  { openSqliteStore(newer); }
-  sql(newer, "PRAGMA user_version = 99");
+TEST_P(Stores, AStoreOfANewerSchemaIsRefusedInOneLine) {
+  { open(); }
+  sql(GetParam() == StoreEngine::Sqlite ? "PRAGMA user_version = 99" : "UPDATE rotafab_schema SET version = 99");
   try {
-    openSqliteStore(newer);
+    open();
     FAIL();
   } catch (const StoreError& error) {
     EXPECT_NE(std::string(error.what()).find("schema version 99, made by a newer rotafabd"), std::string::npos)
         << error.what();
+    EXPECT_EQ(std::string(error.what()).find('\n'), std::string::npos) << error.what();
   }
+}
+
+TEST(JobStore, AFileThatIsNotADatabaseIsRefusedInOneLine) {
+  TempDir dir;
   const auto garbage = dir.write("garbage.sqlite3", std::string(4096, 'x'));
   try {
     openSqliteStore(garbage);
@@ -268,6 +337,75 @@ TEST(JobStore, AStoreOfANewerSchemaOrNotADatabaseIsRefusedInOneLine) {
   } catch (const StoreError& error) {
     EXPECT_NE(std::string(error.what()).find("not a sound SQLite database"), std::string::npos) << error.what();
   }
+}
+
+// A server that is not there, or a database that is not: one line naming
+// the store, and never its password.
+TEST(JobStore, APostgresStoreThatCannotBeReachedIsOneLineWithoutItsPassword) {
+  const std::string server = test::testServerUri();
+  const std::string port = server.substr(server.rfind(':') + 1, server.rfind('/') - server.rfind(':') - 1);
+  for (const std::string& uri : {std::string("postgresql://rotafab:s3cret@127.0.0.1:1/jobs"),
+                                 "postgresql://rotafab:s3cret@127.0.0.1:" + port + "/no_such_database"}) {
+    SCOPED_TRACE(uri);
+    try {
+      openPostgresStore(uri);
+      FAIL();
+    } catch (const StoreError& error) {
+      const std::string what = error.what();
+      EXPECT_TRUE(what.starts_with(uriWithoutPassword(uri) + ": cannot reach the job store: ")) << what;
+      EXPECT_EQ(what.find("s3cret"), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  }
+  EXPECT_EQ(uriWithoutPassword("postgresql://ann:pw@db:5432/jobs"), "postgresql://ann:***@db:5432/jobs");
+  EXPECT_EQ(uriWithoutPassword("postgresql://ann@db:5432/jobs"), "postgresql://ann@db:5432/jobs");
+}
+
+// Until the hosts that share a store claim their work from it, a second
+// daemon on a store is refused, and the store is free again once the first
+// has gone.
+TEST(JobStore, APostgresStoreOpenedForADaemonIsThatDaemonsAlone) {
+  test::TestDatabase database;
+  {
+    auto first = openPostgresStore(database.uri(), std::nullopt, true);
+    try {
+      openPostgresStore(database.uri(), std::nullopt, true);
+      FAIL();
+    } catch (const StoreError& error) {
+      EXPECT_NE(std::string(error.what()).find("another rotafabd uses this job store"), std::string::npos)
+          << error.what();
+    }
+    auto reader = openPostgresStore(database.uri());  // a reader (a test, a check) is not a daemon
+    EXPECT_EQ(reader->integrityCheck(), "ok");
+  }
+  EXPECT_NO_THROW(openPostgresStore(database.uri(), std::nullopt, true));
+}
+
+// Several connections adding jobs at once (as several hosts will): each job
+// once, each at a place of its own at the end of the queue.
+TEST(JobStore, JobsAddedThroughSeveralConnectionsAtOnceEachGetAPlaceOfTheirOwn) {
+  test::TestDatabase database;
+  { openPostgresStore(database.uri()); }
+  std::vector<std::thread> hosts;
+  for (int host = 0; host < 4; ++host) {
+    hosts.emplace_back([&, host] {
+      auto store = openPostgresStore(database.uri());
+      for (int i = 0; i < 25; ++i) store->addJob(meshJob(fmt::format("h{}-{}", host, i)), "s");
+    });
+  }
+  for (std::thread& host : hosts) host.join();
+  auto store = openPostgresStore(database.uri());
+  const auto all = store->jobs();
+  ASSERT_EQ(all.size(), 100u);
+  std::set<double> positions;
+  std::set<std::string> sources;
+  for (const JobRecord& job : all) {
+    positions.insert(job.position);
+    sources.insert(job.source);
+  }
+  EXPECT_EQ(positions.size(), 100u);
+  EXPECT_EQ(sources.size(), 100u);
+  EXPECT_EQ(store->integrityCheck(), "ok");
 }
 
 }  // namespace

@@ -1,0 +1,430 @@
+// The job store on PostgreSQL (JobStore.h), through libpq: a store several
+// daemons share. Each call is one transaction at READ COMMITTED; a
+// transition reads its job's row FOR UPDATE, so two hosts moving one job are
+// serialized by the row's lock and the second sees what the first wrote. The
+// end of the queue is read and extended under a transaction-scoped advisory
+// lock, so jobs submitted through two hosts at once get distinct places. The
+// server commits synchronously (its default), so a call that returned
+// survives a kill of this process and of the server. The schema is the
+// SQLite store's (StoreSchema.h), its version in a one-row table.
+
+#include <fmt/format.h>
+#include <libpq-fe.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "daemon/service/JobStore.h"
+#include "daemon/service/StoreSchema.h"
+
+namespace rotafab::service {
+namespace {
+
+// Advisory lock keys, arbitrary but fixed: for migrations, the end of the queue, and the daemon's.
+constexpr const char* kMigrationLock = "SELECT pg_advisory_xact_lock(7208301)";
+constexpr const char* kQueueEndLock = "SELECT pg_advisory_xact_lock(7208302)";
+constexpr const char* kDaemonLock = "SELECT pg_try_advisory_lock(7208303)";
+
+// libpq's messages end in a newline and may run to several lines: the first, trimmed.
+std::string firstLine(const char* message) {
+  std::string text = message ? message : "";
+  if (const size_t end = text.find('\n'); end != std::string::npos) text.resize(end);
+  while (!text.empty() && (text.back() == ' ' || text.back() == '\r')) text.pop_back();
+  if (text.starts_with("ERROR:  ")) text.erase(0, 8);
+  return text.empty() ? "the server gave no reason" : text;
+}
+
+// A parameter: text, or SQL NULL.
+using Parameter = std::optional<std::string>;
+
+class Result {
+ public:
+  explicit Result(PGresult* result) : result_(result) {}
+  ~Result() { PQclear(result_); }
+  Result(Result&& other) noexcept : result_(std::exchange(other.result_, nullptr)) {}
+  Result(const Result&) = delete;
+  Result& operator=(const Result&) = delete;
+
+  [[nodiscard]] int rows() const { return PQntuples(result_); }
+  [[nodiscard]] bool isNull(int row, int column) const { return PQgetisnull(result_, row, column) != 0; }
+  [[nodiscard]] std::string text(int row, int column) const {
+    return std::string(PQgetvalue(result_, row, column), static_cast<size_t>(PQgetlength(result_, row, column)));
+  }
+  [[nodiscard]] int64_t integer(int row, int column) const {
+    return std::strtoll(PQgetvalue(result_, row, column), nullptr, 10);
+  }
+  [[nodiscard]] double real(int row, int column) const {
+    return std::strtod(PQgetvalue(result_, row, column), nullptr);
+  }
+  [[nodiscard]] const PGresult* raw() const { return result_; }
+
+ private:
+  PGresult* result_;
+};
+
+class PostgresStore final : public JobStore {
+ public:
+  PostgresStore(const std::string& uri, std::optional<int> upTo, bool exclusive) : shown_(uriWithoutPassword(uri)) {
+    // libpq takes a URI or key=value words; only the URI form is the config's.
+    connection_ = PQconnectdb(uri.c_str());
+    if (!connection_ || PQstatus(connection_) != CONNECTION_OK) {
+      const std::string why = connection_ ? firstLine(PQerrorMessage(connection_)) : "out of memory";
+      PQfinish(connection_);
+      throw StoreError(fmt::format("{}: cannot reach the job store: {}", shown_, why));
+    }
+    try {
+      // Notices (a table that exists already) are not ours to print.
+      PQsetNoticeProcessor(
+          connection_, [](void*, const char*) {}, nullptr);
+      execute("SET client_min_messages = warning");
+      execute("SET synchronous_commit = on");
+      migrate(upTo.value_or(newestSchemaVersion()));
+      // A lock of the session's, let go when the connection ends (a killed
+      // daemon's too, once its server process has seen the connection close:
+      // a few seconds are allowed for that).
+      const auto tryLock = [&] { return query(kDaemonLock).text(0, 0) == "t"; };
+      bool locked = !exclusive || tryLock();
+      for (int attempt = 0; !locked && attempt < 30; ++attempt) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        locked = tryLock();
+      }
+      if (!locked) {
+        throw StoreError(
+            fmt::format("{}: another rotafabd uses this job store; one store shared by several "
+                        "daemons is not supported yet: give each its own database",
+                        shown_));
+      }
+    } catch (...) {
+      PQfinish(connection_);
+      throw;
+    }
+  }
+  ~PostgresStore() override { PQfinish(connection_); }
+  PostgresStore(const PostgresStore&) = delete;
+  PostgresStore& operator=(const PostgresStore&) = delete;
+
+  JobRecord addJob(const NewJob& job, std::string_view reason) override {
+    return addJobs({job}, {std::string(reason)}).front();
+  }
+
+  std::vector<JobRecord> addJobs(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons) override {
+    checkFirstSteps(jobs);
+    Transaction transaction(*this);
+    execute(kQueueEndLock);
+    const double last = query("SELECT COALESCE(MAX(position), 0) FROM jobs").real(0, 0);
+    JobRows rows;
+    rows.insert = [&](const NewJob& job, double position, double at) {
+      return query(
+                 "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                 "submitted, updated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) RETURNING id",
+                 {std::string(stateName(JobState::Queued)), std::string(kindName(job.kind)), job.source, job.owner,
+                  job.device, std::to_string(job.priority), number(position), job.options, job.spool, number(at),
+                  number(at)})
+          .integer(0, 0);
+    };
+    rows.record = [&](JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+      record(id, from, to, at, reason);
+    };
+    rows.move = [&](JobId id, JobState from, JobState to, double at, std::string_view reason) {
+      move(id, from, to, at, reason);
+    };
+    rows.apply = [&](JobId id, const JobChange& change) { apply(id, change); };
+    const std::vector<JobId> ids = addJobRows(jobs, reasons, last, rows);
+    transaction.commit();
+    std::vector<JobRecord> added;
+    for (JobId id : ids) added.push_back(*this->job(id));
+    return added;
+  }
+
+  std::optional<JobRecord> job(JobId id) override {
+    const Result found = query(fmt::format("SELECT {} FROM jobs WHERE id = $1", kJobColumns), {std::to_string(id)});
+    if (found.rows() == 0) return std::nullopt;
+    return jobOf(found, 0);
+  }
+
+  std::vector<JobRecord> jobs() override {
+    std::vector<JobRecord> all;
+    eachJob([&](const JobRecord& job) { all.push_back(job); });
+    return all;
+  }
+
+  void eachJob(const std::function<void(const JobRecord&)>& visit) override {
+    // A page at a time, by keyset, so that a long queue is never all in memory.
+    constexpr int kPage = 500;
+    std::optional<std::pair<int, std::pair<double, JobId>>> after;
+    for (;;) {
+      const Result page =
+          after
+              ? query(
+                    fmt::format(
+                        "SELECT {} FROM jobs WHERE (-priority, position, id) > ($1::BIGINT, $2::DOUBLE PRECISION, "
+                        "$3::BIGINT) ORDER BY "
+                        "-priority, position, id LIMIT {}",
+                        kJobColumns, kPage),
+                    {std::to_string(-after->first), number(after->second.first), std::to_string(after->second.second)})
+              : query(fmt::format("SELECT {} FROM jobs ORDER BY -priority, position, id LIMIT {}", kJobColumns, kPage));
+      for (int row = 0; row < page.rows(); ++row) {
+        const JobRecord job = jobOf(page, row);
+        after = {job.priority, {job.position, job.id}};
+        visit(job);
+      }
+      if (page.rows() < kPage) return;
+    }
+  }
+
+  std::vector<JobRecord> jobsIn(const std::vector<JobState>& states, size_t limit, const std::string& device) override {
+    std::vector<Parameter> parameters;
+    std::string marks;
+    for (JobState state : states) {
+      parameters.emplace_back(std::string(stateName(state)));
+      marks += fmt::format("{}${}", marks.empty() ? "" : ", ", parameters.size());
+    }
+    std::string where = fmt::format("state IN ({})", marks.empty() ? "NULL" : marks);
+    if (!device.empty()) {
+      parameters.emplace_back(device);
+      where += fmt::format(" AND device = ${}", parameters.size());
+    }
+    parameters.emplace_back(std::to_string(std::min<size_t>(limit, INT64_MAX)));
+    const Result found = query(fmt::format("SELECT {} FROM jobs WHERE {} ORDER BY priority DESC, position LIMIT ${}",
+                                           kJobColumns, where, parameters.size()),
+                               parameters);
+    std::vector<JobRecord> all;
+    for (int row = 0; row < found.rows(); ++row) all.push_back(jobOf(found, row));
+    return all;
+  }
+
+  JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change) override {
+    Transaction transaction(*this);
+    const Result current = query("SELECT state FROM jobs WHERE id = $1 FOR UPDATE", {std::to_string(id)});
+    if (current.rows() == 0) throw TransitionRefused(fmt::format("there is no job {}", id));
+    move(id, stateNamed(current.text(0, 0)).value_or(JobState::Failed), to, unixSeconds(), reason);
+    apply(id, change);
+    transaction.commit();
+    return *job(id);
+  }
+
+  void update(JobId id, const JobChange& change) override {
+    Transaction transaction(*this);
+    apply(id, change);
+    transaction.commit();
+  }
+
+  void reorder(JobId id, int priority, double position) override {
+    query("UPDATE jobs SET priority = $1, position = $2, updated = $3 WHERE id = $4",
+          {std::to_string(priority), number(position), number(unixSeconds()), std::to_string(id)});
+  }
+
+  std::vector<Transition> transitions(JobId id) override {
+    const Result found =
+        query("SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = $1 ORDER BY id",
+              {std::to_string(id)});
+    std::vector<Transition> all;
+    for (int row = 0; row < found.rows(); ++row) {
+      Transition t;
+      t.job = found.integer(row, 0);
+      if (!found.isNull(row, 1)) t.from = stateNamed(found.text(row, 1));
+      t.to = stateNamed(found.text(row, 2)).value_or(JobState::Failed);
+      t.at = found.real(row, 3);
+      t.reason = found.text(row, 4);
+      all.push_back(std::move(t));
+    }
+    return all;
+  }
+
+  void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) override {
+    query("INSERT INTO events (job, at, kind, text) VALUES ($1, $2, $3, $4)",
+          {job ? Parameter(std::to_string(*job)) : std::nullopt, number(unixSeconds()), std::string(kind),
+           std::string(text)});
+  }
+
+  std::vector<Event> events(std::optional<JobId> job, size_t newest) override {
+    const Result found =
+        job ? query("SELECT id, job, at, kind, text FROM events WHERE job = $1 ORDER BY id DESC LIMIT $2",
+                    {std::to_string(*job), std::to_string(newest)})
+            : query("SELECT id, job, at, kind, text FROM events ORDER BY id DESC LIMIT $1", {std::to_string(newest)});
+    std::vector<Event> all;
+    for (int row = found.rows() - 1; row >= 0; --row) {
+      Event e;
+      e.id = found.integer(row, 0);
+      if (!found.isNull(row, 1)) e.job = found.integer(row, 1);
+      e.at = found.real(row, 2);
+      e.kind = found.text(row, 3);
+      e.text = found.text(row, 4);
+      all.push_back(std::move(e));
+    }
+    return all;
+  }
+
+  int schemaVersion() override {
+    const Result version = query("SELECT version FROM rotafab_schema");
+    return version.rows() == 0 ? 0 : static_cast<int>(version.integer(0, 0));
+  }
+
+  std::string integrityCheck() override {
+    std::string faults;
+    for (const std::string& check : consistencyQueries()) {
+      const Result found = query(check);
+      for (int row = 0; row < found.rows(); ++row) faults += (faults.empty() ? "" : "; ") + found.text(row, 0);
+    }
+    return faults.empty() ? "ok" : faults;
+  }
+
+ private:
+  static constexpr const char* kJobColumns =
+      "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
+      "summary, sheet, stroke, strokes, message";
+
+  // BEGIN ... COMMIT, rolled back unless committed.
+  class Transaction {
+   public:
+    explicit Transaction(PostgresStore& store) : store_(store) { store_.execute("BEGIN"); }
+    ~Transaction() {
+      if (!committed_) PQclear(PQexec(store_.connection_, "ROLLBACK"));
+    }
+    Transaction(const Transaction&) = delete;
+    Transaction& operator=(const Transaction&) = delete;
+    void commit() {
+      store_.execute("COMMIT");
+      committed_ = true;
+    }
+
+   private:
+    PostgresStore& store_;
+    bool committed_ = false;
+  };
+
+  // A double as text that reads back to the same double.
+  static std::string number(double value) { return fmt::format("{}", value); }
+
+  static JobRecord jobOf(const Result& row, int i) {
+    JobRecord job;
+    job.id = row.integer(i, 0);
+    job.state = stateNamed(row.text(i, 1)).value_or(JobState::Failed);
+    job.kind = row.text(i, 2) == "planned" ? JobKind::Planned : JobKind::Mesh;
+    job.source = row.text(i, 3);
+    job.owner = row.text(i, 4);
+    job.device = row.text(i, 5);
+    job.priority = static_cast<int>(row.integer(i, 6));
+    job.position = row.real(i, 7);
+    job.options = row.text(i, 8);
+    job.spool = row.text(i, 9);
+    job.submitted = row.real(i, 10);
+    job.updated = row.real(i, 11);
+    job.sheets = static_cast<int>(row.integer(i, 12));
+    job.summary = row.text(i, 13);
+    job.sheet = static_cast<int>(row.integer(i, 14));
+    job.stroke = row.integer(i, 15);
+    job.strokes = row.integer(i, 16);
+    job.message = row.text(i, 17);
+    return job;
+  }
+
+  // One statement with its parameters; StoreError in one line when the server refuses it.
+  Result query(const std::string& sql, const std::vector<Parameter>& parameters = {}) {
+    std::vector<const char*> values;
+    for (const Parameter& p : parameters) values.push_back(p ? p->c_str() : nullptr);
+    Result result(PQexecParams(connection_, sql.c_str(), static_cast<int>(values.size()), nullptr, values.data(),
+                               nullptr, nullptr, 0));
+    check(result);
+    return result;
+  }
+
+  // Statements without parameters (several, separated by semicolons, as a migration is).
+  void execute(const std::string& sql) {
+    Result result(PQexec(connection_, sql.c_str()));
+    check(result);
+  }
+
+  void check(const Result& result) const {
+    const PGresult* raw = result.raw();
+    const ExecStatusType status = raw ? PQresultStatus(raw) : PGRES_FATAL_ERROR;
+    if (status == PGRES_COMMAND_OK || status == PGRES_TUPLES_OK) return;
+    if (PQstatus(connection_) != CONNECTION_OK) {
+      throw StoreError(fmt::format("{}: the connection to the job store was lost: {}", shown_,
+                                   firstLine(PQerrorMessage(connection_))));
+    }
+    const char* state = raw ? PQresultErrorField(raw, PG_DIAG_SQLSTATE) : nullptr;
+    const std::string code = state ? state : "";
+    if (code == "53100") throw StoreError(fmt::format("{}: the disk that holds the job store is full", shown_));
+    throw StoreError(fmt::format("{}: the job store: {}", shown_,
+                                 firstLine(raw ? PQresultErrorMessage(raw) : PQerrorMessage(connection_))));
+  }
+
+  void migrate(int upTo) {
+    // Two daemons starting together on one store: one migrates, the other
+    // waits for it and finds the schema new.
+    Transaction transaction(*this);
+    execute(kMigrationLock);
+    execute("CREATE TABLE IF NOT EXISTS rotafab_schema (version INTEGER NOT NULL)");
+    if (query("SELECT version FROM rotafab_schema").rows() == 0) execute("INSERT INTO rotafab_schema VALUES (0)");
+    const int found = schemaVersion();
+    if (found > newestSchemaVersion()) {
+      throw StoreError(
+          fmt::format("{}: the job store has schema version {}, made by a newer rotafabd (this one "
+                      "knows up to {}); run that version on every host",
+                      shown_, found, newestSchemaVersion()));
+    }
+    for (int version = found; version < upTo; ++version) {
+      execute(migrationSql(version, StoreEngine::Postgres));
+      query("UPDATE rotafab_schema SET version = $1", {std::to_string(version + 1)});
+    }
+    transaction.commit();
+  }
+
+  void apply(JobId id, const JobChange& change) {
+    const auto set = [&](const char* column, const Parameter& value) {
+      if (value) query(fmt::format("UPDATE jobs SET {} = $1 WHERE id = $2", column), {value, std::to_string(id)});
+    };
+    const auto numberOf = [](const auto& value) -> Parameter {
+      return value ? Parameter(std::to_string(*value)) : std::nullopt;
+    };
+    set("device", change.device);
+    set("summary", change.summary);
+    set("sheets", numberOf(change.sheets));
+    set("sheet", numberOf(change.sheet));
+    set("stroke", numberOf(change.stroke));
+    set("strokes", numberOf(change.strokes));
+  }
+
+  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) {
+    if (!allowedTransition(from, to)) {
+      throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
+    }
+    query("UPDATE jobs SET state = $1, message = $2, updated = $3 WHERE id = $4",
+          {std::string(stateName(to)), std::string(reason), number(at), std::to_string(id)});
+    record(id, from, to, at, reason);
+  }
+
+  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+    query("INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES ($1, $2, $3, $4, $5)",
+          {std::to_string(id), from ? Parameter(std::string(stateName(*from))) : std::nullopt,
+           std::string(stateName(to)), number(at), std::string(reason)});
+  }
+
+  std::string shown_;
+  PGconn* connection_ = nullptr;
+};
+
+}  // namespace
+
+std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion, bool exclusive) {
+  return std::make_unique<PostgresStore>(uri, upToVersion, exclusive);
+}
+
+std::string uriWithoutPassword(const std::string& uri) {
+  // postgresql://USER:PASSWORD@HOST...: the password is between the first ':' after the scheme and the '@'.
+  const size_t scheme = uri.find("://");
+  if (scheme == std::string::npos) return uri;
+  const size_t at = uri.find('@', scheme + 3);
+  if (at == std::string::npos) return uri;
+  const size_t colon = uri.find(':', scheme + 3);
+  if (colon == std::string::npos || colon > at) return uri;
+  return uri.substr(0, colon + 1) + "***" + uri.substr(at);
+}
+
+}  // namespace rotafab::service
