@@ -136,7 +136,8 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "rotafabd 0.1.0");
   std::string configFile, token;
   app.add_option("--config", configFile,
-                 "YAML configuration: state_dir, listen, devices, tokens (SPEC \"Daemon\"; every key optional)")
+                 "YAML configuration: state_dir, store (sqlite, or postgresql://USER@HOST:PORT/DB), listen, devices, "
+                 "tokens (SPEC \"Daemon\"; every key optional)")
       ->check(CLI::ExistingFile);
   app.add_option("--hash-token", token, "Print the salted hash of TOKEN for the configuration's tokens, and exit");
   app.footer(
