@@ -47,6 +47,13 @@ class Result {
   explicit Result(PGresult* result) : result_(result) {}
   ~Result() { PQclear(result_); }
   Result(Result&& other) noexcept : result_(std::exchange(other.result_, nullptr)) {}
+  Result& operator=(Result&& other) noexcept {
+    if (this != &other) {
+      PQclear(result_);
+      result_ = std::exchange(other.result_, nullptr);
+    }
+    return *this;
+  }
   Result(const Result&) = delete;
   Result& operator=(const Result&) = delete;
 
@@ -78,27 +85,10 @@ class PostgresStore final : public JobStore {
       throw StoreError(fmt::format("{}: cannot reach the job store: {}", shown_, why));
     }
     try {
-      // Notices (a table that exists already) are not ours to print.
-      PQsetNoticeProcessor(
-          connection_, [](void*, const char*) {}, nullptr);
-      execute("SET client_min_messages = warning");
-      execute("SET synchronous_commit = on");
+      startSession();
       migrate(upTo.value_or(newestSchemaVersion()));
-      // A lock of the session's, let go when the connection ends (a killed
-      // daemon's too, once its server process has seen the connection close:
-      // a few seconds are allowed for that).
-      const auto tryLock = [&] { return query(kDaemonLock).text(0, 0) == "t"; };
-      bool locked = !exclusive || tryLock();
-      for (int attempt = 0; !locked && attempt < 30; ++attempt) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        locked = tryLock();
-      }
-      if (!locked) {
-        throw StoreError(
-            fmt::format("{}: another rotafabd uses this job store; one store shared by several "
-                        "daemons is not supported yet: give each its own database",
-                        shown_));
-      }
+      exclusive_ = exclusive;
+      if (exclusive_) holdTheStore();
     } catch (...) {
       PQfinish(connection_);
       throw;
@@ -279,11 +269,16 @@ class PostgresStore final : public JobStore {
       "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
       "summary, sheet, stroke, strokes, message";
 
-  // BEGIN ... COMMIT, rolled back unless committed.
+  // BEGIN ... COMMIT, rolled back unless committed. (Its BEGIN may connect
+  // again; nothing within it does: a transaction cut off is lost whole.)
   class Transaction {
    public:
-    explicit Transaction(PostgresStore& store) : store_(store) { store_.execute("BEGIN"); }
+    explicit Transaction(PostgresStore& store) : store_(store) {
+      store_.execute("BEGIN");
+      store_.inTransaction_ = true;
+    }
     ~Transaction() {
+      store_.inTransaction_ = false;
       if (!committed_) PQclear(PQexec(store_.connection_, "ROLLBACK"));
     }
     Transaction(const Transaction&) = delete;
@@ -291,6 +286,7 @@ class PostgresStore final : public JobStore {
     void commit() {
       store_.execute("COMMIT");
       committed_ = true;
+      store_.inTransaction_ = false;
     }
 
    private:
@@ -328,8 +324,12 @@ class PostgresStore final : public JobStore {
   Result query(const std::string& sql, const std::vector<Parameter>& parameters = {}) {
     std::vector<const char*> values;
     for (const Parameter& p : parameters) values.push_back(p ? p->c_str() : nullptr);
-    Result result(PQexecParams(connection_, sql.c_str(), static_cast<int>(values.size()), nullptr, values.data(),
-                               nullptr, nullptr, 0));
+    const auto run = [&] {
+      return Result(PQexecParams(connection_, sql.c_str(), static_cast<int>(values.size()), nullptr, values.data(),
+                                 nullptr, nullptr, 0));
+    };
+    Result result = run();
+    if (connectedAgain(result)) result = run();
     check(result);
     return result;
   }
@@ -337,7 +337,59 @@ class PostgresStore final : public JobStore {
   // Statements without parameters (several, separated by semicolons, as a migration is).
   void execute(const std::string& sql) {
     Result result(PQexec(connection_, sql.c_str()));
+    if (connectedAgain(result)) result = Result(PQexec(connection_, sql.c_str()));
     check(result);
+  }
+
+  // The session's settings, as every connection starts.
+  void startSession() {
+    // Notices (a table that exists already) are not ours to print.
+    PQsetNoticeProcessor(
+        connection_, [](void*, const char*) {}, nullptr);
+    execute("SET client_min_messages = warning");
+    execute("SET synchronous_commit = on");
+  }
+
+  // The store held for this daemon by a lock of the session's, let go when
+  // the connection ends (a killed daemon's too, once its server process has
+  // seen the connection close: a few seconds are allowed for that).
+  void holdTheStore() {
+    const auto tryLock = [&] { return query(kDaemonLock).text(0, 0) == "t"; };
+    bool locked = tryLock();
+    for (int attempt = 0; !locked && attempt < 30; ++attempt) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      locked = tryLock();
+    }
+    if (!locked) {
+      throw StoreError(
+          fmt::format("{}: another rotafabd uses this job store; one store shared by several "
+                      "daemons is not supported yet: give each its own database",
+                      shown_));
+    }
+  }
+
+  // When a statement outside a transaction failed because the connection
+  // was lost (the server restarted, an administrator ended it), connects
+  // again once, as the store was opened; true when the statement can be
+  // sent again. (Sent again, a statement the server had run before the
+  // connection dropped runs twice: only single statements are, an event
+  // or a reorder, never a transaction.)
+  bool connectedAgain(const Result& failed) {
+    if (inTransaction_ || reconnecting_ || PQstatus(connection_) == CONNECTION_OK) return false;
+    const PGresult* raw = failed.raw();
+    if (raw && (PQresultStatus(raw) == PGRES_COMMAND_OK || PQresultStatus(raw) == PGRES_TUPLES_OK)) return false;
+    PQreset(connection_);
+    if (PQstatus(connection_) != CONNECTION_OK) return false;
+    reconnecting_ = true;
+    try {
+      startSession();
+      if (exclusive_) holdTheStore();
+    } catch (...) {
+      reconnecting_ = false;
+      throw;
+    }
+    reconnecting_ = false;
+    return true;
   }
 
   void check(const Result& result) const {
@@ -408,6 +460,7 @@ class PostgresStore final : public JobStore {
 
   std::string shown_;
   PGconn* connection_ = nullptr;
+  bool exclusive_ = false, inTransaction_ = false, reconnecting_ = false;
 };
 
 }  // namespace

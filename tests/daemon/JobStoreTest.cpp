@@ -381,6 +381,25 @@ TEST(JobStore, APostgresStoreOpenedForADaemonIsThatDaemonsAlone) {
   EXPECT_NO_THROW(openPostgresStore(database.uri(), std::nullopt, true));
 }
 
+// The server ended the store's connection (a restart, an administrator):
+// the store connects again at its next call, as it was opened, holding the
+// store for its daemon again.
+TEST(JobStore, APostgresStoreWhoseConnectionWasEndedConnectsAgain) {
+  test::TestDatabase database;
+  auto store = openPostgresStore(database.uri(), std::nullopt, true);
+  const JobId id = store->addJob(meshJob("a"), "s").id;
+  const auto endItsConnections = [&] {
+    test::serverSql("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = '" + database.name() +
+                    "' AND pid <> pg_backend_pid()");
+  };
+  endItsConnections();
+  EXPECT_EQ(store->job(id)->source, "a");
+  endItsConnections();
+  EXPECT_EQ(store->addJob(meshJob("b"), "s").id, id + 1);  // a transaction's BEGIN connects again too
+  EXPECT_THROW(openPostgresStore(database.uri(), std::nullopt, true), StoreError);
+  EXPECT_EQ(store->integrityCheck(), "ok");
+}
+
 // Several connections adding jobs at once (as several hosts will): each job
 // once, each at a place of its own at the end of the queue.
 TEST(JobStore, JobsAddedThroughSeveralConnectionsAtOnceEachGetAPlaceOfTheirOwn) {
