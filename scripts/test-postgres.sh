@@ -14,7 +14,7 @@ dir=$(realpath -m "${2:-}")
 bin=$(pg_config --bindir 2>/dev/null || true)
 [[ -x $bin/pg_ctl ]] || bin=/usr/lib/postgresql/15/bin
 if [[ ! -x $bin/pg_ctl ]]; then
-  echo "test-postgres: no PostgreSQL server ($bin/pg_ctl); scripts/setup.sh installs postgresql" >&2
+  echo "test-postgres: no PostgreSQL server ($bin/pg_ctl); scripts/setup.sh installs it (postgresql-15)" >&2
   exit 1
 fi
 

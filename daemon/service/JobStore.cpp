@@ -26,12 +26,12 @@ void checkFirstSteps(const std::vector<NewJob>& jobs) {
 }
 
 std::vector<JobId> addJobRows(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons,
-                              double lastPosition, const JobRows& rows) {
+                              double lastPosition, JobRows& rows) {
   const double at = unixSeconds();
   std::vector<JobId> ids;
   for (size_t i = 0; i < jobs.size(); ++i) {
     const NewJob& job = jobs[i];
-    const JobId id = rows.insert(job, lastPosition + static_cast<double>(i + 1), at);
+    const JobId id = rows.insertRow(job, lastPosition + static_cast<double>(i + 1), at);
     ids.push_back(id);
     rows.record(id, std::nullopt, JobState::Queued, at, reasons.at(i));
     JobState state = JobState::Queued;

@@ -4,8 +4,8 @@
 // own so that another engine can stand behind it: SQLite (SqliteStore.cpp)
 // or PostgreSQL (PostgresStore.cpp), a store several hosts share. Every call
 // is one transaction: when it returns, what it wrote survives a kill of the
-// process and a loss of power (the engine syncs before it returns). Calls come from one thread
-// at a time (the daemon's state strand).
+// process and a loss of power (the engine syncs before it returns). Calls
+// come from one thread at a time (the daemon's state strand).
 
 #include <cstdint>
 #include <filesystem>
@@ -99,17 +99,25 @@ class StoreError : public std::runtime_error {
 // first steps are allowed (TransitionRefused naming the job's source).
 double unixSeconds();
 void checkFirstSteps(const std::vector<NewJob>& jobs);
-// What an engine's store writes, in its own SQL, within the caller's transaction.
-struct JobRows {
-  std::function<JobId(const NewJob& job, double position, double at)> insert;  // the new job's number
-  std::function<void(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason)> record;
-  std::function<void(JobId id, JobState from, JobState to, double at, std::string_view reason)> move;
-  std::function<void(JobId id, const JobChange& change)> apply;
+// What an engine's store writes, in its own SQL, within the caller's
+// transaction; each store is one (addJobRows takes the steps they share).
+class JobRows {
+ public:
+  // The new job's row, queued; its number.
+  virtual JobId insertRow(const NewJob& job, double position, double at) = 0;
+  // A transition's record alone.
+  virtual void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) = 0;
+  // The job's state and message, and the transition's record (TransitionRefused if the table refuses it).
+  virtual void move(JobId id, JobState from, JobState to, double at, std::string_view reason) = 0;
+  virtual void apply(JobId id, const JobChange& change) = 0;
+
+ protected:
+  ~JobRows() = default;
 };
 // New jobs after the one at `lastPosition`: each inserted, its submission
 // recorded, then its first steps and its change; their numbers, in order.
 std::vector<JobId> addJobRows(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons,
-                              double lastPosition, const JobRows& rows);
+                              double lastPosition, JobRows& rows);
 
 class JobStore {
  public:

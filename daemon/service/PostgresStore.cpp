@@ -74,7 +74,7 @@ class Result {
   PGresult* result_;
 };
 
-class PostgresStore final : public JobStore {
+class PostgresStore final : public JobStore, private JobRows {
  public:
   PostgresStore(const std::string& uri, std::optional<int> upTo, bool exclusive) : shown_(uriWithoutPassword(uri)) {
     // libpq takes a URI or key=value words; only the URI form is the config's.
@@ -107,24 +107,7 @@ class PostgresStore final : public JobStore {
     Transaction transaction(*this);
     execute(kQueueEndLock);
     const double last = query("SELECT COALESCE(MAX(position), 0) FROM jobs").real(0, 0);
-    JobRows rows;
-    rows.insert = [&](const NewJob& job, double position, double at) {
-      return query(
-                 "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
-                 "submitted, updated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) RETURNING id",
-                 {std::string(stateName(JobState::Queued)), std::string(kindName(job.kind)), job.source, job.owner,
-                  job.device, std::to_string(job.priority), number(position), job.options, job.spool, number(at),
-                  number(at)})
-          .integer(0, 0);
-    };
-    rows.record = [&](JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
-      record(id, from, to, at, reason);
-    };
-    rows.move = [&](JobId id, JobState from, JobState to, double at, std::string_view reason) {
-      move(id, from, to, at, reason);
-    };
-    rows.apply = [&](JobId id, const JobChange& change) { apply(id, change); };
-    const std::vector<JobId> ids = addJobRows(jobs, reasons, last, rows);
+    const std::vector<JobId> ids = addJobRows(jobs, reasons, last, *this);
     transaction.commit();
     std::vector<JobRecord> added;
     for (JobId id : ids) added.push_back(*this->job(id));
@@ -144,24 +127,23 @@ class PostgresStore final : public JobStore {
   }
 
   void eachJob(const std::function<void(const JobRecord&)>& visit) override {
-    // A page at a time, by keyset, so that a long queue is never all in memory.
+    // A page at a time, each after the last job of the one before (keyset
+    // paging), so that a long queue is never all in memory.
     constexpr int kPage = 500;
-    std::optional<std::pair<int, std::pair<double, JobId>>> after;
+    std::optional<JobRecord> last;
     for (;;) {
-      const Result page =
-          after
-              ? query(
-                    fmt::format(
-                        "SELECT {} FROM jobs WHERE (-priority, position, id) > ($1::BIGINT, $2::DOUBLE PRECISION, "
-                        "$3::BIGINT) ORDER BY "
-                        "-priority, position, id LIMIT {}",
-                        kJobColumns, kPage),
-                    {std::to_string(-after->first), number(after->second.first), std::to_string(after->second.second)})
-              : query(fmt::format("SELECT {} FROM jobs ORDER BY -priority, position, id LIMIT {}", kJobColumns, kPage));
+      std::string after;
+      std::vector<Parameter> parameters;
+      if (last) {
+        after = "WHERE (-priority, position, id) > ($1::BIGINT, $2::DOUBLE PRECISION, $3::BIGINT) ";
+        parameters = {std::to_string(-last->priority), number(last->position), std::to_string(last->id)};
+      }
+      const Result page = query(
+          fmt::format("SELECT {} FROM jobs {}ORDER BY -priority, position, id LIMIT {}", kJobColumns, after, kPage),
+          parameters);
       for (int row = 0; row < page.rows(); ++row) {
-        const JobRecord job = jobOf(page, row);
-        after = {job.priority, {job.position, job.id}};
-        visit(job);
+        last = jobOf(page, row);
+        visit(*last);
       }
       if (page.rows() < kPage) return;
     }
@@ -428,7 +410,17 @@ class PostgresStore final : public JobStore {
     transaction.commit();
   }
 
-  void apply(JobId id, const JobChange& change) {
+  JobId insertRow(const NewJob& job, double position, double at) override {
+    return query(
+               "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+               "submitted, updated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) RETURNING id",
+               {std::string(stateName(JobState::Queued)), std::string(kindName(job.kind)), job.source, job.owner,
+                job.device, std::to_string(job.priority), number(position), job.options, job.spool, number(at),
+                number(at)})
+        .integer(0, 0);
+  }
+
+  void apply(JobId id, const JobChange& change) override {
     const auto set = [&](const char* column, const Parameter& value) {
       if (value) query(fmt::format("UPDATE jobs SET {} = $1 WHERE id = $2", column), {value, std::to_string(id)});
     };
@@ -443,7 +435,7 @@ class PostgresStore final : public JobStore {
     set("strokes", numberOf(change.strokes));
   }
 
-  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) {
+  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) override {
     if (!allowedTransition(from, to)) {
       throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
     }
@@ -452,7 +444,7 @@ class PostgresStore final : public JobStore {
     record(id, from, to, at, reason);
   }
 
-  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) override {
     query("INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES ($1, $2, $3, $4, $5)",
           {std::to_string(id), from ? Parameter(std::string(stateName(*from))) : std::nullopt,
            std::string(stateName(to)), number(at), std::string(reason)});

@@ -186,7 +186,7 @@ JobRecord jobOf(const Statement& row) {
   return job;
 }
 
-class SqliteStore final : public JobStore {
+class SqliteStore final : public JobStore, private JobRows {
  public:
   SqliteStore(const std::filesystem::path& file, std::optional<int> upTo) : file_(file) {
     const int opened = sqlite3_open_v2(file.c_str(), &db_, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
@@ -222,34 +222,7 @@ class SqliteStore final : public JobStore {
     Transaction transaction(db_);
     Statement last(*statements_, "SELECT COALESCE(MAX(position), 0) FROM jobs");
     last.step();
-    Statement insert(*statements_,
-                     "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
-                     "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    JobRows rows;
-    rows.insert = [&](const NewJob& job, double position, double at) {
-      insert.bind(1, stateName(JobState::Queued))
-          .bind(2, kindName(job.kind))
-          .bind(3, job.source)
-          .bind(4, job.owner)
-          .bind(5, job.device)
-          .bind(6, static_cast<int64_t>(job.priority))
-          .bind(7, position)
-          .bind(8, job.options)
-          .bind(9, job.spool)
-          .bind(10, at)
-          .bind(11, at);
-      insert.step();
-      insert.reset();
-      return static_cast<JobId>(sqlite3_last_insert_rowid(db_));
-    };
-    rows.record = [&](JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
-      record(id, from, to, at, reason);
-    };
-    rows.move = [&](JobId id, JobState from, JobState to, double at, std::string_view reason) {
-      move(id, from, to, at, reason);
-    };
-    rows.apply = [&](JobId id, const JobChange& change) { apply(id, change); };
-    const std::vector<JobId> ids = addJobRows(jobs, reasons, last.real(0), rows);
+    const std::vector<JobId> ids = addJobRows(jobs, reasons, last.real(0), *this);
     transaction.commit();
     std::vector<JobRecord> added;
     for (JobId id : ids) added.push_back(*this->job(id));
@@ -402,7 +375,26 @@ class SqliteStore final : public JobStore {
     }
   }
 
-  void apply(JobId id, const JobChange& change) {
+  JobId insertRow(const NewJob& job, double position, double at) override {
+    Statement insert(*statements_,
+                     "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                     "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    insert.bind(1, stateName(JobState::Queued))
+        .bind(2, kindName(job.kind))
+        .bind(3, job.source)
+        .bind(4, job.owner)
+        .bind(5, job.device)
+        .bind(6, static_cast<int64_t>(job.priority))
+        .bind(7, position)
+        .bind(8, job.options)
+        .bind(9, job.spool)
+        .bind(10, at)
+        .bind(11, at);
+    insert.step();
+    return static_cast<JobId>(sqlite3_last_insert_rowid(db_));
+  }
+
+  void apply(JobId id, const JobChange& change) override {
     const auto setText = [&](const char* column, const std::optional<std::string>& value) {
       if (!value) return;
       Statement set(*statements_, fmt::format("UPDATE jobs SET {} = ? WHERE id = ?", column));
@@ -424,7 +416,7 @@ class SqliteStore final : public JobStore {
   }
 
   // The job's state and message, and the transition's record; in the caller's transaction.
-  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) {
+  void move(JobId id, JobState from, JobState to, double at, std::string_view reason) override {
     if (!allowedTransition(from, to)) {
       throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
     }
@@ -434,7 +426,7 @@ class SqliteStore final : public JobStore {
     record(id, from, to, at, reason);
   }
 
-  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) {
+  void record(JobId id, std::optional<JobState> from, JobState to, double at, std::string_view reason) override {
     Statement insert(*statements_,
                      "INSERT INTO transitions (job, from_state, to_state, at, reason) VALUES (?, ?, ?, ?, ?)");
     insert.bind(1, id);
