@@ -5,6 +5,7 @@
 #include <openssl/sha.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cstdlib>
 
 #include "profiles/YamlReader.h"
@@ -38,7 +39,12 @@ fs::path expanded(const std::string& text) {
 std::string hostName() {
   char name[256] = {};
   if (::gethostname(name, sizeof name - 1) != 0) return "localhost";
-  return name;
+  std::string host = name;
+  // (As a spool entry's name may hold it.)
+  for (char& c : host) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '-') c = '_';
+  }
+  return host.empty() ? "localhost" : host;
 }
 
 std::string hex(const unsigned char* bytes, size_t size) {
@@ -98,10 +104,11 @@ DaemonConfig loadConfig(const fs::path& file) {
     throw ConfigError(error.what());
   }
   try {
-    const auto keys = reader.keys(root, "",
-                                  {"state_dir", "store", "host", "listen", "tokens", "devices", "upload_limit",
-                                   "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
-                                  {});
+    const auto keys =
+        reader.keys(root, "",
+                    {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "devices", "upload_limit",
+                     "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
+                    {});
     bool listenGiven = false;
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
     if (root["store"]) {
@@ -113,7 +120,16 @@ DaemonConfig loadConfig(const fs::path& file) {
                     fmt::format("expected sqlite or postgresql://USER@HOST:PORT/DB, found '{}'", store));
       }
     }
-    if (root["host"]) config.host = reader.text(root["host"], "host");
+    if (root["host"]) {
+      config.host = reader.text(root["host"], "host");
+      if (config.host.empty() || config.host.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                               "0123456789._-") != std::string::npos) {
+        reader.fail(root["host"], "host",
+                    "expected a name of letters, digits, '.', '_' and '-', such as cutter-room-2");
+      }
+    }
+    if (root["spool"]) config.spool = expanded(reader.text(root["spool"], "spool"));
+    if (root["lease"]) config.lease = reader.number(root["lease"], "lease", 1, 3600);
     if (const YAML::Node listen = root["listen"]) {
       if (!listen.IsSequence())
         reader.fail(listen, "listen", "expected a list such as [unix:/run/rotafab.sock, tcp://127.0.0.1:8730]");

@@ -34,7 +34,14 @@ struct DaemonConfig {
   // Where the jobs are kept: empty for SQLite in stateDir (the default), or
   // a PostgreSQL URI (postgresql://USER@HOST:PORT/DB).
   std::string store;
-  std::string host;  // this daemon's name (default: the host name)
+  std::string host;  // this daemon's name (default: the host name); its own on a shared store
+  // Where uploaded meshes and planned sheets are kept: empty for `spool` in
+  // stateDir; on a shared store, a directory every host mounts at this path.
+  std::filesystem::path spool;
+  // Seconds a host on a shared store is taken to be alive after its last
+  // heartbeat (renewed five times within it); once it runs out, another
+  // host releases its jobs (a cut interrupted, a plan made again).
+  double lease = 10;
   // "unix:PATH" and "tcp://HOST:PORT"; the first Unix one is where `rotafab` looks.
   std::vector<std::string> listen;
   // The listeners are the defaults: the socket, and loopback TCP for the

@@ -68,6 +68,8 @@ bool allowedTransition(JobState from, JobState to) {
 
 bool holdsDevice(JobState state) { return state == JobState::Running || state == JobState::Paused; }
 
+bool heldByAHost(JobState state) { return state == JobState::Planning || holdsDevice(state); }
+
 bool isFinal(JobState state) {
   return state == JobState::Done || state == JobState::Cancelled || state == JobState::Failed ||
          state == JobState::Interrupted;

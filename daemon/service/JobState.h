@@ -30,6 +30,9 @@ bool allowedTransition(JobState from, JobState to);
 
 // Whether a job in this state holds its device (one job per device).
 bool holdsDevice(JobState state);
+// Whether a job in this state is in one host's hands (planning, running,
+// paused): that host alone moves it, and it is released if the host dies.
+bool heldByAHost(JobState state);
 // Whether nothing more happens to a job in this state by itself.
 bool isFinal(JobState state);
 

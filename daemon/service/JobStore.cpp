@@ -25,6 +25,33 @@ void checkFirstSteps(const std::vector<NewJob>& jobs) {
   }
 }
 
+void checkHolder(const JobRecord& job, const std::string& host) {
+  if (heldByAHost(job.state) && !job.host.empty() && job.host != host) {
+    throw TransitionRefused(
+        fmt::format("job {} is {} on host {}; only that host can move it now", job.id, stateName(job.state), job.host));
+  }
+}
+
+std::vector<JobId> moveRows(const std::vector<JobRecord>& jobs, const ClaimDecision& decide, JobRows& rows) {
+  const double at = unixSeconds();
+  std::vector<JobId> moved;
+  for (const JobRecord& job : jobs) {
+    const std::optional<Claim> decided = decide(job);
+    if (!decided) continue;
+    rows.move(job.id, job.state, decided->to, at, decided->reason);
+    rows.apply(job.id, decided->change);
+    moved.push_back(job.id);
+  }
+  return moved;
+}
+
+ClaimDecision releasing(const Release& release, const HostRecord& host) {
+  return [release, host](const JobRecord& job) {
+    auto [to, reason] = release(job, host);
+    return std::optional<Claim>(Claim{to, std::move(reason), {}});
+  };
+}
+
 std::vector<JobId> addJobRows(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons,
                               double lastPosition, JobRows& rows) {
   const double at = unixSeconds();

@@ -70,6 +70,47 @@ struct JobRecord {
   int sheet = 0;
   int64_t stroke = 0, strokes = 0;
   std::string message;  // the reason of the last transition
+  // The host that holds it while it is planning, running or paused (the
+  // store sets it: whoever moves a job into one of those states holds it).
+  std::string host;
+  bool anyDevice = false;  // submitted for any device whose machine profile fits
+};
+
+// A daemon on the store, and until when it is taken to be alive (its lease,
+// renewed by its heartbeat; by the server's clock where there is one).
+struct HostRecord {
+  std::string name;
+  std::string address;  // where its API answers, for people (its first TCP listener)
+  double started = 0, seen = 0, leaseUntil = 0;
+  bool gone = false;  // its lease ran out: another host released its jobs
+};
+
+// A device as every host sees it: whose it is, and what it is doing.
+struct DeviceRecord {
+  std::string name, host, machine, material, uri;
+  bool autoStart = false;
+  std::string state, message;  // idle, running, paused, offline, fault, checking
+  std::optional<JobId> job;
+};
+
+// What becomes of a job whose host is gone (a restart, a lease run out):
+// its new state (queued to be planned again, interrupted) and why.
+using Release = std::function<std::pair<JobState, std::string>(const JobRecord& job, const HostRecord& host)>;
+
+// Jobs one host takes for itself, each at most once across every host: up to
+// `limit` jobs in state `from`, in queue order, skipping those another host
+// is taking at that moment; with `device`, only the jobs for it, and those
+// for any device of its machine (`machine`).
+struct ClaimQuery {
+  JobState from = JobState::Queued;
+  size_t limit = 1;
+  std::string device, machine;
+};
+// What the claiming host does with a job: its next state, why, and what changes with it.
+struct Claim {
+  JobState to = JobState::Planning;
+  std::string reason;
+  JobChange change;
 };
 
 struct Transition {
@@ -99,6 +140,8 @@ class StoreError : public std::runtime_error {
 // first steps are allowed (TransitionRefused naming the job's source).
 double unixSeconds();
 void checkFirstSteps(const std::vector<NewJob>& jobs);
+// TransitionRefused when another host than `host` holds the job.
+void checkHolder(const JobRecord& job, const std::string& host);
 // What an engine's store writes, in its own SQL, within the caller's
 // transaction; each store is one (addJobRows takes the steps they share).
 class JobRows {
@@ -114,6 +157,13 @@ class JobRows {
  protected:
   ~JobRows() = default;
 };
+// What a claim decides for a job: its move, or nothing (JobStore::claim).
+using ClaimDecision = std::function<std::optional<Claim>(const JobRecord&)>;
+// Each of `jobs` moved as `decide` says, with its change, in the caller's
+// transaction; the numbers of those moved (a claim, a release).
+std::vector<JobId> moveRows(const std::vector<JobRecord>& jobs, const ClaimDecision& decide, JobRows& rows);
+// A release as a claim decides it: every job moved, as `release` says for `host`.
+ClaimDecision releasing(const Release& release, const HostRecord& host);
 // New jobs after the one at `lastPosition`: each inserted, its submission
 // recorded, then its first steps and its change; their numbers, in order.
 std::vector<JobId> addJobRows(const std::vector<NewJob>& jobs, const std::vector<std::string>& reasons,
@@ -138,15 +188,43 @@ class JobStore {
                                                       const std::string& device = "") = 0;
   // Moves a job to `to` if the table allows it from the state it is in
   // (JobState.h; TransitionRefused otherwise, naming both), with `change`,
-  // and records the transition, all in one transaction.
+  // and records the transition, all in one transaction. A job another host
+  // holds is that host's to move (TransitionRefused naming it).
   virtual JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change = {}) = 0;
-  // Progress without a change of state.
+  // Progress without a change of state (of a job this host holds; else nothing).
   virtual void update(JobId id, const JobChange& change) = 0;
   // A new place in the queue.
   virtual void reorder(JobId id, int priority, double position) = 0;
   [[nodiscard]] virtual std::vector<Transition> transitions(JobId id) = 0;
   virtual void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) = 0;
   [[nodiscard]] virtual std::vector<Event> events(std::optional<JobId> job, size_t newest) = 0;
+  // ---- several hosts on one store ----
+  // Whether other hosts may share it (PostgreSQL), or it is this daemon's alone (SQLite).
+  [[nodiscard]] virtual bool shared() const = 0;
+  // Registers this daemon as host `me.name` with its devices, for `lease`
+  // seconds, and releases what this host held before (a restart): each job
+  // as `release` says. A shared store waits up to `wait` seconds for a
+  // lease the same host name still holds (a kill -9 leaves one), then
+  // refuses: another daemon runs under that name. Refuses a device name
+  // another live host has. Returns the jobs released.
+  virtual std::vector<JobRecord> join(const HostRecord& me, const std::vector<DeviceRecord>& devices, double lease,
+                                      double wait, const Release& release) = 0;
+  // Renews this host's lease; false when it had run out and another host
+  // released this host's jobs (it must stop what it was doing and join again).
+  virtual bool heartbeat(double lease) = 0;
+  // Every other host whose lease has run out: marked gone, its devices with
+  // it, its jobs released as `release` says (once, by one host). The jobs.
+  virtual std::vector<JobRecord> releaseLapsedHosts(const Release& release) = 0;
+  [[nodiscard]] virtual std::vector<HostRecord> hosts() = 0;
+  // Every host's devices, by name.
+  [[nodiscard]] virtual std::vector<DeviceRecord> devices() = 0;
+  // One of this host's devices, as it now is.
+  virtual void putDevice(const DeviceRecord& device) = 0;
+  // The jobs `query` finds, each moved as `decide` says (nullopt: left as
+  // it is), in one transaction; those moved. A job moved into planning,
+  // running or paused is this host's.
+  virtual std::vector<JobRecord> claim(const ClaimQuery& query, const ClaimDecision& decide) = 0;
+
   // The schema version of the store as opened.
   [[nodiscard]] virtual int schemaVersion() = 0;
   // Whether the engine finds the store sound ("ok"), or what it finds wrong.
@@ -162,11 +240,8 @@ std::unique_ptr<JobStore> openSqliteStore(const std::filesystem::path& file,
 // PostgreSQL at `uri` (postgresql://USER@HOST:PORT/DB, libpq's form), a
 // store several daemons share; migrated as the SQLite one, by one daemon at a
 // time. Every transaction is committed with the server's synchronous commit.
-// Throws StoreError naming the URI without its password. `exclusive`: the
-// store is this daemon's alone while it is open (a second daemon on it is
-// refused), until the hosts that share one store claim their work from it.
-std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion = std::nullopt,
-                                            bool exclusive = false);
+// Throws StoreError naming the URI without its password.
+std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion = std::nullopt);
 
 // The URI as it may be shown: any password in it replaced by ***.
 std::string uriWithoutPassword(const std::string& uri);

@@ -20,15 +20,20 @@
 #include <vector>
 
 #include "daemon/service/JobStore.h"
+#include "daemon/service/StoreRows.h"
 #include "daemon/service/StoreSchema.h"
 
 namespace rotafab::service {
 namespace {
 
-// Advisory lock keys, arbitrary but fixed: for migrations, the end of the queue, and the daemon's.
+// Advisory lock keys, arbitrary but fixed: for migrations, the end of the
+// queue, and the hosts (one host joins, or releases a lapsed one, at a time).
 constexpr const char* kMigrationLock = "SELECT pg_advisory_xact_lock(7208301)";
 constexpr const char* kQueueEndLock = "SELECT pg_advisory_xact_lock(7208302)";
-constexpr const char* kDaemonLock = "SELECT pg_try_advisory_lock(7208303)";
+constexpr const char* kHostsLock = "SELECT pg_advisory_xact_lock(7208304)";
+// Leases are reckoned by the server's clock, the one clock every host shares.
+constexpr const char* kNow = "EXTRACT(EPOCH FROM clock_timestamp())::DOUBLE PRECISION";
+constexpr const char* kHeldStates = "('planning', 'running', 'paused')";
 
 // libpq's messages end in a newline and may run to several lines: the first, trimmed.
 std::string firstLine(const char* message) {
@@ -70,13 +75,25 @@ class Result {
   }
   [[nodiscard]] const PGresult* raw() const { return result_; }
 
+  // One row, as StoreRows.h reads it.
+  struct Row {
+    const Result& result;
+    int index;
+    [[nodiscard]] std::string text(int column) const { return result.text(index, column); }
+    [[nodiscard]] int64_t integer(int column) const { return result.integer(index, column); }
+    [[nodiscard]] double real(int column) const { return result.real(index, column); }
+    [[nodiscard]] bool isNull(int column) const { return result.isNull(index, column); }
+    [[nodiscard]] int columns() const { return PQnfields(result.result_); }
+  };
+  [[nodiscard]] Row row(int index) const { return {*this, index}; }
+
  private:
   PGresult* result_;
 };
 
 class PostgresStore final : public JobStore, private JobRows {
  public:
-  PostgresStore(const std::string& uri, std::optional<int> upTo, bool exclusive) : shown_(uriWithoutPassword(uri)) {
+  PostgresStore(const std::string& uri, std::optional<int> upTo) : shown_(uriWithoutPassword(uri)) {
     // libpq takes a URI or key=value words; only the URI form is the config's.
     connection_ = PQconnectdb(uri.c_str());
     if (!connection_ || PQstatus(connection_) != CONNECTION_OK) {
@@ -87,8 +104,8 @@ class PostgresStore final : public JobStore, private JobRows {
     try {
       startSession();
       migrate(upTo.value_or(newestSchemaVersion()));
-      exclusive_ = exclusive;
-      if (exclusive_) holdTheStore();
+      version_ = schemaVersion();
+      columns_ = jobColumns(version_);
     } catch (...) {
       PQfinish(connection_);
       throw;
@@ -115,9 +132,9 @@ class PostgresStore final : public JobStore, private JobRows {
   }
 
   std::optional<JobRecord> job(JobId id) override {
-    const Result found = query(fmt::format("SELECT {} FROM jobs WHERE id = $1", kJobColumns), {std::to_string(id)});
+    const Result found = query(fmt::format("SELECT {} FROM jobs WHERE id = $1", columns_), {std::to_string(id)});
     if (found.rows() == 0) return std::nullopt;
-    return jobOf(found, 0);
+    return jobOf(found.row(0));
   }
 
   std::vector<JobRecord> jobs() override {
@@ -138,11 +155,11 @@ class PostgresStore final : public JobStore, private JobRows {
         after = "WHERE (-priority, position, id) > ($1::BIGINT, $2::DOUBLE PRECISION, $3::BIGINT) ";
         parameters = {std::to_string(-last->priority), number(last->position), std::to_string(last->id)};
       }
-      const Result page = query(
-          fmt::format("SELECT {} FROM jobs {}ORDER BY -priority, position, id LIMIT {}", kJobColumns, after, kPage),
-          parameters);
+      const Result page =
+          query(fmt::format("SELECT {} FROM jobs {}ORDER BY -priority, position, id LIMIT {}", columns_, after, kPage),
+                parameters);
       for (int row = 0; row < page.rows(); ++row) {
-        last = jobOf(page, row);
+        last = jobOf(page.row(row));
         visit(*last);
       }
       if (page.rows() < kPage) return;
@@ -163,18 +180,19 @@ class PostgresStore final : public JobStore, private JobRows {
     }
     parameters.emplace_back(std::to_string(std::min<size_t>(limit, INT64_MAX)));
     const Result found = query(fmt::format("SELECT {} FROM jobs WHERE {} ORDER BY priority DESC, position LIMIT ${}",
-                                           kJobColumns, where, parameters.size()),
+                                           columns_, where, parameters.size()),
                                parameters);
-    std::vector<JobRecord> all;
-    for (int row = 0; row < found.rows(); ++row) all.push_back(jobOf(found, row));
-    return all;
+    return jobsOf(found);
   }
 
   JobRecord transition(JobId id, JobState to, std::string_view reason, const JobChange& change) override {
     Transaction transaction(*this);
-    const Result current = query("SELECT state FROM jobs WHERE id = $1 FOR UPDATE", {std::to_string(id)});
+    const Result current =
+        query(fmt::format("SELECT {} FROM jobs WHERE id = $1 FOR UPDATE", columns_), {std::to_string(id)});
     if (current.rows() == 0) throw TransitionRefused(fmt::format("there is no job {}", id));
-    move(id, stateNamed(current.text(0, 0)).value_or(JobState::Failed), to, unixSeconds(), reason);
+    const JobRecord found = jobOf(current.row(0));
+    checkHolder(found, host_);
+    move(id, found.state, to, unixSeconds(), reason);
     apply(id, change);
     transaction.commit();
     return *job(id);
@@ -182,8 +200,148 @@ class PostgresStore final : public JobStore, private JobRows {
 
   void update(JobId id, const JobChange& change) override {
     Transaction transaction(*this);
+    if (version_ >= kFirstVersionWithHosts) {
+      // A host whose jobs were released (its lease ran out) no longer writes to them.
+      const Result holder = query("SELECT host FROM jobs WHERE id = $1 FOR UPDATE", {std::to_string(id)});
+      if (holder.rows() == 0 || (!holder.text(0, 0).empty() && holder.text(0, 0) != host_)) return;
+    }
     apply(id, change);
     transaction.commit();
+  }
+
+  // ---- hosts ----
+
+  bool shared() const override { return true; }
+
+  std::vector<JobRecord> join(const HostRecord& me, const std::vector<DeviceRecord>& devices, double lease, double wait,
+                              const Release& release) override {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait);
+    for (;;) {
+      Transaction transaction(*this);
+      execute(kHostsLock);
+      const Result mine =
+          query(fmt::format("SELECT {}, lease_until - {} FROM hosts WHERE name = $1 FOR UPDATE", kHostColumns, kNow),
+                {me.name});
+      if (mine.rows() > 0 && mine.integer(0, 5) == 0 && mine.real(0, 6) > 0) {
+        // The same name's lease still runs: a daemon killed a moment ago (its
+        // lease runs out soon), or another daemon under this name (it renews it).
+        if (std::chrono::steady_clock::now() < deadline) {
+          transaction.rollback();
+          std::this_thread::sleep_for(std::chrono::milliseconds(250));
+          continue;
+        }
+        throw StoreError(fmt::format(
+            "{}: another rotafabd runs as host {} on this job store (its lease is renewed); give each daemon "
+            "its own name with `host:` in its configuration",
+            shown_, me.name));
+      }
+      for (const DeviceRecord& device : devices) {
+        const Result taken =
+            query(fmt::format("SELECT d.host FROM devices d JOIN hosts h ON h.name = d.host "
+                              "WHERE d.name = $1 AND d.host <> $2 AND h.gone = 0 AND h.lease_until > {}",
+                              kNow),
+                  {device.name, me.name});
+        if (taken.rows() > 0) {
+          throw StoreError(
+              fmt::format("{}: device {} is host {}'s on this job store; give each device a name of "
+                          "its own across the hosts",
+                          shown_, device.name, taken.text(0, 0)));
+        }
+      }
+      query(fmt::format("INSERT INTO hosts (name, address, started, seen, lease_until, gone) "
+                        "VALUES ($1, $2, {0}, {0}, {0} + $3, 0) ON CONFLICT (name) DO UPDATE SET "
+                        "address = excluded.address, started = excluded.started, seen = excluded.seen, "
+                        "lease_until = excluded.lease_until, gone = 0",
+                        kNow),
+            {me.name, me.address, number(lease)});
+      query("DELETE FROM devices WHERE host = $1", {me.name});
+      for (const DeviceRecord& device : devices) {
+        query(
+            "INSERT INTO devices (name, host, machine, material, uri, auto_start, state, message, job) "
+            "VALUES ($1, $2, $3, $4, $5, $6, $7, $8, NULL) ON CONFLICT (name) DO UPDATE SET host = excluded.host, "
+            "machine = excluded.machine, material = excluded.material, uri = excluded.uri, "
+            "auto_start = excluded.auto_start, state = excluded.state, message = excluded.message, job = NULL",
+            {device.name, me.name, device.machine, device.material, device.uri, device.autoStart ? "1" : "0",
+             device.state, device.message});
+      }
+      host_ = me.name;
+      // What this host held before (and what a daemon before the hosts held, under no name).
+      HostRecord before = me;
+      if (mine.rows() > 0) before = hostOf(mine.row(0));
+      const std::vector<JobId> released =
+          releaseJobs(fmt::format("host IN ($1, '') AND state IN {} ORDER BY id FOR UPDATE", kHeldStates), me.name,
+                      before, release);
+      transaction.commit();
+      return jobsNumbered(released);
+    }
+  }
+
+  bool heartbeat(double lease) override {
+    return query(fmt::format("UPDATE hosts SET seen = {0}, lease_until = {0} + $2 WHERE name = $1 AND gone = 0 "
+                             "RETURNING 1",
+                             kNow),
+                 {host_, number(lease)})
+               .rows() > 0;
+  }
+
+  std::vector<JobRecord> releaseLapsedHosts(const Release& release) override {
+    const std::string lapsed = fmt::format("gone = 0 AND lease_until < {} AND name <> $1", kNow);
+    if (query(fmt::format("SELECT 1 FROM hosts WHERE {} LIMIT 1", lapsed), {host_}).rows() == 0) return {};
+    Transaction transaction(*this);
+    execute(kHostsLock);  // (then read again: another host may have released them while this one waited)
+    const Result hosts =
+        query(fmt::format("SELECT {} FROM hosts WHERE {} ORDER BY name FOR UPDATE", kHostColumns, lapsed), {host_});
+    std::vector<JobId> released;
+    for (int row = 0; row < hosts.rows(); ++row) {
+      const HostRecord gone = hostOf(hosts.row(row));
+      query("UPDATE hosts SET gone = 1 WHERE name = $1", {gone.name});
+      query("UPDATE devices SET state = 'gone', message = '', job = NULL WHERE host = $1", {gone.name});
+      const std::vector<JobId> its = releaseJobs(
+          fmt::format("host = $1 AND state IN {} ORDER BY id FOR UPDATE", kHeldStates), gone.name, gone, release);
+      released.insert(released.end(), its.begin(), its.end());
+    }
+    transaction.commit();
+    return jobsNumbered(released);
+  }
+
+  std::vector<HostRecord> hosts() override {
+    const Result found = query(fmt::format("SELECT {} FROM hosts ORDER BY name", kHostColumns));
+    std::vector<HostRecord> all;
+    for (int row = 0; row < found.rows(); ++row) all.push_back(hostOf(found.row(row)));
+    return all;
+  }
+
+  std::vector<DeviceRecord> devices() override {
+    const Result found = query(fmt::format("SELECT {} FROM devices ORDER BY name", kDeviceColumns));
+    std::vector<DeviceRecord> all;
+    for (int row = 0; row < found.rows(); ++row) all.push_back(deviceOf(found.row(row)));
+    return all;
+  }
+
+  void putDevice(const DeviceRecord& device) override {
+    query("UPDATE devices SET state = $1, message = $2, job = $3 WHERE name = $4 AND host = $5",
+          {device.state, device.message, device.job ? Parameter(std::to_string(*device.job)) : std::nullopt,
+           device.name, host_});
+  }
+
+  std::vector<JobRecord> claim(const ClaimQuery& claimed, const ClaimDecision& decide) override {
+    Transaction transaction(*this);
+    std::vector<Parameter> parameters{std::string(stateName(claimed.from))};
+    std::string forDevice;
+    if (!claimed.device.empty()) {
+      parameters.emplace_back(claimed.device);
+      parameters.emplace_back(claimed.machine);
+      forDevice = " AND (device = $2 OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = $3)))";
+    }
+    parameters.emplace_back(std::to_string(std::min<size_t>(claimed.limit, INT64_MAX)));
+    // SKIP LOCKED: a job another host is claiming at this moment is passed over, not waited for.
+    const Result found = query(fmt::format("SELECT {} FROM jobs WHERE state = $1{} ORDER BY priority DESC, position "
+                                           "LIMIT ${} FOR UPDATE SKIP LOCKED",
+                                           columns_, forDevice, parameters.size()),
+                               parameters);
+    const std::vector<JobId> moved = moveRows(jobsOf(found), decide, *this);
+    transaction.commit();
+    return jobsNumbered(moved);
   }
 
   void reorder(JobId id, int priority, double position) override {
@@ -247,10 +405,6 @@ class PostgresStore final : public JobStore, private JobRows {
   }
 
  private:
-  static constexpr const char* kJobColumns =
-      "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
-      "summary, sheet, stroke, strokes, message";
-
   // BEGIN ... COMMIT, rolled back unless committed. (Its BEGIN may connect
   // again; nothing within it does: a transaction cut off is lost whole.)
   class Transaction {
@@ -270,6 +424,11 @@ class PostgresStore final : public JobStore, private JobRows {
       committed_ = true;
       store_.inTransaction_ = false;
     }
+    void rollback() {
+      PQclear(PQexec(store_.connection_, "ROLLBACK"));
+      committed_ = true;
+      store_.inTransaction_ = false;
+    }
 
    private:
     PostgresStore& store_;
@@ -279,27 +438,23 @@ class PostgresStore final : public JobStore, private JobRows {
   // A double as text that reads back to the same double.
   static std::string number(double value) { return fmt::format("{}", value); }
 
-  static JobRecord jobOf(const Result& row, int i) {
-    JobRecord job;
-    job.id = row.integer(i, 0);
-    job.state = stateNamed(row.text(i, 1)).value_or(JobState::Failed);
-    job.kind = row.text(i, 2) == "planned" ? JobKind::Planned : JobKind::Mesh;
-    job.source = row.text(i, 3);
-    job.owner = row.text(i, 4);
-    job.device = row.text(i, 5);
-    job.priority = static_cast<int>(row.integer(i, 6));
-    job.position = row.real(i, 7);
-    job.options = row.text(i, 8);
-    job.spool = row.text(i, 9);
-    job.submitted = row.real(i, 10);
-    job.updated = row.real(i, 11);
-    job.sheets = static_cast<int>(row.integer(i, 12));
-    job.summary = row.text(i, 13);
-    job.sheet = static_cast<int>(row.integer(i, 14));
-    job.stroke = row.integer(i, 15);
-    job.strokes = row.integer(i, 16);
-    job.message = row.text(i, 17);
-    return job;
+  // The held jobs `where` finds (its $1: `host`), each moved as `release` says; their numbers.
+  std::vector<JobId> releaseJobs(const std::string& where, const std::string& host, const HostRecord& before,
+                                 const Release& release) {
+    const Result held = query(fmt::format("SELECT {} FROM jobs WHERE {}", columns_, where), {host});
+    return moveRows(jobsOf(held), releasing(release, before), *this);
+  }
+
+  static std::vector<JobRecord> jobsOf(const Result& found) {
+    std::vector<JobRecord> all;
+    for (int row = 0; row < found.rows(); ++row) all.push_back(jobOf(found.row(row)));
+    return all;
+  }
+
+  std::vector<JobRecord> jobsNumbered(const std::vector<JobId>& ids) {
+    std::vector<JobRecord> all;
+    for (JobId id : ids) all.push_back(*job(id));
+    return all;
   }
 
   // One statement with its parameters; StoreError in one line when the server refuses it.
@@ -332,24 +487,6 @@ class PostgresStore final : public JobStore, private JobRows {
     execute("SET synchronous_commit = on");
   }
 
-  // The store held for this daemon by a lock of the session's, let go when
-  // the connection ends (a killed daemon's too, once its server process has
-  // seen the connection close: a few seconds are allowed for that).
-  void holdTheStore() {
-    const auto tryLock = [&] { return query(kDaemonLock).text(0, 0) == "t"; };
-    bool locked = tryLock();
-    for (int attempt = 0; !locked && attempt < 30; ++attempt) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
-      locked = tryLock();
-    }
-    if (!locked) {
-      throw StoreError(
-          fmt::format("{}: another rotafabd uses this job store; one store shared by several "
-                      "daemons is not supported yet: give each its own database",
-                      shown_));
-    }
-  }
-
   // When a statement outside a transaction failed because the connection
   // was lost (the server restarted, an administrator ended it), connects
   // again once, as the store was opened; true when the statement can be
@@ -365,7 +502,6 @@ class PostgresStore final : public JobStore, private JobRows {
     reconnecting_ = true;
     try {
       startSession();
-      if (exclusive_) holdTheStore();
     } catch (...) {
       reconnecting_ = false;
       throw;
@@ -411,12 +547,30 @@ class PostgresStore final : public JobStore, private JobRows {
   }
 
   JobId insertRow(const NewJob& job, double position, double at) override {
+    std::vector<Parameter> values{std::string(stateName(JobState::Queued)),
+                                  std::string(kindName(job.kind)),
+                                  job.source,
+                                  job.owner,
+                                  job.device,
+                                  std::to_string(job.priority),
+                                  number(position),
+                                  job.options,
+                                  job.spool,
+                                  number(at),
+                                  number(at)};
+    if (version_ < kFirstVersionWithHosts) {
+      return query(
+                 "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                 "submitted, updated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) RETURNING id",
+                 values)
+          .integer(0, 0);
+    }
+    values.emplace_back(job.device.empty() ? "1" : "0");
     return query(
                "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
-               "submitted, updated) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11) RETURNING id",
-               {std::string(stateName(JobState::Queued)), std::string(kindName(job.kind)), job.source, job.owner,
-                job.device, std::to_string(job.priority), number(position), job.options, job.spool, number(at),
-                number(at)})
+               "submitted, updated, any_device) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11, $12) "
+               "RETURNING id",
+               values)
         .integer(0, 0);
   }
 
@@ -439,8 +593,14 @@ class PostgresStore final : public JobStore, private JobRows {
     if (!allowedTransition(from, to)) {
       throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
     }
-    query("UPDATE jobs SET state = $1, message = $2, updated = $3 WHERE id = $4",
-          {std::string(stateName(to)), std::string(reason), number(at), std::to_string(id)});
+    if (version_ >= kFirstVersionWithHosts) {
+      query("UPDATE jobs SET state = $1, message = $2, updated = $3, host = $4 WHERE id = $5",
+            {std::string(stateName(to)), std::string(reason), number(at), heldByAHost(to) ? host_ : std::string(),
+             std::to_string(id)});
+    } else {
+      query("UPDATE jobs SET state = $1, message = $2, updated = $3 WHERE id = $4",
+            {std::string(stateName(to)), std::string(reason), number(at), std::to_string(id)});
+    }
     record(id, from, to, at, reason);
   }
 
@@ -452,13 +612,16 @@ class PostgresStore final : public JobStore, private JobRows {
 
   std::string shown_;
   PGconn* connection_ = nullptr;
-  bool exclusive_ = false, inTransaction_ = false, reconnecting_ = false;
+  int version_ = 0;
+  std::string columns_;  // a job's (jobColumns())
+  std::string host_;     // this daemon's, once it joined
+  bool inTransaction_ = false, reconnecting_ = false;
 };
 
 }  // namespace
 
-std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion, bool exclusive) {
-  return std::make_unique<PostgresStore>(uri, upToVersion, exclusive);
+std::unique_ptr<JobStore> openPostgresStore(const std::string& uri, std::optional<int> upToVersion) {
+  return std::make_unique<PostgresStore>(uri, upToVersion);
 }
 
 std::string uriWithoutPassword(const std::string& uri) {

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <fstream>
 #include <future>
+#include <mutex>
 #include <regex>
 #include <set>
 #include <thread>
@@ -166,6 +167,14 @@ struct Service::Impl {
     std::string checked;  // what the check at the daemon's start found
     std::optional<JobId> job;
   };
+  // A device a job may be planned for or cut on: this host's, or another's
+  // on a shared store (its profiles from this host's catalogue, by the
+  // names its own host gave).
+  struct Target {
+    std::string name, host;
+    profiles::MachineProfile machine;
+    profiles::MaterialProfile material;
+  };
   struct Planning {
     std::shared_ptr<core::Cancellation> cancel;
     json progress;
@@ -232,6 +241,17 @@ struct Service::Impl {
   bool groupTimerSet = false;
   size_t nextSubscriber = 1;
   bool stopping = false;
+  // On a shared store: whether this host is in it (joined, lease renewed),
+  // when its lease was last renewed, and the timer that renews it and
+  // looks for work other hosts added.
+  bool joined = false;
+  Clock::time_point lastBeat{};
+  std::optional<asio::steady_timer> ticker;
+  int ticks = 0;
+  // The devices of the other live hosts, as the last heartbeat found them;
+  // read off the strand too (a planned folder's submission), hence the lock.
+  std::mutex othersMutex;
+  std::vector<Target> others;
   std::function<void()> stopped;
 
   template <typename Work>
@@ -293,6 +313,7 @@ struct Service::Impl {
 
   json deviceJson(const Device& device) const {
     json out{{"name", device.config.name},
+             {"host", config.host},
              {"uri", device.config.uri},
              {"machine", device.machine.name},
              {"material", device.material.name},
@@ -319,6 +340,7 @@ struct Service::Impl {
              {"stroke", job.stroke},
              {"strokes", job.strokes},
              {"message", job.message}};
+    out["host"] = job.host.empty() ? json(nullptr) : json(job.host);
     out["options"] = json::parse(job.options.empty() ? "[]" : job.options, nullptr, false);
     if (!job.summary.empty()) out["summary"] = json::parse(job.summary, nullptr, false);
     if (const auto p = planning.find(job.id); p != planning.end() && !p->second.progress.is_null()) {
@@ -335,7 +357,14 @@ struct Service::Impl {
     if (!subscribers.empty()) publish("job", jobJson(job));
   }
 
-  void deviceChanged(const Device& device) { publish("device", deviceJson(device)); }
+  void deviceChanged(const Device& device) {
+    try {
+      store->putDevice(deviceRecord(device));
+    } catch (const std::exception& error) {
+      log->error("{}", error.what());
+    }
+    publish("device", deviceJson(device));
+  }
 
   // ---- start ----
 
@@ -346,9 +375,9 @@ struct Service::Impl {
       throw StoreError(
           fmt::format("{}: cannot create the state directory: {}", config.stateDir.string(), error.message()));
     }
-    store = config.store.empty() ? openSqliteStore(config.stateDir / "jobs.sqlite3")
-                                 : openPostgresStore(config.store, std::nullopt, true);
-    spool = std::make_unique<Spool>(config.stateDir / "spool");
+    store = config.store.empty() ? openSqliteStore(config.stateDir / "jobs.sqlite3") : openPostgresStore(config.store);
+    spool = std::make_unique<Spool>(config.spool.empty() ? config.stateDir / "spool" : config.spool,
+                                    store->shared() ? config.host : "");
     catalogue = profiles::loadProfiles(profiles::profileSearchPath());
     const std::string where = config.file.empty() ? std::string("the default configuration") : config.file.string();
     for (const DeviceConfig& deviceConfig : config.devices) {
@@ -384,28 +413,152 @@ struct Service::Impl {
     }
   }
 
-  // What a stop of the daemon left: jobs it was cutting become interrupted
-  // (never restarted), plans it was making are made again.
-  void recover() {
-    std::set<std::string> named;
-    store->eachJob([&](const JobRecord& job) { named.insert(job.spool); });
-    for (const JobRecord& job : store->jobsIn({JobState::Running, JobState::Paused, JobState::Planning})) {
-      if (holdsDevice(job.state)) {
-        const std::string where = sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes);
-        const std::string reason = fmt::format(
-            "the daemon stopped while it cut, {}; check the machine and the sheet, then go on with `rotafab resume "
-            "{} --from-sheet {}`",
-            where, job.id, std::max(1, job.sheet));
-        store->transition(job.id, JobState::Interrupted, reason);
-        log->warn("job {}: {}", job.id, reason);
-      } else if (job.state == JobState::Planning) {
-        store->transition(job.id, JobState::Queued, "the daemon stopped while it planned; it is planned again");
+  // What becomes of a job whose host stopped: cut, it is interrupted (never
+  // restarted by itself); planned, it is planned again. `who`: "the daemon"
+  // after this host's own stop, else the host whose lease ran out.
+  static std::pair<JobState, std::string> released(const JobRecord& job, const std::string& who) {
+    if (holdsDevice(job.state)) {
+      return {
+          JobState::Interrupted,
+          fmt::format("{} stopped while it cut, {}; check the machine and the sheet, then go on with `rotafab "
+                      "resume {} --from-sheet {}`",
+                      who, sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes), job.id, std::max(1, job.sheet))};
+    }
+    return {JobState::Queued, fmt::format("{} stopped while it planned; it is planned again", who)};
+  }
+
+  DeviceRecord deviceRecord(const Device& device) const {
+    DeviceRecord record;
+    record.name = device.config.name;
+    record.host = config.host;
+    record.machine = device.machine.name;
+    record.material = device.material.name;
+    record.uri = device.config.uri;
+    record.autoStart = device.config.autoStart;
+    record.state = device.state;
+    record.message = device.message;
+    record.job = device.job;
+    return record;
+  }
+
+  // This host into the store, and what a stop of it left: jobs it was
+  // cutting become interrupted, plans it was making are made again; spool
+  // folders no job names (a stop mid-submission) are removed.
+  void join() {
+    HostRecord me;
+    me.name = config.host;
+    for (const std::string& address : config.listen) {
+      if (address.starts_with("tcp://")) {
+        me.address = "http://" + address.substr(6);
+        break;
       }
     }
+    std::vector<DeviceRecord> records;
+    for (const Device& device : devices) records.push_back(deviceRecord(device));
+    // (A daemon killed a moment ago holds its lease a little longer: waited for.)
+    const std::vector<JobRecord> left =
+        store->join(me, records, config.lease, config.lease + 2,
+                    [](const JobRecord& job, const HostRecord&) { return released(job, "the daemon"); });
+    joined = true;
+    lastBeat = Clock::now();
+    for (const JobRecord& job : left) {
+      if (job.state == JobState::Interrupted) log->warn("job {}: {}", job.id, job.message);
+    }
+    std::set<std::string> named;
+    store->eachJob([&](const JobRecord& job) { named.insert(job.spool); });
     if (const size_t removed = spool->removeOrphans(named); removed > 0) {
       log->info("removed {} spool folder{} that no job names (left by a stop mid-submission)", removed,
                 removed == 1 ? "" : "s");
     }
+    if (store->shared()) {
+      log->info("host {} on the shared job store, lease {:g} s", config.host, config.lease);
+      refreshOthers();
+      ticker.emplace(strand);
+      tick();
+    }
+  }
+
+  // On a shared store, twice a second: work the other hosts added; five
+  // times a lease, the heartbeat, and the hosts whose lease ran out.
+  void tick() {
+    ticker->expires_after(std::chrono::milliseconds(500));
+    ticker->async_wait([this](const boost::system::error_code& error) {
+      if (error || stopping) return;
+      const int beatEvery = std::max(1, static_cast<int>(config.lease / 5 / 0.5));
+      if (ticks++ % beatEvery == 0) beat();
+      pump();
+      tick();
+    });
+  }
+
+  void beat() {
+    try {
+      if (!joined) {
+        join();  // (again, after its lease ran out)
+        return;
+      }
+      if (!store->heartbeat(config.lease)) {
+        fence("its lease ran out and another host released its jobs");
+        return;
+      }
+      lastBeat = Clock::now();
+      const std::vector<JobRecord> taken = store->releaseLapsedHosts([](const JobRecord& job, const HostRecord& host) {
+        return released(job, fmt::format("host {} (its last heartbeat {})", host.name, isoTime(host.seen)));
+      });
+      for (const JobRecord& job : taken) {
+        log->warn("job {}: {}", job.id, job.message);
+        jobChanged(job);
+      }
+      refreshOthers();
+    } catch (const std::exception& error) {
+      log->error("{}", error.what());
+      if (joined && Clock::now() - lastBeat > std::chrono::duration<double>(config.lease)) {
+        fence("it could not renew its lease on the job store in time");
+      }
+    }
+  }
+
+  // This host's lease ran out (it was stalled, or cut off from the store):
+  // another host may take its jobs, so it stops them at once, lasers off,
+  // and joins the store again (which releases what it still held).
+  void fence(const std::string& why) {
+    log->error("host {}: {}: stopping its cuts and plans", config.host, why);
+    joined = false;
+    for (auto& [id, plan] : planning) plan.cancel->cancel();
+    for (auto& [id, cut] : cuts) {
+      cut->control->shutdown = true;
+      cut->control->cancel.cancel();
+      if (cut->waiting) {
+        cut->waiting->set_value(false);
+        cut->waiting.reset();
+      }
+    }
+  }
+
+  void refreshOthers() {
+    std::vector<Target> found;
+    for (const DeviceRecord& device : store->devices()) {
+      if (device.host == config.host || device.state == "gone") continue;
+      try {
+        found.push_back({device.name, device.host, profiles::findMachine(catalogue, device.machine),
+                         profiles::findMaterial(catalogue, device.material)});
+      } catch (const profiles::ProfileError&) {
+        // A profile this host does not have: it cannot plan for that device.
+      }
+    }
+    std::lock_guard lock(othersMutex);
+    others = std::move(found);
+  }
+
+  // " (http://HOST:PORT)" where another host's API answers, when it said.
+  std::string hostAddressSaid(const std::string& host) {
+    try {
+      for (const HostRecord& record : store->hosts()) {
+        if (record.name == host && !record.address.empty()) return " (" + record.address + ")";
+      }
+    } catch (const std::exception&) {
+    }
+    return "";
   }
 
   // Every device is stopped safely before anything is cut: whatever a run
@@ -458,41 +611,81 @@ struct Service::Impl {
 
   // Starts what can start: plans for queued jobs while a planner is free,
   // and cuts of ready jobs on idle devices configured to start by themselves.
+  // Each job is claimed from the store (JobStore::claim), so that on a
+  // shared store no two hosts plan or cut the same one.
   void pump() {
-    if (stopping) return;
+    if (stopping || !joined) return;
     try {
       if (planning.size() < config.planners) {
-        for (const JobRecord& job : store->jobsIn({JobState::Queued}, config.planners - planning.size())) {
-          startPlanning(job);
+        // Any host plans any job, against its device's profiles wherever that device is.
+        std::map<JobId, std::optional<Target>> targets;
+        std::map<JobId, std::string> refusals;
+        const std::vector<JobRecord> claimed =
+            store->claim({JobState::Queued, config.planners - planning.size(), "", ""}, [&](const JobRecord& job) {
+              std::string why;
+              std::optional<Target> device = deviceFor(job.device, job.options, why);
+              Claim claim{JobState::Planning, "planning", {}};
+              if (device) {
+                claim.reason = planningReason(*device);
+                claim.change.device = device->name;
+              }
+              targets[job.id] = std::move(device);
+              refusals[job.id] = why;
+              return std::optional<Claim>(claim);
+            });
+        for (const JobRecord& job : claimed) {
+          if (const auto& device = targets[job.id]) {
+            startPlanning(job, *device);
+          } else {
+            jobChanged(job);
+            jobChanged(store->transition(job.id, JobState::Failed, refusals[job.id]));
+          }
         }
       }
       for (Device& device : devices) {
         if (!device.config.autoStart || device.state != "idle" || device.job) continue;
-        for (const JobRecord& job : store->jobsIn({JobState::Ready}, 1, device.config.name)) {
-          try {
-            startCut(job, 1, fmt::format("started by itself: {} has auto_start", device.config.name));
-          } catch (const std::exception& error) {
-            log->error("job {}: {}", job.id, error.what());
-          }
-        }
+        // Its own jobs, and those for any device of its machine.
+        const std::string reason = fmt::format("started by itself: {} has auto_start", device.config.name);
+        const std::vector<JobRecord> claimed =
+            store->claim({JobState::Ready, 1, device.config.name, device.machine.name},
+                         [&](const JobRecord& job) -> std::optional<Claim> {
+                           if (job.sheets < 1) return std::nullopt;
+                           return Claim{JobState::Running, reason, cutFromSheet(1, device.config.name)};
+                         });
+        for (const JobRecord& job : claimed) launchCut(job, device, 1);
       }
     } catch (const std::exception& error) {
       log->error("{}", error.what());
     }
   }
 
+  static Target targetOf(const Device& device, const std::string& host) {
+    return {device.config.name, host, device.machine, device.material};
+  }
+
   // The device a job is planned against: the one it names, or the first
-  // whose machine profile the job's options do not rule out. It reads only
-  // what open() set (names and profiles), so a submission may ask it off the strand.
-  Device* deviceFor(const std::string& named, const std::string& options, std::string& why) {
-    if (!named.empty()) {
-      Device* device = deviceNamed(named);
-      if (!device) why = fmt::format("there is no device {} now (the devices: {})", named, deviceNames());
-      return device;
+  // (this host's before the others') whose machine profile the job's
+  // options do not rule out. It reads only what open() set and the other
+  // hosts' devices under their lock, so a submission may ask it off the strand.
+  std::optional<Target> deviceFor(const std::string& named, const std::string& options, std::string& why) {
+    std::vector<Target> all;
+    for (const Device& device : devices) all.push_back(targetOf(device, config.host));
+    {
+      std::lock_guard lock(othersMutex);
+      all.insert(all.end(), others.begin(), others.end());
     }
-    if (devices.empty()) {
+    std::string names;
+    for (const Target& target : all) names += (names.empty() ? "" : ", ") + target.name;
+    if (!named.empty()) {
+      for (const Target& target : all) {
+        if (target.name == named) return target;
+      }
+      why = fmt::format("there is no device {} now (the devices: {})", named, names);
+      return std::nullopt;
+    }
+    if (all.empty()) {
       why = "the daemon has no devices";
-      return nullptr;
+      return std::nullopt;
     }
     const json words = json::parse(options.empty() ? "[]" : options, nullptr, false);
     std::string machine;
@@ -501,15 +694,15 @@ struct Service::Impl {
         if (words[i] == "--machine") machine = words[i + 1].get<std::string>();
       }
     }
-    for (Device& device : devices) {
-      if (machine.empty() || device.machine.name == machine) return &device;
+    for (const Target& target : all) {
+      if (machine.empty() || target.machine.name == machine) return target;
     }
-    why = fmt::format("no device has the machine profile {} (the devices: {})", machine, deviceNames());
-    return nullptr;
+    why = fmt::format("no device has the machine profile {} (the devices: {})", machine, names);
+    return std::nullopt;
   }
 
-  static std::string planningReason(const Device& device) {
-    return fmt::format("planning against {} ({})", device.config.name, device.machine.name);
+  static std::string planningReason(const Target& device) {
+    return fmt::format("planning against {} ({})", device.name, device.machine.name);
   }
 
   static std::string plannedReason(int sheets, JobId id) {
@@ -545,7 +738,7 @@ struct Service::Impl {
   // then and there, in the words of the folder the submitter named.
   void planOnSubmission(NewJob& job, const fs::path& folder, const fs::path& submitted) {
     std::string why;
-    const Device* device = deviceFor(job.device, job.options, why);
+    const std::optional<Target> device = deviceFor(job.device, job.options, why);
     if (!device) throw ApiError(409, why);
     json summary;
     try {
@@ -554,24 +747,15 @@ struct Service::Impl {
       throw ApiError(400, inSubmittersWords(error.what(), folder, submitted));
     }
     const int sheets = summary["sheets"].get<int>();
-    job.change.device = device->config.name;
+    job.change.device = device->name;
     job.change.sheets = sheets;
     job.change.summary = summary.dump();
     job.then = {{JobState::Planning, [reason = planningReason(*device)](JobId) { return reason; }},
                 {JobState::Ready, [sheets](JobId id) { return plannedReason(sheets, id); }}};
   }
 
-  void startPlanning(const JobRecord& queued) {
-    std::string why;
-    Device* device = deviceFor(queued.device, queued.options, why);
-    if (!device) {
-      jobChanged(store->transition(queued.id, JobState::Planning, "planning"));
-      jobChanged(store->transition(queued.id, JobState::Failed, why));
-      return;
-    }
-    JobChange change;
-    change.device = device->config.name;
-    const JobRecord job = store->transition(queued.id, JobState::Planning, planningReason(*device), change);
+  // A job this host claimed to plan (planning, its device set): planned on a planner.
+  void startPlanning(const JobRecord& job, const Target& device) {
     jobChanged(job);
     auto cancel = std::make_shared<core::Cancellation>();
     // A plan that takes longer than plan_timeout is stopped, and its job fails saying so.
@@ -586,7 +770,7 @@ struct Service::Impl {
       }
     });
     planning[job.id] = Planning{cancel, json(), "", timeout};
-    asio::post(planners, [this, job, machine = device->machine, material = device->material, cancel] {
+    asio::post(planners, [this, job, machine = device.machine, material = device.material, cancel] {
       plan(job, machine, material, cancel);
     });
   }
@@ -697,9 +881,40 @@ struct Service::Impl {
     });
   }
 
+  // What a cut from `fromSheet` on `device` changes in its job.
+  static JobChange cutFromSheet(int fromSheet, const std::string& device) {
+    JobChange change;
+    change.device = device;
+    change.sheet = fromSheet;
+    change.stroke = 0;
+    change.strokes = 0;
+    return change;
+  }
+
+  // The device of this host a job is cut on: its own, or, for a job
+  // submitted for any device, one of this host's of the same machine.
+  // Otherwise another host's device: the job is started there.
+  Device& localDeviceFor(const JobRecord& job) {
+    if (Device* own = deviceNamed(job.device)) return *own;
+    std::string why;
+    const std::optional<Target> planned = deviceFor(job.device, "", why);
+    if (job.anyDevice && planned) {
+      Device* idle = nullptr;
+      for (Device& device : devices) {
+        if (device.machine.name != planned->machine.name) continue;
+        if (!idle || (device.state == "idle" && !device.job)) idle = &device;
+      }
+      if (idle) return *idle;
+    }
+    if (planned) {
+      throw ApiError(409, fmt::format("job {} is for {}, a device of host {}{}: start it there", job.id, job.device,
+                                      planned->host, hostAddressSaid(planned->host)));
+    }
+    throw ApiError(409, fmt::format("job {}: there is no device {} now", job.id, job.device));
+  }
+
   void startCut(const JobRecord& job, int fromSheet, const std::string& reason) {
-    Device* device = deviceNamed(job.device);
-    if (!device) throw ApiError(409, fmt::format("job {}: there is no device {} now", job.id, job.device));
+    Device* device = &localDeviceFor(job);
     if (device->job) {
       throw ApiError(409, fmt::format("{} is busy with job {}; job {} can start once it is done", device->config.name,
                                       *device->job, job.id));
@@ -720,11 +935,13 @@ struct Service::Impl {
     if (fromSheet < 1 || fromSheet > job.sheets) {
       throw ApiError(400, fmt::format("job {} has sheets 1 to {}, not {}", job.id, job.sheets, fromSheet));
     }
-    JobChange change;
-    change.sheet = fromSheet;
-    change.stroke = 0;
-    change.strokes = 0;
-    const JobRecord running = store->transition(job.id, JobState::Running, reason, change);
+    launchCut(store->transition(job.id, JobState::Running, reason, cutFromSheet(fromSheet, device->config.name)),
+              *device, fromSheet);
+  }
+
+  // A job this host moved to running on `device`: its cut on a thread of its own.
+  void launchCut(const JobRecord& job, Device& on, int fromSheet) {
+    Device* device = &on;
     const size_t index = static_cast<size_t>(device - devices.data());
     auto cut = std::make_unique<Cut>();
     cut->control = std::make_shared<RunControl>();
@@ -741,7 +958,7 @@ struct Service::Impl {
                      material = device->material, folder, fromSheet,
                      sheets = job.sheets] { runCut(id, control, uri, machine, material, folder, fromSheet, sheets); });
     log->info("job {}: cutting on {} from sheet {}", job.id, device->config.name, fromSheet);
-    jobChanged(running);
+    jobChanged(job);
     deviceChanged(*device);
   }
 
@@ -1025,6 +1242,15 @@ struct Service::Impl {
     const auto refuse = [&](const std::string& why) -> Reply {
       throw ApiError(409, fmt::format("job {} is {}{}", id, stateName(job.state), why));
     };
+    // A job another host is planning or cutting is that host's to act on (its driver, its planner).
+    if (heldByAHost(job.state) && !job.host.empty() && job.host != config.host &&
+        (action == "cancel" || action == "pause" || action == "resume" || action == "next")) {
+      refuse(fmt::format(" on host {}{}: ask that host to {} it", job.host, hostAddressSaid(job.host), action));
+    }
+    // (Held by this host, a job is in `planning` or `cuts` until it leaves that state.)
+    if ((job.state == JobState::Planning && !planning.contains(id)) || (holdsDevice(job.state) && !cuts.contains(id))) {
+      refuse(", but this daemon is not working on it (it is being released); ask again in a moment");
+    }
     if (action == "cancel") {
       if (job.state == JobState::Planning) {
         planning[id].cancelledBy = who;
@@ -1167,7 +1393,7 @@ void Service::start() {
   auto done = recovered.get_future();
   impl_->onStrand([this, &recovered] {
     try {
-      impl_->recover();
+      impl_->join();
       recovered.set_value();
     } catch (...) {
       recovered.set_exception(std::current_exception());
@@ -1373,7 +1599,8 @@ void Service::sheet(JobId id, int sheet, ReplyHandler done) {
       if (sheet < 1 || sheet > job.sheets) {
         throw ApiError(404, fmt::format("job {} has sheets 1 to {}, not {}", id, job.sheets, sheet));
       }
-      const Impl::Device* device = impl_->deviceNamed(job.device);
+      std::string why;
+      const std::optional<Impl::Target> device = impl_->deviceFor(job.device, "", why);
       if (!device) throw ApiError(409, fmt::format("job {} has no device to plan its strokes for", id));
       work = [folder = impl_->plannedFolder(job), machine = device->machine, material = device->material, sheet, id] {
         const std::vector<jobs::JobSheet> drawn = jobs::readJobSheets(folder, std::optional<int>(sheet));
@@ -1402,7 +1629,32 @@ void Service::devices(ReplyHandler done) {
   impl_->answer(std::move(done), [this] {
     json all = json::array();
     for (const auto& device : impl_->devices) all.push_back(impl_->deviceJson(device));
-    return Reply{200, {{"devices", all}}};
+    if (!impl_->store->shared()) return Reply{200, {{"devices", all}}};
+    // On a shared store, the other hosts' devices as their hosts last said, and the hosts.
+    json hosts = json::array();
+    std::set<std::string> gone;
+    for (const HostRecord& host : impl_->store->hosts()) {
+      if (host.gone) gone.insert(host.name);
+      json entry{{"name", host.name},
+                 {"address", host.address},
+                 {"state", host.gone ? "gone" : "up"},
+                 {"seen", isoTime(host.seen)}};
+      hosts.push_back(std::move(entry));
+    }
+    for (const DeviceRecord& device : impl_->store->devices()) {
+      if (device.host == impl_->config.host) continue;
+      json entry{{"name", device.name},
+                 {"host", device.host},
+                 {"uri", device.uri},
+                 {"machine", device.machine},
+                 {"material", device.material},
+                 {"auto_start", device.autoStart},
+                 {"state", gone.contains(device.host) ? "gone" : device.state}};
+      if (!device.message.empty()) entry["message"] = device.message;
+      entry["job"] = device.job ? json(*device.job) : json(nullptr);
+      all.push_back(std::move(entry));
+    }
+    return Reply{200, {{"devices", all}, {"hosts", hosts}}};
   });
 }
 

@@ -35,7 +35,7 @@ void syncFolder(const fs::path& folder) {
   }
 }
 
-Spool::Spool(fs::path folder) : folder_(std::move(folder)) {
+Spool::Spool(fs::path folder, std::string owner) : folder_(std::move(folder)), owner_(std::move(owner)) {
   std::error_code error;
   fs::create_directories(folder_, error);
   if (error)
@@ -43,7 +43,7 @@ Spool::Spool(fs::path folder) : folder_(std::move(folder)) {
 }
 
 Spool::Entry Spool::begin() const {
-  const std::string name = "job-" + randomName();
+  const std::string name = "job-" + randomName() + (owner_.empty() ? "" : "@" + owner_);
   fs::path folder = folder_ / name;
   std::error_code error;
   fs::create_directory(folder, error);
@@ -137,6 +137,7 @@ size_t Spool::removeOrphans(const std::set<std::string>& named) const {
     const std::string name = entry.path().filename().string();
     if (named.contains(name)) continue;
     if (!name.starts_with("job-")) continue;
+    if (!owner_.empty() && !name.ends_with("@" + owner_)) continue;  // another host's, perhaps being filled now
     std::error_code ignored;
     fs::remove_all(entry.path(), ignored);
     ++removed;

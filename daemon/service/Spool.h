@@ -22,7 +22,9 @@ namespace rotafab::service {
 class Spool {
  public:
   // Creates the folder if need be; throws std::runtime_error naming it.
-  explicit Spool(std::filesystem::path folder);
+  // `owner`: the host whose entries these are, in a spool several hosts
+  // share (each entry's name ends in "@owner", and a host removes only its own orphans).
+  explicit Spool(std::filesystem::path folder, std::string owner = "");
 
   // An entry being filled; removed unless committed.
   class Entry {
@@ -51,7 +53,7 @@ class Spool {
     bool committed_ = false;
   };
 
-  // A new entry, "job-<random>".
+  // A new entry, "job-<random>" (then "@owner" when there is one).
   Entry begin() const;
   [[nodiscard]] std::filesystem::path pathOf(const std::string& name) const { return folder_ / name; }
   [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }
@@ -60,6 +62,7 @@ class Spool {
 
  private:
   std::filesystem::path folder_;
+  std::string owner_;
 };
 
 // fsync of a folder, which makes the names in it (a rename) durable.

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "daemon/service/JobStore.h"
+#include "daemon/service/StoreRows.h"
 #include "daemon/service/StoreSchema.h"
 
 namespace rotafab::service {
@@ -104,6 +105,7 @@ class Statement {
     fail("step");
   }
   int64_t integer(int column) const { return sqlite3_column_int64(statement_, column); }
+  int columns() const { return sqlite3_column_count(statement_); }
   double real(int column) const { return sqlite3_column_double(statement_, column); }
   void reset() { sqlite3_reset(statement_); }
   bool isNull(int column) const { return sqlite3_column_type(statement_, column) == SQLITE_NULL; }
@@ -159,32 +161,10 @@ class Transaction {
   bool committed_ = false;
 };
 
-constexpr const char* kJobColumns =
-    "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
-    "summary, sheet, stroke, strokes, message";
-
-JobRecord jobOf(const Statement& row) {
-  JobRecord job;
-  job.id = row.integer(0);
-  job.state = stateNamed(row.text(1)).value_or(JobState::Failed);
-  job.kind = row.text(2) == "planned" ? JobKind::Planned : JobKind::Mesh;
-  job.source = row.text(3);
-  job.owner = row.text(4);
-  job.device = row.text(5);
-  job.priority = static_cast<int>(row.integer(6));
-  job.position = row.real(7);
-  job.options = row.text(8);
-  job.spool = row.text(9);
-  job.submitted = row.real(10);
-  job.updated = row.real(11);
-  job.sheets = static_cast<int>(row.integer(12));
-  job.summary = row.text(13);
-  job.sheet = static_cast<int>(row.integer(14));
-  job.stroke = row.integer(15);
-  job.strokes = row.integer(16);
-  job.message = row.text(17);
-  return job;
-}
+// The jobs for a device (its name, then its machine's): those submitted for
+// it, and those for any device that were planned for a device of its machine.
+constexpr const char* kForTheDevice =
+    " AND (device = ? OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = ?)))";
 
 class SqliteStore final : public JobStore, private JobRows {
  public:
@@ -202,6 +182,8 @@ class SqliteStore final : public JobStore, private JobRows {
       execute(db_, "PRAGMA synchronous=FULL", doing("set synchronous=FULL").c_str());
       execute(db_, "PRAGMA foreign_keys=ON", doing("turn on foreign keys").c_str());
       migrate(upTo.value_or(newestSchemaVersion()));
+      version_ = schemaVersion();
+      columns_ = jobColumns(version_);
       statements_.emplace(db_);
     } catch (...) {
       sqlite3_close(db_);
@@ -230,7 +212,7 @@ class SqliteStore final : public JobStore, private JobRows {
   }
 
   std::optional<JobRecord> job(JobId id) override {
-    Statement select(*statements_, fmt::format("SELECT {} FROM jobs WHERE id = ?", kJobColumns));
+    Statement select(*statements_, fmt::format("SELECT {} FROM jobs WHERE id = ?", columns_));
     select.bind(1, id);
     if (!select.step()) return std::nullopt;
     return jobOf(select);
@@ -243,7 +225,7 @@ class SqliteStore final : public JobStore, private JobRows {
   }
 
   void eachJob(const std::function<void(const JobRecord&)>& visit) override {
-    Statement select(*statements_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", kJobColumns));
+    Statement select(*statements_, fmt::format("SELECT {} FROM jobs ORDER BY priority DESC, position", columns_));
     while (select.step()) visit(jobOf(select));
   }
 
@@ -253,7 +235,7 @@ class SqliteStore final : public JobStore, private JobRows {
     Statement select(*statements_,
                      fmt::format("SELECT {} FROM jobs WHERE state IN ({}){} ORDER BY priority DESC, position "
                                  "LIMIT ?",
-                                 kJobColumns, marks, device.empty() ? "" : " AND device = ?"));
+                                 columns_, marks, device.empty() ? "" : " AND device = ?"));
     int index = 1;
     for (JobState state : states) select.bind(index++, stateName(state));
     if (!device.empty()) select.bind(index++, device);
@@ -267,6 +249,7 @@ class SqliteStore final : public JobStore, private JobRows {
     Transaction transaction(db_);
     const auto current = job(id);
     if (!current) throw TransitionRefused(fmt::format("there is no job {}", id));
+    checkHolder(*current, host_);
     move(id, current->state, to, unixSeconds(), reason);
     apply(id, change);
     transaction.commit();
@@ -277,6 +260,101 @@ class SqliteStore final : public JobStore, private JobRows {
     Transaction transaction(db_);
     apply(id, change);
     transaction.commit();
+  }
+
+  // ---- hosts: one, this daemon (the store is in its state directory) ----
+
+  bool shared() const override { return false; }
+
+  std::vector<JobRecord> join(const HostRecord& me, const std::vector<DeviceRecord>& devices, double lease, double,
+                              const Release& release) override {
+    Transaction transaction(db_);
+    const double now = unixSeconds();
+    execute(db_, "DELETE FROM devices", doing("forget the devices").c_str());
+    {
+      Statement others(*statements_, "DELETE FROM hosts WHERE name <> ?");
+      others.bind(1, me.name);
+      others.step();
+      Statement upsert(*statements_,
+                       "INSERT INTO hosts (name, address, started, seen, lease_until, gone) VALUES (?, ?, ?, ?, ?, 0) "
+                       "ON CONFLICT (name) DO UPDATE SET address = excluded.address, started = excluded.started, "
+                       "seen = excluded.seen, lease_until = excluded.lease_until, gone = 0");
+      upsert.bind(1, me.name).bind(2, me.address).bind(3, now).bind(4, now).bind(5, now + lease);
+      upsert.step();
+    }
+    for (const DeviceRecord& device : devices) insertDevice(device, me.name);
+    host_ = me.name;
+    // Whatever any host held before is this one's to release: it alone uses the store.
+    std::vector<JobRecord> held;
+    {
+      Statement select(*statements_, fmt::format("SELECT {} FROM jobs WHERE state IN ('planning', 'running', "
+                                                 "'paused') ORDER BY id",
+                                                 columns_));
+      while (select.step()) held.push_back(jobOf(select));
+    }
+    const std::vector<JobId> released = moveRows(held, releasing(release, me), *this);
+    transaction.commit();
+    return jobsNumbered(released);
+  }
+
+  // Nothing to renew: no other host could take this one's jobs (and a
+  // synced write every few seconds would cost for nothing).
+  bool heartbeat(double) override { return true; }
+  std::vector<JobRecord> releaseLapsedHosts(const Release&) override { return {}; }
+
+  std::vector<JobRecord> jobsNumbered(const std::vector<JobId>& ids) {
+    std::vector<JobRecord> all;
+    for (JobId id : ids) all.push_back(*job(id));
+    return all;
+  }
+
+  std::vector<HostRecord> hosts() override {
+    Statement select(*statements_, fmt::format("SELECT {} FROM hosts ORDER BY name", kHostColumns));
+    std::vector<HostRecord> all;
+    while (select.step()) all.push_back(hostOf(select));
+    return all;
+  }
+
+  std::vector<DeviceRecord> devices() override {
+    Statement select(*statements_, fmt::format("SELECT {} FROM devices ORDER BY name", kDeviceColumns));
+    std::vector<DeviceRecord> all;
+    while (select.step()) all.push_back(deviceOf(select));
+    return all;
+  }
+
+  void putDevice(const DeviceRecord& device) override {
+    Transaction transaction(db_);
+    Statement set(*statements_, "UPDATE devices SET state = ?, message = ?, job = ? WHERE name = ? AND host = ?");
+    set.bind(1, device.state).bind(2, device.message);
+    if (device.job) {
+      set.bind(3, *device.job);
+    } else {
+      set.bindNull(3);
+    }
+    set.bind(4, device.name).bind(5, host_);
+    set.step();
+    transaction.commit();
+  }
+
+  std::vector<JobRecord> claim(const ClaimQuery& query, const ClaimDecision& decide) override {
+    Transaction transaction(db_);
+    std::vector<JobRecord> found;
+    {
+      Statement select(*statements_,
+                       fmt::format("SELECT {} FROM jobs WHERE state = ?{} ORDER BY priority DESC, position LIMIT ?",
+                                   columns_, query.device.empty() ? "" : kForTheDevice));
+      int index = 1;
+      select.bind(index++, stateName(query.from));
+      if (!query.device.empty()) {
+        select.bind(index, query.device).bind(index + 1, query.machine);
+        index += 2;
+      }
+      select.bind(index, static_cast<int64_t>(std::min<size_t>(query.limit, INT64_MAX)));
+      while (select.step()) found.push_back(jobOf(select));
+    }
+    const std::vector<JobId> moved = moveRows(found, decide, *this);
+    transaction.commit();
+    return jobsNumbered(moved);
   }
 
   void reorder(JobId id, int priority, double position) override {
@@ -375,10 +453,29 @@ class SqliteStore final : public JobStore, private JobRows {
     }
   }
 
+  void insertDevice(const DeviceRecord& device, const std::string& host) {
+    Statement insert(*statements_,
+                     "INSERT INTO devices (name, host, machine, material, uri, auto_start, state, message, job) "
+                     "VALUES (?, ?, ?, ?, ?, ?, ?, ?, NULL)");
+    insert.bind(1, device.name)
+        .bind(2, host)
+        .bind(3, device.machine)
+        .bind(4, device.material)
+        .bind(5, device.uri)
+        .bind(6, static_cast<int64_t>(device.autoStart))
+        .bind(7, device.state)
+        .bind(8, device.message);
+    insert.step();
+  }
+
   JobId insertRow(const NewJob& job, double position, double at) override {
     Statement insert(*statements_,
-                     "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
-                     "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+                     version_ >= kFirstVersionWithHosts
+                         ? "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                           "submitted, updated, any_device) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"
+                         : "INSERT INTO jobs (state, kind, source, owner, device, priority, position, options, spool, "
+                           "submitted, updated) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    if (version_ >= kFirstVersionWithHosts) insert.bind(12, static_cast<int64_t>(job.device.empty()));
     insert.bind(1, stateName(JobState::Queued))
         .bind(2, kindName(job.kind))
         .bind(3, job.source)
@@ -420,9 +517,15 @@ class SqliteStore final : public JobStore, private JobRows {
     if (!allowedTransition(from, to)) {
       throw TransitionRefused(fmt::format("job {} is {}; it cannot become {}", id, stateName(from), stateName(to)));
     }
-    Statement set(*statements_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
-    set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
-    set.step();
+    if (version_ >= kFirstVersionWithHosts) {
+      Statement set(*statements_, "UPDATE jobs SET state = ?, message = ?, updated = ?, host = ? WHERE id = ?");
+      set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, heldByAHost(to) ? host_ : "").bind(5, id);
+      set.step();
+    } else {
+      Statement set(*statements_, "UPDATE jobs SET state = ?, message = ?, updated = ? WHERE id = ?");
+      set.bind(1, stateName(to)).bind(2, reason).bind(3, at).bind(4, id);
+      set.step();
+    }
     record(id, from, to, at, reason);
   }
 
@@ -440,6 +543,9 @@ class SqliteStore final : public JobStore, private JobRows {
   }
 
   std::filesystem::path file_;
+  int version_ = 0;
+  std::string columns_;  // a job's (jobColumns())
+  std::string host_;     // this daemon's, once it joined
   sqlite3* db_ = nullptr;
   std::optional<StatementCache> statements_;
 };

@@ -54,6 +54,32 @@ constexpr const char* kMigrations[] = {
     // 4: the end of the queue, where a new job goes, found without reading
     // every job (MAX over jobs_queue's second column reads the whole index).
     R"(CREATE INDEX jobs_position ON jobs(position);)",
+    // 5: several hosts on one store. Each host's row says until when it is
+    // alive (its lease, renewed by its heartbeat); a job in planning,
+    // running or paused names the host that holds it; a job submitted for
+    // any device may be cut by any device of the machine it was planned
+    // for; and every host's devices are listed, so that each host can plan
+    // for the others' and show them.
+    R"(CREATE TABLE hosts (
+         name TEXT PRIMARY KEY,
+         address TEXT NOT NULL,
+         started {real} NOT NULL,
+         seen {real} NOT NULL,
+         lease_until {real} NOT NULL,
+         gone {integer} NOT NULL DEFAULT 0);
+       CREATE TABLE devices (
+         name TEXT PRIMARY KEY,
+         host TEXT NOT NULL,
+         machine TEXT NOT NULL,
+         material TEXT NOT NULL,
+         uri TEXT NOT NULL,
+         auto_start {integer} NOT NULL,
+         state TEXT NOT NULL,
+         message TEXT NOT NULL DEFAULT '',
+         job {integer});
+       ALTER TABLE jobs ADD COLUMN host TEXT NOT NULL DEFAULT '';
+       ALTER TABLE jobs ADD COLUMN any_device {integer} NOT NULL DEFAULT 0;
+       CREATE INDEX jobs_host ON jobs(host, state);)",
 };
 
 std::string replaced(std::string sql, const std::string& word, const std::string& by) {
@@ -73,6 +99,14 @@ std::string migrationSql(int from, StoreEngine engine) {
   sql = replaced(sql, "{integer}", sqlite ? "INTEGER" : "BIGINT");
   sql = replaced(sql, "{real}", sqlite ? "REAL" : "DOUBLE PRECISION");
   return sql;
+}
+
+std::string jobColumns(int version) {
+  std::string columns =
+      "id, state, kind, source, owner, device, priority, position, options, spool, submitted, updated, sheets, "
+      "summary, sheet, stroke, strokes, message";
+  if (version >= kFirstVersionWithHosts) columns += ", host, any_device";
+  return columns;
 }
 
 int newestSchemaVersion() { return static_cast<int>(std::size(kMigrations)); }

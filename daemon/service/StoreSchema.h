@@ -19,6 +19,14 @@ std::string migrationSql(int from, StoreEngine engine);
 // The newest schema version this program knows.
 int newestSchemaVersion();
 
+// The columns a job is read by, in this order, in a store at schema
+// `version` (a store opened at an older one, as the migrations' tests do,
+// reads the columns it has): id, state, kind, source, owner, device,
+// priority, position, options, spool, submitted, updated, sheets, summary,
+// sheet, stroke, strokes, message; from version 5 host and any_device.
+std::string jobColumns(int version);
+constexpr int kFirstVersionWithHosts = 5;
+
 // Queries that find a store whose jobs and transitions disagree, each
 // returning one row per fault with its description in the first column, in
 // words both engines accept: a job in a state no program knows, a job whose

@@ -549,12 +549,13 @@ TEST(Daemon, OneDaemonPerStateDirectoryAndAConfigMistakeIsOneLine) {
 
 // `store: postgresql://...`: the same daemon on a PostgreSQL server. A job
 // is planned and cut, a kill mid-cut leaves it interrupted (resumed only by
-// an operator), and a second daemon on the store is refused in one line.
+// an operator), and a second daemon under the same host name is refused in one line.
 TEST(Daemon, OnAPostgresStoreAKillMidCutLeavesTheJobInterruptedAndASecondDaemonIsRefused) {
   test::TestDatabase database;
   TempDir root, otherRoot;
-  const std::string config =
-      "store: " + database.uri() + "\ndevices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=5\"}]\n";
+  const std::string config = "store: " + database.uri() +
+                             "\nhost: solo\nlease: 2\ndevices: [{name: laser1, machine: grbl-diode-400, uri: "
+                             "\"sim:grbl?speed=5\"}]\n";
   Daemon daemon(root.path(), config);
   daemon.start();
   const long long id = cuttingThreeSheets(daemon);
@@ -562,7 +563,7 @@ TEST(Daemon, OnAPostgresStoreAKillMidCutLeavesTheJobInterruptedAndASecondDaemonI
 
   Daemon second(otherRoot.path(), config);
   EXPECT_EQ(second.runToEnd({"--config", (otherRoot.path() / "rotafabd.yaml").string()}), 1);
-  EXPECT_NE(readFile(second.log()).find(": another rotafabd uses this job store"), std::string::npos)
+  EXPECT_NE(readFile(second.log()).find(": another rotafabd runs as host solo on this job store"), std::string::npos)
       << readFile(second.log());
 
   daemon.kill9();

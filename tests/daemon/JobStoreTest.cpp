@@ -8,7 +8,9 @@
 
 #include <fmt/format.h>
 
+#include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <thread>
 
@@ -361,32 +363,147 @@ TEST(JobStore, APostgresStoreThatCannotBeReachedIsOneLineWithoutItsPassword) {
   EXPECT_EQ(uriWithoutPassword("postgresql://ann@db:5432/jobs"), "postgresql://ann@db:5432/jobs");
 }
 
-// Until the hosts that share a store claim their work from it, a second
-// daemon on a store is refused, and the store is free again once the first
-// has gone.
-TEST(JobStore, APostgresStoreOpenedForADaemonIsThatDaemonsAlone) {
+HostRecord host(const std::string& name) { return {name, "http://127.0.0.1:1/" + name, 0, 0, 0, false}; }
+
+DeviceRecord device(const std::string& name, const std::string& machine = "grbl-diode-400") {
+  DeviceRecord record;
+  record.name = name;
+  record.machine = machine;
+  record.material = "posterboard";
+  record.uri = "sim:grbl";
+  record.state = "idle";
+  return record;
+}
+
+const Release kReleased = [](const JobRecord& job, const HostRecord& by) {
+  return std::pair{holdsDevice(job.state) ? JobState::Interrupted : JobState::Queued, "released from " + by.name};
+};
+
+// A host name is one daemon's at a time on a shared store: a second daemon
+// under it waits for the first one's lease, then is refused; and a device
+// name is one host's.
+TEST(JobStore, OnASharedStoreAHostNameAndADeviceNameAreOneDaemonsAtATime) {
+  test::TestDatabase database;
+  auto first = openPostgresStore(database.uri());
+  ASSERT_TRUE(first->shared());
+  EXPECT_TRUE(first->join(host("a"), {device("laser1")}, 30, 0, kReleased).empty());
+  auto second = openPostgresStore(database.uri());
+  try {
+    second->join(host("a"), {}, 30, 0.3, kReleased);
+    FAIL();
+  } catch (const StoreError& error) {
+    EXPECT_NE(std::string(error.what()).find("another rotafabd runs as host a on this job store"), std::string::npos)
+        << error.what();
+  }
+  try {
+    second->join(host("b"), {device("laser1")}, 30, 0, kReleased);
+    FAIL();
+  } catch (const StoreError& error) {
+    EXPECT_NE(std::string(error.what()).find("device laser1 is host a's"), std::string::npos) << error.what();
+  }
+  EXPECT_NO_THROW(second->join(host("b"), {device("laser2")}, 30, 0, kReleased));
+  const auto devices = second->devices();
+  ASSERT_EQ(devices.size(), 2u);
+  EXPECT_EQ(devices[0].host, "a");
+  EXPECT_EQ(devices[1].host, "b");
+}
+
+// Hosts claiming at once from one queue: each job claimed by exactly one,
+// which then holds it (and only it moves it).
+TEST(JobStore, JobsClaimedByTwoHostsAtOnceAreEachClaimedOnce) {
   test::TestDatabase database;
   {
-    auto first = openPostgresStore(database.uri(), std::nullopt, true);
-    try {
-      openPostgresStore(database.uri(), std::nullopt, true);
-      FAIL();
-    } catch (const StoreError& error) {
-      EXPECT_NE(std::string(error.what()).find("another rotafabd uses this job store"), std::string::npos)
-          << error.what();
-    }
-    auto reader = openPostgresStore(database.uri());  // a reader (a test, a check) is not a daemon
-    EXPECT_EQ(reader->integrityCheck(), "ok");
+    auto store = openPostgresStore(database.uri());
+    for (int i = 0; i < 60; ++i) store->addJob(meshJob(fmt::format("j{}", i)), "s");
   }
-  EXPECT_NO_THROW(openPostgresStore(database.uri(), std::nullopt, true));
+  std::map<std::string, std::vector<JobId>> claimed;
+  std::vector<std::thread> hosts;
+  std::mutex mutex;
+  for (const std::string name : {"a", "b", "c"}) {
+    hosts.emplace_back([&, name] {
+      auto store = openPostgresStore(database.uri());
+      store->join(host(name), {device("laser-" + name)}, 30, 0, kReleased);
+      for (;;) {
+        const auto taken = store->claim({JobState::Queued, 2, "", ""}, [&](const JobRecord&) {
+          return std::optional<Claim>(Claim{JobState::Planning, "planning on " + name, {}});
+        });
+        if (taken.empty()) return;
+        std::lock_guard lock(mutex);
+        for (const JobRecord& job : taken) {
+          EXPECT_EQ(job.host, name);
+          claimed[name].push_back(job.id);
+        }
+      }
+    });
+  }
+  for (std::thread& thread : hosts) thread.join();
+  std::set<JobId> once;
+  size_t total = 0;
+  for (const auto& [name, ids] : claimed) {
+    total += ids.size();
+    once.insert(ids.begin(), ids.end());
+  }
+  EXPECT_EQ(total, 60u);
+  EXPECT_EQ(once.size(), 60u);
+  auto store = openPostgresStore(database.uri());
+  store->join(host("d"), {}, 30, 0, kReleased);
+  const JobId someone = *once.begin();
+  try {
+    store->transition(someone, JobState::Ready, "planned by d");
+    FAIL();
+  } catch (const TransitionRefused& error) {
+    EXPECT_NE(std::string(error.what()).find(" is planning on host "), std::string::npos) << error.what();
+  }
+  for (const JobRecord& job : store->jobs()) EXPECT_EQ(store->transitions(job.id).size(), 2u) << job.id;
+  EXPECT_EQ(store->integrityCheck(), "ok");
+}
+
+// A host whose lease runs out: another host releases its jobs, once (its
+// plan made again, its cut interrupted), its devices are gone with it, and
+// it no longer moves or writes to them.
+TEST(JobStore, ALapsedHostsJobsAreReleasedOnceByAnotherHost) {
+  test::TestDatabase database;
+  auto a = openPostgresStore(database.uri());
+  auto b = openPostgresStore(database.uri());
+  auto c = openPostgresStore(database.uri());
+  a->join(host("a"), {device("laser-a")}, 1, 0, kReleased);
+  b->join(host("b"), {device("laser-b")}, 30, 0, kReleased);
+  c->join(host("c"), {}, 30, 0, kReleased);
+  const JobId planned = a->addJob(meshJob("planned"), "s").id;
+  const JobId cut = a->addJob(meshJob("cut"), "s").id;
+  const auto claim = [&](JobStore& store, JobState from, JobState to) {
+    return store.claim({from, 1, "", ""}, [&](const JobRecord&) { return std::optional<Claim>(Claim{to, "", {}}); });
+  };
+  ASSERT_EQ(claim(*a, JobState::Queued, JobState::Planning).size(), 1u);
+  a->transition(planned, JobState::Ready, "planned");
+  ASSERT_EQ(claim(*a, JobState::Ready, JobState::Running).front().id, planned);
+  ASSERT_EQ(claim(*a, JobState::Queued, JobState::Planning).front().id, cut);
+  EXPECT_TRUE(b->releaseLapsedHosts(kReleased).empty());  // its lease still runs
+  std::this_thread::sleep_for(std::chrono::milliseconds(1300));
+  std::vector<JobRecord> byB, byC;
+  std::thread other([&] { byC = c->releaseLapsedHosts(kReleased); });
+  byB = b->releaseLapsedHosts(kReleased);
+  other.join();
+  ASSERT_EQ(byB.size() + byC.size(), 2u);
+  EXPECT_EQ(b->job(planned)->state, JobState::Interrupted);
+  EXPECT_EQ(b->job(planned)->message, "released from a");
+  EXPECT_EQ(b->job(cut)->state, JobState::Queued);
+  EXPECT_EQ(b->job(cut)->host, "");
+  EXPECT_FALSE(a->heartbeat(1));
+  EXPECT_THROW(a->transition(cut, JobState::Ready, "planned"), TransitionRefused);
+  for (const HostRecord& h : b->hosts()) EXPECT_EQ(h.gone, h.name == "a") << h.name;
+  for (const DeviceRecord& d : b->devices()) EXPECT_EQ(d.state == "gone", d.host == "a") << d.name;
+  // Joined again, it starts afresh.
+  EXPECT_TRUE(a->join(host("a"), {device("laser-a")}, 1, 0, kReleased).empty());
+  EXPECT_TRUE(a->heartbeat(1));
+  EXPECT_EQ(b->integrityCheck(), "ok");
 }
 
 // The server ended the store's connection (a restart, an administrator):
-// the store connects again at its next call, as it was opened, holding the
-// store for its daemon again.
+// the store connects again at its next call, as it was opened.
 TEST(JobStore, APostgresStoreWhoseConnectionWasEndedConnectsAgain) {
   test::TestDatabase database;
-  auto store = openPostgresStore(database.uri(), std::nullopt, true);
+  auto store = openPostgresStore(database.uri());
   const JobId id = store->addJob(meshJob("a"), "s").id;
   const auto endItsConnections = [&] {
     test::serverSql("SELECT pg_terminate_backend(pid) FROM pg_stat_activity WHERE datname = '" + database.name() +
@@ -396,7 +513,6 @@ TEST(JobStore, APostgresStoreWhoseConnectionWasEndedConnectsAgain) {
   EXPECT_EQ(store->job(id)->source, "a");
   endItsConnections();
   EXPECT_EQ(store->addJob(meshJob("b"), "s").id, id + 1);  // a transaction's BEGIN connects again too
-  EXPECT_THROW(openPostgresStore(database.uri(), std::nullopt, true), StoreError);
   EXPECT_EQ(store->integrityCheck(), "ok");
 }
 

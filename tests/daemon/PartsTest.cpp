@@ -75,8 +75,11 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
       "listen: [tcp://0.0.0.0:8730]\n",
       "1:10: listen[0]: tcp://0.0.0.0:8730 is reachable from other machines: give tokens (rotafabd --hash-token)");
   expectRefused("statedir: /tmp\n",
-                "1:1: statedir: unknown key (expected one of: state_dir, store, host, listen, tokens, devices, "
-                "upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
+                "1:1: statedir: unknown key (expected one of: state_dir, store, host, spool, lease, listen, tokens, "
+                "devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
+  expectRefused("host: cutter room\n",
+                "1:7: host: expected a name of letters, digits, '.', '_' and '-', such as cutter-room-2");
+  expectRefused("lease: 0.5\n", "1:8: lease: must be between 1 and 3600, not 0.5");
   expectRefused("devices: [{name: a, uri: x}, {name: a, uri: y}]\n",
                 "1:37: devices[1].name: another device has this name");
   expectRefused(
@@ -85,6 +88,11 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
   expectRefused("devices: [a\n", "2:1: syntax: end of sequence flow not found");
   EXPECT_EQ(loadConfig(dir.write("plan.yaml", "plan_timeout: 90\n")).planTimeout, 90);
   EXPECT_EQ(defaults.planTimeout, 3600);
+  const DaemonConfig shared = loadConfig(dir.write("shared.yaml", "host: room-2\nspool: /mnt/fab/spool\nlease: 4\n"));
+  EXPECT_EQ(shared.host, "room-2");
+  EXPECT_EQ(shared.spool, "/mnt/fab/spool");
+  EXPECT_EQ(shared.lease, 4);
+  EXPECT_EQ(defaults.lease, 10);
 }
 
 TEST(DaemonConfig, ATokenMatchesOnlyTheHashMadeFromIt) {
