@@ -106,14 +106,19 @@ void printJobs(const json& jobs) {
     fmt::print("no jobs; submit one with `rotafab submit MESH --structure band`\n");
     return;
   }
-  fmt::print("{:>4}  {:<11}  {:<10}  {:>6}  {:<10}  {:<22}  {}\n", "ID", "STATE", "DEVICE", "SHEETS", "OWNER", "SOURCE",
-             "NOTE");
+  // On a shared store the host that plans or cuts a job is shown with its device: laser2@room-2.
+  const bool hosts =
+      std::any_of(jobs.begin(), jobs.end(), [](const json& job) { return job.value("host", json()).is_string(); });
+  const int width = hosts ? 18 : 10;
+  fmt::print("{:>4}  {:<11}  {:<{}}  {:>6}  {:<10}  {:<22}  {}\n", "ID", "STATE", hosts ? "DEVICE@HOST" : "DEVICE",
+             width, "SHEETS", "OWNER", "SOURCE", "NOTE");
   for (const json& job : jobs) {
-    const std::string device = job["device"].is_string() ? job["device"].get<std::string>() : "any";
+    std::string device = job["device"].is_string() ? job["device"].get<std::string>() : "any";
+    if (job.value("host", json()).is_string()) device += "@" + job["host"].get<std::string>();
     std::string state = job.value("state", "");
     if (job.value("waiting_for_next", false)) state += "*";
-    fmt::print("{:>4}  {:<11}  {:<10}  {:>6}  {:<10}  {:<22}  {}\n", job.value("id", 0), state, device, sheetsOf(job),
-               shortened(job.value("owner", ""), 10),
+    fmt::print("{:>4}  {:<11}  {:<{}}  {:>6}  {:<10}  {:<22}  {}\n", job.value("id", 0), state, device, width,
+               sheetsOf(job), shortened(job.value("owner", ""), 10),
                shortened(fs::path(job.value("source", "")).filename().string(), 22),
                shortened(job.value("message", ""), 70));
   }
@@ -329,12 +334,26 @@ int runDaemonDevices(bool asJson, const std::string& server, const std::string& 
       std::cout << answer.dump(1) << '\n';
       return kSuccess;
     }
-    fmt::print("{:<10}  {:<9}  {:<16}  {:>4}  {}\n", "DEVICE", "STATE", "MACHINE", "JOB", "URI / MESSAGE");
+    // On a shared store: every host's devices, each with its host, then the hosts.
+    const bool shared = answer.contains("hosts");
+    fmt::print("{:<10}  {}{:<9}  {:<16}  {:>4}  {}\n", "DEVICE", shared ? fmt::format("{:<12}  ", "HOST") : "", "STATE",
+               "MACHINE", "JOB", "URI / MESSAGE");
     for (const json& device : answer["devices"]) {
-      fmt::print("{:<10}  {:<9}  {:<16}  {:>4}  {}{}\n", device.value("name", ""), device.value("state", ""),
+      fmt::print("{:<10}  {}{:<9}  {:<16}  {:>4}  {}{}\n", device.value("name", ""),
+                 shared ? fmt::format("{:<12}  ", device.value("host", "")) : "", device.value("state", ""),
                  device.value("machine", ""),
                  device["job"].is_null() ? "-" : std::to_string(device["job"].get<long long>()),
                  device.value("uri", ""), device.contains("message") ? ": " + device.value("message", "") : "");
+    }
+    if (shared) {
+      std::string hosts;
+      for (const json& host : answer["hosts"]) {
+        const bool gone = host.value("state", "") == "gone";
+        hosts += fmt::format("{}{} ({}{})", hosts.empty() ? "" : ", ", host.value("name", ""),
+                             gone ? "gone, last heard " + host.value("seen", "") : "up",
+                             host.value("address", "").empty() || gone ? "" : ", " + host.value("address", ""));
+      }
+      fmt::print("hosts on the shared job store: {}\n", hosts);
     }
     return kSuccess;
   });

@@ -623,7 +623,8 @@ struct Service::Impl {
         const std::vector<JobRecord> claimed =
             store->claim({JobState::Queued, config.planners - planning.size(), "", ""}, [&](const JobRecord& job) {
               std::string why;
-              std::optional<Target> device = deviceFor(job.device, job.options, why);
+              // (A job for any device planned before, by a host since gone, is planned again for any device.)
+              std::optional<Target> device = deviceFor(job.anyDevice ? "" : job.device, job.options, why);
               Claim claim{JobState::Planning, "planning", {}};
               if (device) {
                 claim.reason = planningReason(*device);
@@ -680,7 +681,7 @@ struct Service::Impl {
       for (const Target& target : all) {
         if (target.name == named) return target;
       }
-      why = fmt::format("there is no device {} now (the devices: {})", named, names);
+      why = fmt::format("there is no device {} (the devices: {})", named, names);
       return std::nullopt;
     }
     if (all.empty()) {
@@ -906,9 +907,12 @@ struct Service::Impl {
       }
       if (idle) return *idle;
     }
-    if (planned) {
-      throw ApiError(409, fmt::format("job {} is for {}, a device of host {}{}: start it there", job.id, job.device,
-                                      planned->host, hostAddressSaid(planned->host)));
+    for (const DeviceRecord& device : store->devices()) {
+      if (device.name != job.device) continue;
+      const bool gone = device.state == "gone";
+      throw ApiError(409, fmt::format("job {} is for {}, a device of host {}{}{}: start it there{}", job.id, job.device,
+                                      device.host, gone ? ", which is gone" : "",
+                                      gone ? "" : hostAddressSaid(device.host), gone ? " once it runs again" : ""));
     }
     throw ApiError(409, fmt::format("job {}: there is no device {} now", job.id, job.device));
   }
@@ -1435,13 +1439,9 @@ void Service::submit(Submission submission, ReplyHandler done) {
     try {
       if (impl.stopping) throw ApiError(503, "the daemon is stopping");
       if (!submission.device.empty()) {
-        bool known = false;
-        for (const DeviceConfig& device : impl.config.devices) known = known || device.name == submission.device;
-        if (!known) {
-          std::string names;
-          for (const DeviceConfig& device : impl.config.devices) names += (names.empty() ? "" : ", ") + device.name;
-          throw ApiError(400, fmt::format("there is no device {} (the devices: {})", submission.device, names));
-        }
+        // (Any host's: on a shared store a job may be submitted here for a device of another.)
+        std::string why;
+        if (!impl.deviceFor(submission.device, "", why)) throw ApiError(400, why);
       }
       entry.emplace(impl.spool->begin());
       if (!submission.fileName.empty()) {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <mutex>
 #include <random>
 #include <set>
@@ -250,21 +251,19 @@ TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
   EXPECT_NE(cancelled.value("message", "").find("at sheet 3 of 3"), std::string::npos) << cancelled.dump();
 }
 
-TEST(Daemon, TwoHundredConcurrentSubmissionsEachLandExactlyOnce) {
-  TempDir root;
-  Daemon daemon(root.path());
-  daemon.start();
-  constexpr int kClients = 8, kEach = 25;
-  std::vector<std::thread> clients;
+// `clients` clients at once, each submitting `each` jobs through the daemon
+// `through` gives it, with the words `words` gives each submission (its
+// number); the jobs' numbers, and what any refusal said.
+std::vector<long long> submitAtOnce(int clients, int each, const std::function<const Daemon&(int client)>& through,
+                                    const std::function<std::string(int submission)>& words,
+                                    std::vector<std::string>& failures) {
+  std::vector<std::thread> threads;
   std::mutex mutex;
   std::vector<long long> ids;
-  std::vector<std::string> failures;
-  for (int c = 0; c < kClients; ++c) {
-    clients.emplace_back([&, c] {
-      for (int i = 0; i < kEach; ++i) {
-        const int tag = c * kEach + i;  // the priority tells each submission apart
-        const CommandResult r =
-            daemon.client(fmt::format("submit {} --priority {} --json", quoted(threeSheets()), tag));
+  for (int c = 0; c < clients; ++c) {
+    threads.emplace_back([&, c] {
+      for (int i = 0; i < each; ++i) {
+        const CommandResult r = through(c).client(words(c * each + i));
         std::lock_guard lock(mutex);
         if (r.status != 0) {
           failures.push_back(r.err);
@@ -274,7 +273,20 @@ TEST(Daemon, TwoHundredConcurrentSubmissionsEachLandExactlyOnce) {
       }
     });
   }
-  for (auto& client : clients) client.join();
+  for (auto& thread : threads) thread.join();
+  return ids;
+}
+
+TEST(Daemon, TwoHundredConcurrentSubmissionsEachLandExactlyOnce) {
+  TempDir root;
+  Daemon daemon(root.path());
+  daemon.start();
+  constexpr int kClients = 8, kEach = 25;
+  std::vector<std::string> failures;
+  // (The priority tells each submission apart.)
+  const std::vector<long long> ids = submitAtOnce(
+      kClients, kEach, [&](int) -> const Daemon& { return daemon; },
+      [&](int tag) { return fmt::format("submit {} --priority {} --json", quoted(threeSheets()), tag); }, failures);
   EXPECT_TRUE(failures.empty()) << failures.front();
   EXPECT_EQ(std::set<long long>(ids.begin(), ids.end()).size(), static_cast<size_t>(kClients * kEach));
   const json jobs = daemon.clientJson("jobs")["jobs"];
@@ -576,6 +588,143 @@ TEST(Daemon, OnAPostgresStoreAKillMidCutLeavesTheJobInterruptedAndASecondDaemonI
   std::vector<std::string> states;
   for (const json& t : job["transitions"]) states.push_back(t["to"]);
   EXPECT_EQ(states, (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
+}
+
+// A `make` output folder of one sheet, quick to cut.
+const fs::path& oneSheet() {
+  static TempDir folder;
+  static const fs::path made = [] {
+    const fs::path out = folder.path() / "cube";
+    const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
+    EXPECT_EQ(r.status, 0) << r.err;
+    return out;
+  }();
+  return made;
+}
+
+// One host of a fab lab: its name, the shared store and spool, a short
+// lease, and one simulated GRBL of its own.
+std::string hostConfig(const test::TestDatabase& database, const fs::path& spool, const std::string& host,
+                       const std::string& simulator, bool autoStart) {
+  return fmt::format(
+      "store: {}\nhost: {}\nspool: {}\nlease: 2\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
+      "\"{}\", auto_start: {}}}]\n",
+      database.uri(), host, spool.string(), host, simulator, autoStart);
+}
+
+std::vector<std::string> statesOf(const json& job) {
+  std::vector<std::string> states;
+  for (const json& t : job["transitions"]) states.push_back(t["to"]);
+  return states;
+}
+
+// Two hosts on one PostgreSQL store and one spool, each with its own
+// cutter: 200 submissions through either host at once each land once and
+// are cut exactly once, on one device or the other.
+TEST(Daemon, TwoHostsOnOneStoreCutEachOfTwoHundredConcurrentSubmissionsExactlyOnce) {
+  test::TestDatabase database;
+  TempDir shared, rootA, rootB;
+  Daemon a(rootA.path(), hostConfig(database, shared.path(), "a", "sim:grbl?speed=10000", true));
+  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=10000", true));
+  a.start();
+  b.start();
+  constexpr int kClients = 8, kEach = 25;
+  std::vector<std::string> failures;
+  const std::vector<long long> ids = submitAtOnce(
+      kClients, kEach, [&](int client) -> const Daemon& { return client % 2 == 0 ? a : b; },
+      [&](int) { return "submit " + quoted(oneSheet()) + " --json"; }, failures);
+  ASSERT_TRUE(failures.empty()) << failures.front();
+  ASSERT_EQ(std::set<long long>(ids.begin(), ids.end()).size(), static_cast<size_t>(kClients * kEach));
+  json jobs;
+  const bool allDone = eventually(
+      [&] {
+        jobs = b.clientJson("jobs")["jobs"];
+        return std::all_of(jobs.begin(), jobs.end(), [](const json& job) { return state(job) == "done"; });
+      },
+      300);
+  ASSERT_TRUE(allDone) << jobs.dump();
+  ASSERT_EQ(jobs.size(), static_cast<size_t>(kClients * kEach));
+  std::map<std::string, int> cutOn;
+  for (const json& job : jobs) ++cutOn[job["device"].get<std::string>()];
+  EXPECT_GT(cutOn["laser-a"], 0);
+  EXPECT_GT(cutOn["laser-b"], 0);
+  EXPECT_EQ(cutOn["laser-a"] + cutOn["laser-b"], kClients * kEach);
+  // Each cut once: one run, then done, in every job's history.
+  for (const long long id : {ids.front(), ids[ids.size() / 2], ids.back()}) {
+    EXPECT_EQ(statesOf(a.job(id)), (std::vector<std::string>{"queued", "planning", "ready", "running", "done"}));
+  }
+  auto store = service::openPostgresStore(database.uri());
+  for (const service::JobRecord& job : store->jobs()) {
+    const auto history = store->transitions(job.id);
+    EXPECT_EQ(std::count_if(history.begin(), history.end(),
+                            [](const service::Transition& t) { return t.to == service::JobState::Running; }),
+              1)
+        << job.id;
+  }
+  EXPECT_EQ(store->integrityCheck(), "ok");
+}
+
+// Three hosts; two are killed (kill -9), one mid-cut and one mid-plan. Once
+// their leases run out the third releases their jobs: the cut comes back
+// interrupted and stays so (no laser restarts by itself), the plan is made
+// again on the third, which cuts it and goes on with its own job; the
+// client shows the hosts that are gone.
+TEST(Daemon, WhenTwoOfThreeHostsAreKilledTheirCutIsInterruptedTheirPlanMadeAgainAndTheThirdGoesOn) {
+  test::TestDatabase database;
+  TempDir shared, rootA, rootB, rootC;
+  Daemon a(rootA.path(), hostConfig(database, shared.path(), "a", "sim:grbl?speed=2", true));
+  Daemon c(rootC.path(), hostConfig(database, shared.path(), "c", "sim:grbl?speed=2", false));
+  a.start();
+  c.start();
+  // X: cut on a's laser. Y: a mesh for any device, planned on a or c (a nest of 8 s).
+  const long long x = a.clientJson("submit " + quoted(oneSheet()) + " --device laser-a --json")["id"];
+  const json cutting =
+      a.waitForJob(x, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+  ASSERT_EQ(state(cutting), "running") << cutting.dump();
+  EXPECT_EQ(cutting["host"], "a");
+  const long long y = c.clientJson("submit " + quoted(kSource / "examples/soccer-ball.obj") +
+                                   " --structure band --time 8 --json")["id"];
+  const json planning = c.waitForJob(y, [](const json& j) { return state(j) == "planning"; });
+  ASSERT_EQ(state(planning), "planning") << planning.dump();
+  const std::string planner = planning["host"];
+  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=100", true));
+  b.start();
+  // Z: b's own.
+  const long long z = b.clientJson("submit " + quoted(oneSheet()) + " --device laser-b --json")["id"];
+  a.kill9();
+  c.kill9();
+  const json interrupted = b.waitForJob(
+      x, [](const json& j) { return state(j) == "interrupted"; }, 30);
+  EXPECT_EQ(state(interrupted), "interrupted") << interrupted.dump();
+  EXPECT_NE(interrupted.value("message", "").find("host a (its last heartbeat "), std::string::npos)
+      << interrupted.dump();
+  EXPECT_NE(interrupted.value("message", "").find("stopped while it cut, at sheet 1 of 1"), std::string::npos)
+      << interrupted.dump();
+  EXPECT_EQ(state(b.waitForJob(z, [](const json& j) { return state(j) == "done"; })), "done");
+  // (Cut on laser-b, its first sheet; it would then wait for the next to be loaded.)
+  const json replanned = b.waitForJob(
+      y, [](const json& j) { return state(j) == "running"; }, 120);
+  ASSERT_EQ(state(replanned), "running") << replanned.dump();
+  EXPECT_EQ(replanned["device"], "laser-b");
+  EXPECT_EQ(replanned["host"], "b");
+  EXPECT_EQ(statesOf(replanned),
+            (std::vector<std::string>{"queued", "planning", "queued", "planning", "ready", "running"}));
+  EXPECT_NE(replanned["transitions"][2]["reason"].get<std::string>().find("host " + planner), std::string::npos)
+      << replanned.dump();
+  // Nothing restarted the interrupted cut.
+  EXPECT_EQ(state(b.job(x)), "interrupted");
+  EXPECT_EQ(statesOf(b.job(x)), (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
+  // The client shows who is gone.
+  const CommandResult devices = b.client("devices --daemon");
+  EXPECT_NE(devices.out.find("laser-a     a             gone"), std::string::npos) << devices.out;
+  EXPECT_NE(devices.out.find("a (gone, last heard "), std::string::npos) << devices.out;
+  EXPECT_NE(devices.out.find("b (up"), std::string::npos) << devices.out;
+  // Its job is started only where its device is.
+  const CommandResult elsewhere = b.client(fmt::format("resume {} --from-sheet 1", x));
+  EXPECT_EQ(elsewhere.status, 1);
+  EXPECT_NE(elsewhere.err.find("a device of host a"), std::string::npos) << elsewhere.err;
+  EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
 }
 
 TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {
