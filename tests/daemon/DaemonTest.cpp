@@ -727,6 +727,50 @@ TEST(Daemon, WhenTwoOfThreeHostsAreKilledTheirCutIsInterruptedTheirPlanMadeAgain
   EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
 }
 
+// A host stalled past its lease (here stopped by SIGSTOP; a hung machine, a
+// cut network) finds on waking that another host released its cut: it
+// stops the cut at once, laser off, and the job stays interrupted.
+TEST(Daemon, AHostWhoseLeaseRanOutWhileItCutStopsItsLaserAndLeavesTheJobInterrupted) {
+  test::TestDatabase database;
+  TempDir shared, rootA, rootB;
+  const fs::path witness = rootA.path() / "laser";
+  Daemon a(rootA.path(),
+           hostConfig(database, shared.path(), "a", "sim:grbl?speed=2&witness=" + witness.string(), true));
+  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=100", false));
+  a.start();
+  b.start();
+  const long long id = b.clientJson("submit " + quoted(oneSheet()) + " --device laser-a --json")["id"];
+  const json cutting =
+      a.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+  ASSERT_EQ(state(cutting), "running") << cutting.dump();
+  a.signal(SIGSTOP);
+  const json released = b.waitForJob(
+      id, [](const json& j) { return state(j) == "interrupted"; }, 30);
+  a.signal(SIGCONT);
+  EXPECT_EQ(state(released), "interrupted") << released.dump();
+  EXPECT_TRUE(eventually([&] { return readFile(a.log()).find("its lease ran out") != std::string::npos; }, 10))
+      << readFile(a.log());
+  EXPECT_NE(readFile(witness).find("on\n"), std::string::npos);
+  EXPECT_TRUE(eventually([&] { return readFile(witness).ends_with("off\n"); }, 10)) << readFile(witness);
+  // And it stays off: the cut does not go on.
+  const std::string after = readFile(witness);
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  EXPECT_EQ(readFile(witness), after);
+  // It joins again, and nothing it did after its lease ran out counts.
+  const auto laserA = [&] {
+    const json devices = b.clientJson("devices --daemon")["devices"];
+    for (const json& device : devices) {
+      if (device["name"] == "laser-a") return device;
+    }
+    return json::object();
+  };
+  EXPECT_TRUE(eventually([&] { return laserA().value("state", "") == "idle"; }, 10))
+      << b.clientJson("devices --daemon").dump();
+  EXPECT_EQ(state(b.job(id)), "interrupted");
+  EXPECT_EQ(statesOf(b.job(id)), (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
+  EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
+}
+
 TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {
   TempDir root;
   Daemon daemon(root.path());  // not started
