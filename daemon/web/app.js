@@ -8,6 +8,7 @@
   const state = {
     jobs: [],
     devices: [],
+    hosts: [],  // on a shared store: every host, up or gone
     progress: new Map(),  // job id -> its last progress event
     sheets: { job: null, sheet: 1, path: null, lines: [] },
     guide: null,
@@ -223,7 +224,8 @@
                   : job.message || ''),
                 warningsOf(job)),
         element('td', {}, job.owner || ''),
-        element('td', {}, job.device || '–'),
+        // On a shared store, the host that plans or cuts it: laser2@room-2.
+        element('td', {}, (job.device || '–') + (job.host ? `@${job.host}` : '')),
         element('td', { class: 'sheets' }, sheetsDone(job)),
         element('td', { class: 'time-left' }, timeLeft(job)),
         element('td', {}, element('div', { class: 'actions' }, ...actionsOf(job))));
@@ -295,6 +297,7 @@
       const fraction = cutting && progress.strokes ? progress.stroke / progress.strokes : null;
       cards.append(element('article', { class: 'device', 'data-device': device.name, 'data-state': device.state },
         element('h3', {}, device.name, element('span', { class: `state ${device.state}` }, device.state)),
+        state.hosts.length ? element('p', { class: 'device-host' }, `on host ${device.host}`) : null,
         element('p', {}, `${device.machine || '?'} · ${device.material || ''} · ${device.uri}`),
         device.message ? element('p', { class: 'device-message' }, device.message) : null,
         device.job ? element('p', {}, `job ${device.job}` + (cutting ? `, sheet ${progress.sheet} of ${progress.sheets}` : '')) : null,
@@ -306,6 +309,11 @@
         cutting ? element('p', { class: 'progress-text' },
           `${Math.round(fraction * 100)}% of the sheet · ${duration(progress.seconds_left)} left`) : null));
     }
+    // On a shared store, every host and whether it is there.
+    const hosts = $('hosts');
+    hosts.hidden = state.hosts.length === 0;
+    hosts.replaceChildren(...state.hosts.map((host) => element('span', { class: `host ${host.state}`, 'data-host': host.name },
+      host.state === 'gone' ? `${host.name}: gone, last heard ${host.seen}` : `${host.name}: up`)));
     const choose = $('opt-device');
     const chosen = choose.value;
     choose.replaceChildren(element('option', { value: '' }, 'any that fits'));
@@ -318,6 +326,7 @@
   async function refreshDevices() {
     const answer = await api('GET', '/api/devices');
     state.devices = answer.devices || [];
+    state.hosts = answer.hosts || [];
     renderDevices();
   }
 
@@ -1081,6 +1090,10 @@
     attempt(async () => {
       await Promise.all([refreshDevices(), refreshJobs()]);
       listen();
+      // What the other hosts do (their devices, the jobs they cut) comes with no event here: looked at again every few seconds.
+      setInterval(() => {
+        if (state.hosts.length) Promise.all([refreshDevices(), refreshJobs()]).catch(() => {});
+      }, 3000);
     });
   }
 })();

@@ -15,6 +15,7 @@
 
 #include "daemon/DaemonSupport.h"
 #include "support/Browser.h"
+#include "support/TestDatabase.h"
 
 namespace rotafab::test {
 namespace {
@@ -187,6 +188,47 @@ TEST(Browser, ARefusedActionShowsTheDaemonsOwnWords) {
   browser.screenshot(artefacts() / "refused.png");
   // The browser logs the 409 of the request; nothing else went wrong.
   expectNoErrorsBut(browser, "status of 409");
+}
+
+// Two hosts on one store: the page of either shows every host's devices
+// with their host, each job's host while it cuts, and a host that is gone.
+TEST(Browser, OnASharedStoreThePageShowsEachDevicesHostAndAHostThatIsGone) {
+  TestDatabase database;
+  TempDir shared, rootA, rootB;
+  const auto config = [&](const std::string& host, const std::string& speed) {
+    return fmt::format(
+        "store: {}\nhost: {}\nspool: {}\nlease: 2\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
+        "\"sim:grbl?speed={}\", auto_start: true}}]\n",
+        database.uri(), host, shared.path().string(), host, speed);
+  };
+  Daemon a(rootA.path(), config("a", "2"));
+  Daemon b(rootB.path(), config("b", "100"));
+  a.start();
+  b.start();
+  const CommandResult planned =
+      run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+          " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(shared.path() / "cube"));
+  ASSERT_EQ(planned.status, 0) << planned.err;
+  const long long id = b.clientJson("submit " + quoted(shared.path() / "cube") + " --device laser-a --json")["id"];
+  testing::Browser browser;
+  browser.navigate(loginLink(b));
+  // The job cut by host a, as host b's page shows it.
+  ASSERT_TRUE(browser.waitFor(
+      fmt::format("(document.querySelector('tr[data-job=\"{}\"]') || {{}}).innerText?.includes('laser-a@a')", id), 20s))
+      << browser.evaluate("document.getElementById('jobs').innerText");
+  ASSERT_TRUE(browser.waitFor(
+      "(document.querySelector('.device[data-device=\"laser-a\"] .device-host') || {}).textContent === 'on host a'",
+      10s));
+  a.kill9();
+  ASSERT_TRUE(browser.waitFor("document.querySelector('.host.gone[data-host=\"a\"]')", 20s))
+      << browser.evaluate("document.getElementById('hosts').innerText");
+  ASSERT_TRUE(browser.waitFor("document.querySelector('.device[data-device=\"laser-a\"][data-state=\"gone\"]')", 10s));
+  ASSERT_TRUE(browser.waitFor(
+      fmt::format("document.querySelector('tr[data-job=\"{}\"][data-state=\"interrupted\"]')", id), 10s));
+  EXPECT_NE(browser.evaluate("document.getElementById('hosts').innerText").get<std::string>().find("b: up"),
+            std::string::npos);
+  browser.screenshot(artefacts() / "shared-store.png");
+  expectNoErrors(browser);
 }
 
 // The queue's order as the API gives it.
