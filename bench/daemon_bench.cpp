@@ -8,12 +8,19 @@
 //      connection kept open;
 //   3. status queries per second (GET /api/jobs/ID), 4 clients;
 //   4. with 10,000 jobs in the store: the time from the daemon's start to its
-//      first answer, and its memory (VmRSS) then and after a list of all.
+//      first answer, and its memory (VmRSS) then and after a list of all;
+//   5. on a shared PostgreSQL store (a server of its own, started with
+//      scripts/test-postgres.sh, or --postgres URI), with 1, 2 and 3 hosts:
+//      submissions per second through the hosts (8 clients spread over
+//      them, each on one connection kept open), and claims per second of
+//      the store (each host's connection claiming queued jobs for planning
+//      at once, FOR UPDATE SKIP LOCKED), beside SQLite's claims.
 //
-//   build/rotafab_daemon_bench [--dir DIR] [--jobs 10000]
+//   build/rotafab_daemon_bench [--dir DIR] [--jobs 10000] [--postgres URI] [--only-shared]
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <libpq-fe.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sqlite3.h>
@@ -26,6 +33,8 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -223,16 +232,146 @@ double statusRate(const fs::path& socket, int clients, double seconds) {
   return done / since(start);
 }
 
+// One statement on the server at `uri`; false (and what it said) when refused.
+bool serverSql(const std::string& uri, const std::string& sql) {
+  PGconn* connection = PQconnectdb(uri.c_str());
+  PQsetNoticeProcessor(
+      connection, [](void*, const char*) {}, nullptr);  // ("does not exist, skipping")
+  PGresult* result = PQexec(connection, sql.c_str());
+  const bool ok = PQresultStatus(result) == PGRES_COMMAND_OK;
+  if (!ok) fmt::print(stderr, "{}: {}", sql, PQerrorMessage(connection));
+  PQclear(result);
+  PQfinish(connection);
+  return ok;
+}
+
+// `jobs` queued jobs claimed for planning by `hosts` connections at once,
+// one job per claim, as each daemon's queue claims them; claims per second.
+double claimRate(const std::function<std::unique_ptr<rotafab::service::JobStore>()>& open, int hosts, int jobs) {
+  using namespace rotafab::service;
+  {
+    auto store = open();
+    std::vector<NewJob> batch;
+    for (int i = 0; i < jobs; ++i) {
+      NewJob job;
+      job.source = fmt::format("mesh-{}.obj", i);
+      job.owner = "bench";
+      job.options = "[]";
+      job.spool = fmt::format("job-{}", i);
+      batch.push_back(job);
+    }
+    store->addJobs(batch, std::vector<std::string>(batch.size(), "submitted"));
+  }
+  std::vector<std::unique_ptr<JobStore>> stores;
+  for (int h = 0; h < hosts; ++h) {
+    stores.push_back(open());
+    stores.back()->join({fmt::format("claimer-{}", h), "", 0, 0, 0, false}, {}, 60, 0,
+                        [](const JobRecord&, const HostRecord&) {
+                          return std::pair{JobState::Queued, std::string()};
+                        });
+  }
+  std::atomic<int> claimed{0};
+  const auto start = Clock::now();
+  std::vector<std::thread> threads;
+  for (int h = 0; h < hosts; ++h) {
+    threads.emplace_back([&, h] {
+      for (;;) {
+        const auto taken = stores[h]->claim({JobState::Queued, 1, "", ""}, [](const JobRecord&) {
+          return std::optional<Claim>(Claim{JobState::Planning, "planning", {}});
+        });
+        if (taken.empty()) return;
+        claimed += static_cast<int>(taken.size());
+      }
+    });
+  }
+  for (auto& thread : threads) thread.join();
+  const double rate = claimed / since(start);
+  if (claimed != jobs) fmt::print(stderr, "  ({} of {} jobs claimed)\n", claimed.load(), jobs);
+  return rate;
+}
+
+// Part 5: several hosts on one PostgreSQL store.
+void sharedStore(const fs::path& dir, const fs::path& planned, std::string server) {
+  bool ours = false;
+  if (server.empty()) {
+    const fs::path cluster = dir / "postgres";
+    const std::string start =
+        fmt::format("bash {}/scripts/test-postgres.sh start {} >/dev/null", ROTAFAB_SOURCE_DIR, cluster.string());
+    if (std::system(start.c_str()) != 0) {
+      fmt::print(stderr, "no PostgreSQL server for the shared store's part (scripts/setup.sh installs one)\n");
+      return;
+    }
+    std::ifstream(cluster / "uri") >> server;
+    ours = true;
+  }
+  const auto database = [&](const std::string& name) {
+    serverSql(server, "DROP DATABASE IF EXISTS " + name);
+    serverSql(server, "CREATE DATABASE " + name);
+    return server.substr(0, server.rfind('/') + 1) + name;
+  };
+  fmt::print("shared PostgreSQL store on {}:\n", server);
+  for (int hosts : {1, 2, 3}) {
+    const std::string uri = database(fmt::format("rotafab_bench_{}", hosts));
+    const fs::path spool = dir / fmt::format("shared-{}-spool", hosts);
+    std::vector<Daemon> daemons;
+    for (int h = 0; h < hosts; ++h) {
+      Daemon daemon{0, dir / fmt::format("shared-{}-host-{}", hosts, h)};
+      fs::create_directories(daemon.root);
+      std::ofstream(daemon.root / "rotafabd.yaml") << fmt::format(
+          "store: {}\nhost: h{}\nspool: {}\ndevices: [{{name: laser{}, machine: grbl-diode-400, "
+          "uri: \"sim:grbl?speed=100\"}}]\n",
+          uri, h, spool.string(), h);
+      daemon.start();
+      daemons.push_back(daemon);
+    }
+    for (const Daemon& daemon : daemons) daemon.waitServing();
+    // 8 clients, client c through host c % hosts.
+    std::atomic<int> done{0}, failed{0};
+    const std::string body = fmt::format(R"({{"path": "{}"}})", planned.string());
+    const std::string bytes = fmt::format(
+        "POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{}",
+        body.size(), body);
+    const auto start = Clock::now();
+    std::vector<std::thread> threads;
+    for (int c = 0; c < 8; ++c) {
+      threads.emplace_back([&, c] {
+        KeptConnection connection(daemons[static_cast<size_t>(c % hosts)].socket());
+        while (since(start) < 5) (connection.exchange(bytes) == 201 ? done : failed)++;
+      });
+    }
+    for (auto& thread : threads) thread.join();
+    const double submissions = done / since(start);
+    for (Daemon& daemon : daemons) daemon.stop();
+    if (failed > 0) fmt::print(stderr, "  ({} submissions refused)\n", failed.load());
+    const std::string claimsUri = database(fmt::format("rotafab_claims_{}", hosts));
+    const double claims = claimRate([&] { return rotafab::service::openPostgresStore(claimsUri); }, hosts, 2000);
+    fmt::print("  {} host{}: submissions of a planned folder, 8 clients: {:.0f}/s; claims: {:.0f}/s\n", hosts,
+               hosts == 1 ? "" : "s", submissions, claims);
+  }
+  const fs::path file = dir / "claims.sqlite3";
+  fmt::print("  SQLite (one daemon): claims: {:.0f}/s\n",
+             claimRate([&] { return rotafab::service::openSqliteStore(file); }, 1, 2000));
+  if (ours) {
+    const std::string stop =
+        fmt::format("bash {}/scripts/test-postgres.sh stop {}", ROTAFAB_SOURCE_DIR, (dir / "postgres").string());
+    std::system(stop.c_str());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   fs::path dir = fs::temp_directory_path() / fmt::format("rotafab-daemon-bench-{}", ::getpid());
   int manyJobs = 10000;
+  std::string postgres;
+  bool onlyShared = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string flag = argv[i];
     if (flag == "--dir") dir = fs::path(argv[i + 1]) / fmt::format("rotafab-daemon-bench-{}", ::getpid());
     if (flag == "--jobs") manyJobs = std::stoi(argv[i + 1]);
+    if (flag == "--postgres") postgres = argv[i + 1];
   }
+  for (int i = 1; i < argc; ++i) onlyShared = onlyShared || std::string(argv[i]) == "--only-shared";
   fs::create_directories(dir);
   // A planned folder: the cube on the default device's bed.
   const fs::path planned = dir / "cube";
@@ -245,6 +384,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   fmt::print("state on {} (the disk of {})\n", dir.string(), fs::temp_directory_path().string());
+  if (onlyShared) {
+    sharedStore(dir, planned, postgres);
+    fs::remove_all(dir);
+    return 0;
+  }
   const double bare = bareSqliteRate(dir, 3000);
   fmt::print("bare SQLite transactions (WAL, synchronous=FULL): {:.0f}/s\n", bare);
 
@@ -294,6 +438,7 @@ int main(int argc, char** argv) {
   request(full.socket(), "GET /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n");
   fmt::print("  after listing all {} jobs: VmRSS {:.1f} MiB\n", manyJobs, full.rssKiB() / 1024.0);
   full.stop();
+  sharedStore(dir, planned, postgres);
   fs::remove_all(dir);
   return 0;
 }

@@ -575,18 +575,18 @@ class PostgresStore final : public JobStore, private JobRows {
   }
 
   void apply(JobId id, const JobChange& change) override {
-    const auto set = [&](const char* column, const Parameter& value) {
-      if (value) query(fmt::format("UPDATE jobs SET {} = $1 WHERE id = $2", column), {value, std::to_string(id)});
-    };
     const auto numberOf = [](const auto& value) -> Parameter {
       return value ? Parameter(std::to_string(*value)) : std::nullopt;
     };
-    set("device", change.device);
-    set("summary", change.summary);
-    set("sheets", numberOf(change.sheets));
-    set("sheet", numberOf(change.sheet));
-    set("stroke", numberOf(change.stroke));
-    set("strokes", numberOf(change.strokes));
+    if (!change.device && !change.summary && !change.sheets && !change.sheet && !change.stroke && !change.strokes)
+      return;
+    // One statement, each column kept where its change is unset (NULL): one round trip, not one per column.
+    query(
+        "UPDATE jobs SET device = COALESCE($1, device), summary = COALESCE($2, summary), sheets = COALESCE($3::BIGINT, "
+        "sheets), sheet = COALESCE($4::BIGINT, sheet), stroke = COALESCE($5::BIGINT, stroke), strokes = "
+        "COALESCE($6::BIGINT, strokes) WHERE id = $7",
+        {change.device, change.summary, numberOf(change.sheets), numberOf(change.sheet), numberOf(change.stroke),
+         numberOf(change.strokes), std::to_string(id)});
   }
 
   void move(JobId id, JobState from, JobState to, double at, std::string_view reason) override {
