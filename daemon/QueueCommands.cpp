@@ -317,6 +317,9 @@ void printAnswer(const json& answer, const std::string& action, bool asJson) {
   const std::string state = answer.value("state", "");
   if (asJson) {
     std::cout << answer.dump() << '\n';
+  } else if (answer.contains("asked_host")) {
+    fmt::print("job {}: {} on host {}: asked it to {} it (`rotafab status {}` says when it has)\n",
+               answer.value("id", 0), state, answer.value("asked_host", ""), action, answer.value("id", 0));
   } else if (action == "cancel" && state != "cancelled") {
     fmt::print("job {}: stopping (`rotafab status {}` says when it has)\n", answer.value("id", 0),
                answer.value("id", 0));

@@ -93,6 +93,15 @@ struct DeviceRecord {
   std::optional<JobId> job;
 };
 
+// An action asked through one host for a job another host holds (cancel,
+// pause, resume, next), until the holder takes it.
+struct ActionRequest {
+  int64_t id = 0;
+  JobId job = 0;
+  std::string action, arguments, who;  // arguments: JSON
+  double at = 0;
+};
+
 // What becomes of a job whose host is gone (a restart, a lease run out):
 // its new state (queued to be planned again, interrupted) and why.
 using Release = std::function<std::pair<JobState, std::string>(const JobRecord& job, const HostRecord& host)>;
@@ -224,6 +233,14 @@ class JobStore {
   // it is), in one transaction; those moved. A job moved into planning,
   // running or paused is this host's.
   virtual std::vector<JobRecord> claim(const ClaimQuery& query, const ClaimDecision& decide) = 0;
+
+  // Leaves `request` for the host that holds its job, if another host than
+  // this one holds it (in one transaction with the check); that host, or
+  // nullopt when no other host holds the job (this one acts itself).
+  virtual std::optional<std::string> requestAction(const ActionRequest& request) = 0;
+  // The requests left for the jobs this host holds, oldest first, each
+  // taken as it is read; those for jobs no host holds any more are dropped.
+  virtual std::vector<ActionRequest> takeRequests() = 0;
 
   // The schema version of the store as opened.
   [[nodiscard]] virtual int schemaVersion() = 0;

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <libpq-fe.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <optional>
@@ -302,6 +303,35 @@ class PostgresStore final : public JobStore, private JobRows {
     }
     transaction.commit();
     return jobsNumbered(released);
+  }
+
+  std::optional<std::string> requestAction(const ActionRequest& request) override {
+    Transaction transaction(*this);
+    const Result held = query("SELECT state, host FROM jobs WHERE id = $1 FOR UPDATE", {std::to_string(request.job)});
+    if (held.rows() == 0) return std::nullopt;
+    const std::string host = held.text(0, 1);
+    if (!heldByAHost(stateNamed(held.text(0, 0)).value_or(JobState::Failed)) || host.empty() || host == host_) {
+      return std::nullopt;
+    }
+    query(fmt::format("INSERT INTO requests (job, action, arguments, who, at) VALUES ($1, $2, $3, $4, {})", kNow),
+          {std::to_string(request.job), request.action, request.arguments, request.who});
+    transaction.commit();
+    return host;
+  }
+
+  std::vector<ActionRequest> takeRequests() override {
+    std::vector<ActionRequest> taken;
+    if (query("SELECT 1 FROM requests LIMIT 1").rows() == 0) return taken;
+    Transaction transaction(*this);
+    const Result found =
+        query(fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = $1) RETURNING {}",
+                          kRequestColumns),
+              {host_});
+    for (int row = 0; row < found.rows(); ++row) taken.push_back(requestOf(found.row(row)));
+    query("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = '')");
+    transaction.commit();
+    std::sort(taken.begin(), taken.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+    return taken;
   }
 
   std::vector<HostRecord> hosts() override {

@@ -441,10 +441,11 @@ struct Service::Impl {
     return record;
   }
 
-  // This host into the store, and what a stop of it left: jobs it was
-  // cutting become interrupted, plans it was making are made again; spool
-  // folders no job names (a stop mid-submission) are removed.
-  void join() {
+  // This host into the store (again, after its lease ran out), and what it
+  // held before released: jobs it was cutting become interrupted, plans it
+  // was making are made again. `wait`: seconds to wait for a lease this
+  // host's name still holds (a daemon killed a moment ago holds it a little longer).
+  void joinStore(double wait) {
     HostRecord me;
     me.name = config.host;
     for (const std::string& address : config.listen) {
@@ -455,15 +456,22 @@ struct Service::Impl {
     }
     std::vector<DeviceRecord> records;
     for (const Device& device : devices) records.push_back(deviceRecord(device));
-    // (A daemon killed a moment ago holds its lease a little longer: waited for.)
     const std::vector<JobRecord> left =
-        store->join(me, records, config.lease, config.lease + 2,
+        store->join(me, records, config.lease, wait,
                     [](const JobRecord& job, const HostRecord&) { return released(job, "the daemon"); });
     joined = true;
     lastBeat = Clock::now();
     for (const JobRecord& job : left) {
       if (job.state == JobState::Interrupted) log->warn("job {}: {}", job.id, job.message);
+      jobChanged(job);
     }
+    if (store->shared()) refreshOthers();
+  }
+
+  // At the start: into the store; spool folders no job names (a stop
+  // mid-submission) removed; on a shared store, the heartbeat started.
+  void join() {
+    joinStore(config.lease + 2);
     std::set<std::string> named;
     store->eachJob([&](const JobRecord& job) { named.insert(job.spool); });
     if (const size_t removed = spool->removeOrphans(named); removed > 0) {
@@ -472,7 +480,6 @@ struct Service::Impl {
     }
     if (store->shared()) {
       log->info("host {} on the shared job store, lease {:g} s", config.host, config.lease);
-      refreshOthers();
       ticker.emplace(strand);
       tick();
     }
@@ -486,6 +493,13 @@ struct Service::Impl {
       if (error || stopping) return;
       const int beatEvery = std::max(1, static_cast<int>(config.lease / 5 / 0.5));
       if (ticks++ % beatEvery == 0) beat();
+      if (joined) {
+        try {
+          serveRequests();
+        } catch (const std::exception& failure) {
+          log->error("{}", failure.what());
+        }
+      }
       pump();
       tick();
     });
@@ -494,7 +508,9 @@ struct Service::Impl {
   void beat() {
     try {
       if (!joined) {
-        join();  // (again, after its lease ran out)
+        // Again, after its lease ran out: without waiting (a refusal is tried again at the next beat).
+        joinStore(0);
+        log->info("host {} joined the shared job store again", config.host);
         return;
       }
       if (!store->heartbeat(config.lease)) {
@@ -531,6 +547,21 @@ struct Service::Impl {
       if (cut->waiting) {
         cut->waiting->set_value(false);
         cut->waiting.reset();
+      }
+    }
+  }
+
+  // The actions other hosts left for this host's jobs, done as if asked here.
+  void serveRequests() {
+    for (const ActionRequest& request : store->takeRequests()) {
+      const json arguments = json::parse(request.arguments, nullptr, false);
+      const Reply reply = guarded([&] {
+        return act(request.job, request.action, arguments.is_discarded() ? json::object() : arguments, request.who);
+      });
+      if (reply.status >= 400) {
+        const std::string why = reply.body.value("error", "refused");
+        log->warn("job {}: {}'s {} through another host: {}", request.job, request.who, request.action, why);
+        store->addEvent(request.job, "refused", fmt::format("{}'s {}: {}", request.who, request.action, why));
       }
     }
   }
@@ -1246,13 +1277,34 @@ struct Service::Impl {
     const auto refuse = [&](const std::string& why) -> Reply {
       throw ApiError(409, fmt::format("job {} is {}{}", id, stateName(job.state), why));
     };
-    // A job another host is planning or cutting is that host's to act on (its driver, its planner).
+    // A job another host is planning or cutting is that host's to act on
+    // (its driver, its planner): the action is left for it in the store,
+    // and it acts within half a second (Impl::serveRequests).
     if (heldByAHost(job.state) && !job.host.empty() && job.host != config.host &&
         (action == "cancel" || action == "pause" || action == "resume" || action == "next")) {
-      refuse(fmt::format(" on host {}{}: ask that host to {} it", job.host, hostAddressSaid(job.host), action));
+      if (action == "pause" && job.state != JobState::Running) refuse("; only a running job can be paused");
+      if (action == "resume" && job.state != JobState::Paused) {
+        refuse("; only a paused, interrupted or failed job can be resumed");
+      }
+      if (action == "next" && job.state != JobState::Running)
+        refuse("; only a job waiting between sheets takes `next`");
+      ActionRequest request;
+      request.job = id;
+      request.action = action;
+      request.arguments = arguments.is_null() ? "{}" : arguments.dump();
+      request.who = who;
+      if (const auto holder = store->requestAction(request)) {
+        json answer = jobJson(job);
+        answer["asked_host"] = *holder;
+        store->addEvent(id, "asked", fmt::format("{} asked host {} to {} it", who, *holder, action));
+        return {202, answer};
+      }
+      return act(id, action, arguments, who);  // (released to no host, or to this one, meanwhile)
     }
     // (Held by this host, a job is in `planning` or `cuts` until it leaves that state.)
-    if ((job.state == JobState::Planning && !planning.contains(id)) || (holdsDevice(job.state) && !cuts.contains(id))) {
+    const bool ours = job.host.empty() || job.host == config.host;
+    if (ours && ((job.state == JobState::Planning && !planning.contains(id)) ||
+                 (holdsDevice(job.state) && !cuts.contains(id)))) {
       refuse(", but this daemon is not working on it (it is being released); ask again in a moment");
     }
     if (action == "cancel") {

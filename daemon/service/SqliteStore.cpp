@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <sqlite3.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 #include <string>
@@ -301,6 +302,38 @@ class SqliteStore final : public JobStore, private JobRows {
   // synced write every few seconds would cost for nothing).
   bool heartbeat(double) override { return true; }
   std::vector<JobRecord> releaseLapsedHosts(const Release&) override { return {}; }
+
+  std::optional<std::string> requestAction(const ActionRequest& request) override {
+    Transaction transaction(db_);
+    const auto held = job(request.job);
+    if (!held || !heldByAHost(held->state) || held->host.empty() || held->host == host_) return std::nullopt;
+    Statement insert(*statements_, "INSERT INTO requests (job, action, arguments, who, at) VALUES (?, ?, ?, ?, ?)");
+    insert.bind(1, request.job).bind(2, request.action).bind(3, request.arguments).bind(4, request.who);
+    insert.bind(5, unixSeconds());
+    insert.step();
+    transaction.commit();
+    return held->host;
+  }
+
+  std::vector<ActionRequest> takeRequests() override {
+    std::vector<ActionRequest> taken;
+    Statement any(*statements_, "SELECT 1 FROM requests LIMIT 1");
+    if (!any.step()) return taken;
+    any.reset();
+    Transaction transaction(db_);
+    {
+      Statement take(*statements_, fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = ?) "
+                                               "RETURNING {}",
+                                               kRequestColumns));
+      take.bind(1, host_);
+      while (take.step()) taken.push_back(requestOf(take));
+      Statement stale(*statements_, "DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = '')");
+      stale.step();
+    }
+    transaction.commit();
+    std::sort(taken.begin(), taken.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+    return taken;
+  }
 
   std::vector<JobRecord> jobsNumbered(const std::vector<JobId>& ids) {
     std::vector<JobRecord> all;

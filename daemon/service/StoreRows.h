@@ -10,6 +10,7 @@
 namespace rotafab::service {
 
 constexpr const char* kHostColumns = "name, address, started, seen, lease_until, gone";
+constexpr const char* kRequestColumns = "id, job, action, arguments, who, at";
 constexpr const char* kDeviceColumns = "name, host, machine, material, uri, auto_start, state, message, job";
 
 template <typename Row>
@@ -65,6 +66,11 @@ DeviceRecord deviceOf(const Row& row) {
   device.message = row.text(7);
   if (!row.isNull(8)) device.job = row.integer(8);
   return device;
+}
+
+template <typename Row>
+ActionRequest requestOf(const Row& row) {
+  return {row.integer(0), row.integer(1), row.text(2), row.text(3), row.text(4), row.real(5)};
 }
 
 }  // namespace rotafab::service

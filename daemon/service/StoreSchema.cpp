@@ -77,6 +77,13 @@ constexpr const char* kMigrations[] = {
          state TEXT NOT NULL,
          message TEXT NOT NULL DEFAULT '',
          job {integer});
+       CREATE TABLE requests (
+         id {key},
+         job {integer} NOT NULL REFERENCES jobs(id),
+         action TEXT NOT NULL,
+         arguments TEXT NOT NULL,
+         who TEXT NOT NULL,
+         at {real} NOT NULL);
        ALTER TABLE jobs ADD COLUMN host TEXT NOT NULL DEFAULT '';
        ALTER TABLE jobs ADD COLUMN any_device {integer} NOT NULL DEFAULT 0;
        CREATE INDEX jobs_host ON jobs(host, state);)",

@@ -727,48 +727,94 @@ TEST(Daemon, WhenTwoOfThreeHostsAreKilledTheirCutIsInterruptedTheirPlanMadeAgain
   EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
 }
 
+// Two hosts on one store; a job submitted through b, cut on a's slow laser
+// (its laser's changes in `witness`).
+struct TwoHostsOneCutting {
+  test::TestDatabase database;
+  TempDir shared, rootA, rootB;
+  fs::path witness = rootA.path() / "laser";
+  Daemon a{rootA.path(),
+           hostConfig(database, shared.path(), "a", "sim:grbl?speed=2&witness=" + witness.string(), true)};
+  Daemon b{rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=100", false)};
+  long long id = 0;
+  // Starts both and the cut; whether it got to its third stroke.
+  bool cutting() {
+    a.start();
+    b.start();
+    id = b.clientJson("submit " + quoted(oneSheet()) + " --device laser-a --json")["id"];
+    const json job =
+        a.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+    EXPECT_EQ(state(job), "running") << job.dump();
+    return state(job) == "running";
+  }
+};
+
+// Pause, resume and cancel through the page or client of another host than
+// the one cutting: left for that host in the store, done by it at once.
+TEST(Daemon, AJobCutOnOneHostIsPausedResumedAndCancelledThroughAnother) {
+  TwoHostsOneCutting lab;
+  ASSERT_TRUE(lab.cutting());
+  const CommandResult paused = lab.b.client(fmt::format("pause {}", lab.id));
+  EXPECT_EQ(paused.status, 0) << paused.err;
+  EXPECT_EQ(paused.out, fmt::format("job {0}: running on host a: asked it to pause it (`rotafab status {0}` says when "
+                                    "it has)\n",
+                                    lab.id));
+  EXPECT_EQ(state(lab.b.waitForJob(
+                lab.id, [](const json& j) { return state(j) == "paused"; }, 10)),
+            "paused");
+  EXPECT_EQ(lab.b.client(fmt::format("resume {}", lab.id)).status, 0);
+  EXPECT_EQ(state(lab.b.waitForJob(
+                lab.id, [](const json& j) { return state(j) == "running"; }, 10)),
+            "running");
+  // A resume of a job that is not paused is refused here, in the words a local one gets.
+  const CommandResult refused = lab.b.client(fmt::format("resume {}", lab.id));
+  EXPECT_EQ(refused.status, 1);
+  EXPECT_NE(refused.err.find("only a paused, interrupted or failed job can be resumed"), std::string::npos)
+      << refused.err;
+  EXPECT_EQ(lab.b.client(fmt::format("cancel {}", lab.id)).status, 0);
+  const json cancelled = lab.b.waitForJob(
+      lab.id, [](const json& j) { return state(j) == "cancelled"; }, 10);
+  EXPECT_EQ(state(cancelled), "cancelled") << cancelled.dump();
+  EXPECT_NE(cancelled.value("message", "").find("cancelled by "), std::string::npos) << cancelled.dump();
+  EXPECT_NE(cancelled.value("message", "").find("laser off"), std::string::npos) << cancelled.dump();
+  EXPECT_TRUE(readFile(lab.witness).ends_with("off\n")) << readFile(lab.witness);
+  EXPECT_EQ(statesOf(cancelled),
+            (std::vector<std::string>{"queued", "planning", "ready", "running", "paused", "running", "cancelled"}));
+}
+
 // A host stalled past its lease (here stopped by SIGSTOP; a hung machine, a
 // cut network) finds on waking that another host released its cut: it
 // stops the cut at once, laser off, and the job stays interrupted.
 TEST(Daemon, AHostWhoseLeaseRanOutWhileItCutStopsItsLaserAndLeavesTheJobInterrupted) {
-  test::TestDatabase database;
-  TempDir shared, rootA, rootB;
-  const fs::path witness = rootA.path() / "laser";
-  Daemon a(rootA.path(),
-           hostConfig(database, shared.path(), "a", "sim:grbl?speed=2&witness=" + witness.string(), true));
-  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=100", false));
-  a.start();
-  b.start();
-  const long long id = b.clientJson("submit " + quoted(oneSheet()) + " --device laser-a --json")["id"];
-  const json cutting =
-      a.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
-  ASSERT_EQ(state(cutting), "running") << cutting.dump();
-  a.signal(SIGSTOP);
-  const json released = b.waitForJob(
-      id, [](const json& j) { return state(j) == "interrupted"; }, 30);
-  a.signal(SIGCONT);
+  TwoHostsOneCutting lab;
+  ASSERT_TRUE(lab.cutting());
+  lab.a.signal(SIGSTOP);
+  const json released = lab.b.waitForJob(
+      lab.id, [](const json& j) { return state(j) == "interrupted"; }, 30);
+  lab.a.signal(SIGCONT);
   EXPECT_EQ(state(released), "interrupted") << released.dump();
-  EXPECT_TRUE(eventually([&] { return readFile(a.log()).find("its lease ran out") != std::string::npos; }, 10))
-      << readFile(a.log());
-  EXPECT_NE(readFile(witness).find("on\n"), std::string::npos);
-  EXPECT_TRUE(eventually([&] { return readFile(witness).ends_with("off\n"); }, 10)) << readFile(witness);
+  EXPECT_TRUE(eventually([&] { return readFile(lab.a.log()).find("its lease ran out") != std::string::npos; }, 10))
+      << readFile(lab.a.log());
+  EXPECT_NE(readFile(lab.witness).find("on\n"), std::string::npos);
+  EXPECT_TRUE(eventually([&] { return readFile(lab.witness).ends_with("off\n"); }, 10)) << readFile(lab.witness);
   // And it stays off: the cut does not go on.
-  const std::string after = readFile(witness);
+  const std::string after = readFile(lab.witness);
   std::this_thread::sleep_for(std::chrono::seconds(1));
-  EXPECT_EQ(readFile(witness), after);
+  EXPECT_EQ(readFile(lab.witness), after);
   // It joins again, and nothing it did after its lease ran out counts.
   const auto laserA = [&] {
-    const json devices = b.clientJson("devices --daemon")["devices"];
+    const json devices = lab.b.clientJson("devices --daemon")["devices"];
     for (const json& device : devices) {
       if (device["name"] == "laser-a") return device;
     }
     return json::object();
   };
   EXPECT_TRUE(eventually([&] { return laserA().value("state", "") == "idle"; }, 10))
-      << b.clientJson("devices --daemon").dump();
-  EXPECT_EQ(state(b.job(id)), "interrupted");
-  EXPECT_EQ(statesOf(b.job(id)), (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
-  EXPECT_EQ(service::openPostgresStore(database.uri())->integrityCheck(), "ok");
+      << lab.b.clientJson("devices --daemon").dump();
+  EXPECT_EQ(state(lab.b.job(lab.id)), "interrupted");
+  EXPECT_EQ(statesOf(lab.b.job(lab.id)),
+            (std::vector<std::string>{"queued", "planning", "ready", "running", "interrupted"}));
+  EXPECT_EQ(service::openPostgresStore(lab.database.uri())->integrityCheck(), "ok");
 }
 
 TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {

@@ -499,6 +499,48 @@ TEST(JobStore, ALapsedHostsJobsAreReleasedOnceByAnotherHost) {
   EXPECT_EQ(b->integrityCheck(), "ok");
 }
 
+// An action for a job another host holds waits in the store for that host,
+// which takes it once; one for a job nobody holds any more is dropped.
+TEST(JobStore, AnActionForAJobAnotherHostHoldsIsTakenOnceByThatHost) {
+  test::TestDatabase database;
+  auto a = openPostgresStore(database.uri());
+  auto b = openPostgresStore(database.uri());
+  a->join(host("a"), {}, 30, 0, kReleased);
+  b->join(host("b"), {}, 30, 0, kReleased);
+  const JobId held = a->addJob(meshJob("held"), "s").id;
+  const JobId queued = a->addJob(meshJob("queued"), "s").id;
+  ASSERT_EQ(a->claim({JobState::Queued, 1, "", ""},
+                     [](const JobRecord&) {
+                       return std::optional<Claim>(Claim{JobState::Planning, "", {}});
+                     })
+                .front()
+                .id,
+            held);
+  ActionRequest cancel{0, held, "cancel", "{}", "alice", 0};
+  EXPECT_EQ(a->requestAction(cancel), std::nullopt);  // its own: it acts itself
+  EXPECT_EQ(b->requestAction(cancel), std::optional<std::string>("a"));
+  EXPECT_EQ(b->requestAction({0, queued, "cancel", "{}", "alice", 0}), std::nullopt);  // nobody holds it
+  EXPECT_TRUE(b->takeRequests().empty());
+  const auto taken = a->takeRequests();
+  ASSERT_EQ(taken.size(), 1u);
+  EXPECT_EQ(taken[0].job, held);
+  EXPECT_EQ(taken[0].action, "cancel");
+  EXPECT_EQ(taken[0].who, "alice");
+  EXPECT_TRUE(a->takeRequests().empty());
+  // Left for a host that then let the job go: dropped.
+  ASSERT_TRUE(b->requestAction({0, held, "cancel", "{}", "bob", 0}));
+  a->transition(held, JobState::Queued, "stopped");
+  EXPECT_TRUE(a->takeRequests().empty());
+  // (Claimed again, it does not find the old request.)
+  ASSERT_EQ(a->claim({JobState::Queued, 1, "", ""},
+                     [](const JobRecord&) { return std::optional<Claim>(Claim{JobState::Planning, "", {}}); })
+                .front()
+                .id,
+            held);
+  EXPECT_TRUE(a->takeRequests().empty());
+  EXPECT_EQ(b->integrityCheck(), "ok");
+}
+
 // The server ended the store's connection (a restart, an administrator):
 // the store connects again at its next call, as it was opened.
 TEST(JobStore, APostgresStoreWhoseConnectionWasEndedConnectsAgain) {
