@@ -276,7 +276,7 @@ double claimRate(const std::function<std::unique_ptr<rotafab::service::JobStore>
   for (int h = 0; h < hosts; ++h) {
     threads.emplace_back([&, h] {
       for (;;) {
-        const auto taken = stores[h]->claim({JobState::Queued, 1, "", ""}, [](const JobRecord&) {
+        const auto taken = stores[h]->claim({JobState::Queued, 1, "", "", ""}, [](const JobRecord&) {
           return std::optional<Claim>(Claim{JobState::Planning, "planning", {}});
         });
         if (taken.empty()) return;

@@ -109,11 +109,11 @@ using Release = std::function<std::pair<JobState, std::string>(const JobRecord& 
 // Jobs one host takes for itself, each at most once across every host: up to
 // `limit` jobs in state `from`, in queue order, skipping those another host
 // is taking at that moment; with `device`, only the jobs for it, and those
-// for any device of its machine (`machine`).
+// for any device that were planned for a device of its machine and material.
 struct ClaimQuery {
   JobState from = JobState::Queued;
   size_t limit = 1;
-  std::string device, machine;
+  std::string device, machine, material;
 };
 // What the claiming host does with a job: its next state, why, and what changes with it.
 struct Claim {
@@ -238,8 +238,9 @@ class JobStore {
   // this one holds it (in one transaction with the check); that host, or
   // nullopt when no other host holds the job (this one acts itself).
   virtual std::optional<std::string> requestAction(const ActionRequest& request) = 0;
-  // The requests left for the jobs this host holds, oldest first, each
-  // taken as it is read; those for jobs no host holds any more are dropped.
+  // The requests left for the jobs this host holds, and for jobs no host
+  // holds any more (a cancel of a job whose plan ended meanwhile is still
+  // carried out, by whichever host takes it), oldest first, each taken as it is read.
   virtual std::vector<ActionRequest> takeRequests() = 0;
 
   // The schema version of the store as opened.

@@ -96,7 +96,14 @@ class PostgresStore final : public JobStore, private JobRows {
  public:
   PostgresStore(const std::string& uri, std::optional<int> upTo) : shown_(uriWithoutPassword(uri)) {
     // libpq takes a URI or key=value words; only the URI form is the config's.
-    connection_ = PQconnectdb(uri.c_str());
+    // A server that goes silent (a cut network) must fail a call within
+    // seconds, not hold the daemon's strand for minutes: connect and TCP
+    // timeouts, keepalives, and (startSession) a statement timeout. The
+    // URI's own settings, read after these, take precedence.
+    const char* keywords[] = {"connect_timeout",  "keepalives",       "keepalives_idle", "keepalives_interval",
+                              "keepalives_count", "tcp_user_timeout", "dbname",          nullptr};
+    const char* values[] = {"10", "1", "5", "2", "3", "10000", uri.c_str(), nullptr};
+    connection_ = PQconnectdbParams(keywords, values, 1);
     if (!connection_ || PQstatus(connection_) != CONNECTION_OK) {
       const std::string why = connection_ ? firstLine(PQerrorMessage(connection_)) : "out of memory";
       PQfinish(connection_);
@@ -204,7 +211,7 @@ class PostgresStore final : public JobStore, private JobRows {
     if (version_ >= kFirstVersionWithHosts) {
       // A host whose jobs were released (its lease ran out) no longer writes to them.
       const Result holder = query("SELECT host FROM jobs WHERE id = $1 FOR UPDATE", {std::to_string(id)});
-      if (holder.rows() == 0 || (!holder.text(0, 0).empty() && holder.text(0, 0) != host_)) return;
+      if (holder.rows() == 0 || holder.text(0, 0) != host_) return;
     }
     apply(id, change);
     transaction.commit();
@@ -324,11 +331,11 @@ class PostgresStore final : public JobStore, private JobRows {
     if (query("SELECT 1 FROM requests LIMIT 1").rows() == 0) return taken;
     Transaction transaction(*this);
     const Result found =
-        query(fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = $1) RETURNING {}",
+        query(fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = $1 OR host = '') "
+                          "RETURNING {}",
                           kRequestColumns),
               {host_});
     for (int row = 0; row < found.rows(); ++row) taken.push_back(requestOf(found.row(row)));
-    query("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = '')");
     transaction.commit();
     std::sort(taken.begin(), taken.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
     return taken;
@@ -361,7 +368,10 @@ class PostgresStore final : public JobStore, private JobRows {
     if (!claimed.device.empty()) {
       parameters.emplace_back(claimed.device);
       parameters.emplace_back(claimed.machine);
-      forDevice = " AND (device = $2 OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = $3)))";
+      parameters.emplace_back(claimed.material);
+      forDevice =
+          " AND (device = $2 OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = $3 AND "
+          "material = $4)))";
     }
     parameters.emplace_back(std::to_string(std::min<size_t>(claimed.limit, INT64_MAX)));
     // SKIP LOCKED: a job another host is claiming at this moment is passed over, not waited for.
@@ -515,6 +525,7 @@ class PostgresStore final : public JobStore, private JobRows {
         connection_, [](void*, const char*) {}, nullptr);
     execute("SET client_min_messages = warning");
     execute("SET synchronous_commit = on");
+    execute("SET statement_timeout = '30s'");
   }
 
   // When a statement outside a transaction failed because the connection

@@ -245,9 +245,45 @@ struct Service::Impl {
   // when its lease was last renewed, and the timer that renews it and
   // looks for work other hosts added.
   bool joined = false;
-  Clock::time_point lastBeat{};
+  Clock::time_point lastBeat{};  // when the last heartbeat that renewed the lease was sent
   std::optional<asio::steady_timer> ticker;
-  int ticks = 0;
+  // The lease watchdog, off the strand: a strand held up in a call to the
+  // store (a network gone silent) must not keep a laser cutting a job that
+  // another host may release. Until `safeUntil` (steady clock, ns; 4/5 of
+  // the lease after the last renewal was sent) this host's lease surely
+  // holds; past it, every cut and plan is stopped at once from here.
+  std::thread watchdog;
+  std::atomic<bool> watching{false}, leaseLost{false};
+  std::atomic<int64_t> safeUntil{INT64_MAX};
+  std::mutex heldMutex;  // the cuts' and plans' cancels, for the watchdog
+  std::map<JobId, std::shared_ptr<RunControl>> heldCuts;
+  std::map<JobId, std::shared_ptr<core::Cancellation>> heldPlans;
+
+  void leaseRenewed(Clock::time_point sent) {
+    lastBeat = sent;
+    const auto margin = std::chrono::duration<double>(config.lease * 0.8);
+    safeUntil = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                    (sent + std::chrono::duration_cast<Clock::duration>(margin)).time_since_epoch())
+                    .count();
+  }
+
+  void watchLease() {
+    while (watching) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      const int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now().time_since_epoch()).count();
+      if (now <= safeUntil || leaseLost.exchange(true)) continue;
+      std::lock_guard lock(heldMutex);
+      log->error("host {}: its lease on the job store was not renewed in time: stopping its {} cut{} and {} plan{}",
+                 config.host, heldCuts.size(), heldCuts.size() == 1 ? "" : "s", heldPlans.size(),
+                 heldPlans.size() == 1 ? "" : "s");
+      for (auto& [id, control] : heldCuts) {
+        control->shutdown = true;
+        control->cancel.cancel();
+      }
+      for (auto& [id, cancel] : heldPlans) cancel->cancel();
+      onStrand([this] { fence("its lease was not renewed in time"); });
+    }
+  }
   // The devices of the other live hosts, as the last heartbeat found them;
   // read off the strand too (a planned folder's submission), hence the lock.
   std::mutex othersMutex;
@@ -308,7 +344,16 @@ struct Service::Impl {
 
   fs::path plannedFolder(const JobRecord& job) const {
     const fs::path folder = spool->pathOf(job.spool);
-    return job.kind == JobKind::Planned ? folder : folder / "planned";
+    if (job.kind == JobKind::Planned) return folder;
+    // On a shared store each plan has a folder of its own, named in its
+    // summary: a plan a stalled host finishes late never overwrites the one
+    // made since by another host.
+    const json summary = json::parse(job.summary.empty() ? "{}" : job.summary, nullptr, false);
+    if (summary.is_object() && summary.contains("folder") && summary["folder"].is_string()) {
+      const std::string name = summary["folder"];
+      if (name.starts_with("planned") && name.find('/') == std::string::npos) return folder / name;
+    }
+    return folder / "planned";
   }
 
   json deviceJson(const Device& device) const {
@@ -456,11 +501,15 @@ struct Service::Impl {
     }
     std::vector<DeviceRecord> records;
     for (const Device& device : devices) records.push_back(deviceRecord(device));
+    const auto sent = Clock::now();
     const std::vector<JobRecord> left =
         store->join(me, records, config.lease, wait,
                     [](const JobRecord& job, const HostRecord&) { return released(job, "the daemon"); });
     joined = true;
-    lastBeat = Clock::now();
+    if (store->shared()) {
+      leaseRenewed(sent);
+      leaseLost = false;
+    }
     for (const JobRecord& job : left) {
       if (job.state == JobState::Interrupted) log->warn("job {}: {}", job.id, job.message);
       jobChanged(job);
@@ -482,6 +531,8 @@ struct Service::Impl {
       log->info("host {} on the shared job store, lease {:g} s", config.host, config.lease);
       ticker.emplace(strand);
       tick();
+      watching = true;
+      watchdog = std::thread([this] { watchLease(); });
     }
   }
 
@@ -490,10 +541,14 @@ struct Service::Impl {
   void tick() {
     ticker->expires_after(std::chrono::milliseconds(500));
     ticker->async_wait([this](const boost::system::error_code& error) {
-      if (error || stopping) return;
-      const int beatEvery = std::max(1, static_cast<int>(config.lease / 5 / 0.5));
-      if (ticks++ % beatEvery == 0) beat();
-      if (joined) {
+      if (error) return;
+      // The heartbeat first, by the clock; and on until a stop has stopped every cut.
+      if (Clock::now() - lastBeat >= std::chrono::duration<double>(config.lease / 5)) beat();
+      if (stopping) {
+        if (!cuts.empty() || !planning.empty()) tick();
+        return;
+      }
+      if (joined && !leaseLost) {
         try {
           serveRequests();
         } catch (const std::exception& failure) {
@@ -508,16 +563,19 @@ struct Service::Impl {
   void beat() {
     try {
       if (!joined) {
-        // Again, after its lease ran out: without waiting (a refusal is tried again at the next beat).
+        // Again, after its lease ran out, once every cut and plan it had has
+        // stopped; without waiting (a refusal is tried again at the next beat).
+        if (stopping || !cuts.empty() || !planning.empty()) return;
         joinStore(0);
         log->info("host {} joined the shared job store again", config.host);
         return;
       }
+      const auto sent = Clock::now();
       if (!store->heartbeat(config.lease)) {
         fence("its lease ran out and another host released its jobs");
         return;
       }
-      lastBeat = Clock::now();
+      leaseRenewed(sent);
       const std::vector<JobRecord> taken = store->releaseLapsedHosts([](const JobRecord& job, const HostRecord& host) {
         return released(job, fmt::format("host {} (its last heartbeat {})", host.name, isoTime(host.seen)));
       });
@@ -527,10 +585,7 @@ struct Service::Impl {
       }
       refreshOthers();
     } catch (const std::exception& error) {
-      log->error("{}", error.what());
-      if (joined && Clock::now() - lastBeat > std::chrono::duration<double>(config.lease)) {
-        fence("it could not renew its lease on the job store in time");
-      }
+      log->error("{}", error.what());  // (the watchdog stops the cuts if the lease is not renewed in time)
     }
   }
 
@@ -538,8 +593,10 @@ struct Service::Impl {
   // another host may take its jobs, so it stops them at once, lasers off,
   // and joins the store again (which releases what it still held).
   void fence(const std::string& why) {
+    if (!joined) return;
     log->error("host {}: {}: stopping its cuts and plans", config.host, why);
     joined = false;
+    leaseLost = true;
     for (auto& [id, plan] : planning) plan.cancel->cancel();
     for (auto& [id, cut] : cuts) {
       cut->control->shutdown = true;
@@ -645,17 +702,36 @@ struct Service::Impl {
   // Each job is claimed from the store (JobStore::claim), so that on a
   // shared store no two hosts plan or cut the same one.
   void pump() {
-    if (stopping || !joined) return;
+    if (stopping || !joined || leaseLost) return;
     try {
       if (planning.size() < config.planners) {
         // Any host plans any job, against its device's profiles wherever that device is.
         std::map<JobId, std::optional<Target>> targets;
         std::map<JobId, std::string> refusals;
+        // A job for a device of another host that this host cannot plan for
+        // (that host joined since this one last looked, or is away, or has a
+        // profile this one lacks) is left queued for a host that can; it
+        // fails only when no host has that device.
+        std::set<std::string> everyDevice;
+        if (store->shared()) {
+          for (const DeviceRecord& device : store->devices()) everyDevice.insert(device.name);
+        }
+        bool lookAgain = false;
+        // (More are looked at than are taken, so that jobs left queued do not hold back those behind them.)
+        const size_t free = config.planners - planning.size();
+        size_t taken = 0;
         const std::vector<JobRecord> claimed =
-            store->claim({JobState::Queued, config.planners - planning.size(), "", ""}, [&](const JobRecord& job) {
+            store->claim({JobState::Queued, free + 16, "", "", ""}, [&](const JobRecord& job) -> std::optional<Claim> {
+              if (taken == free) return std::nullopt;
               std::string why;
-              // (A job for any device planned before, by a host since gone, is planned again for any device.)
-              std::optional<Target> device = deviceFor(job.anyDevice ? "" : job.device, job.options, why);
+              // (A job for any device planned before, by a host since gone, is planned again for any
+              // device.)
+              const std::string named = job.anyDevice ? "" : job.device;
+              std::optional<Target> device = deviceFor(named, job.options, why);
+              if (!device && !named.empty() && everyDevice.contains(named)) {
+                lookAgain = true;
+                return std::nullopt;
+              }
               Claim claim{JobState::Planning, "planning", {}};
               if (device) {
                 claim.reason = planningReason(*device);
@@ -663,8 +739,10 @@ struct Service::Impl {
               }
               targets[job.id] = std::move(device);
               refusals[job.id] = why;
-              return std::optional<Claim>(claim);
+              ++taken;
+              return claim;
             });
+        if (lookAgain) refreshOthers();
         for (const JobRecord& job : claimed) {
           if (const auto& device = targets[job.id]) {
             startPlanning(job, *device);
@@ -679,12 +757,21 @@ struct Service::Impl {
         // Its own jobs, and those for any device of its machine.
         const std::string reason = fmt::format("started by itself: {} has auto_start", device.config.name);
         const std::vector<JobRecord> claimed =
-            store->claim({JobState::Ready, 1, device.config.name, device.machine.name},
+            store->claim({JobState::Ready, 1, device.config.name, device.machine.name, device.material.name},
                          [&](const JobRecord& job) -> std::optional<Claim> {
                            if (job.sheets < 1) return std::nullopt;
                            return Claim{JobState::Running, reason, cutFromSheet(1, device.config.name)};
                          });
-        for (const JobRecord& job : claimed) launchCut(job, device, 1);
+        for (const JobRecord& job : claimed) {
+          try {
+            launchCut(job, device, 1);
+          } catch (const std::exception& error) {
+            // Claimed but not started: not left running with nothing cutting it.
+            log->error("job {}: {}", job.id, error.what());
+            jobChanged(
+                store->transition(job.id, JobState::Failed, fmt::format("its cut could not start: {}", error.what())));
+          }
+        }
       }
     } catch (const std::exception& error) {
       log->error("{}", error.what());
@@ -802,6 +889,10 @@ struct Service::Impl {
       }
     });
     planning[job.id] = Planning{cancel, json(), "", timeout};
+    {
+      std::lock_guard lock(heldMutex);
+      heldPlans[job.id] = cancel;
+    }
     asio::post(planners, [this, job, machine = device.machine, material = device.material, cancel] {
       plan(job, machine, material, cancel);
     });
@@ -856,13 +947,17 @@ struct Service::Impl {
             },
             std::make_shared<spdlog::logger>(
                 "plan", std::make_shared<JobNotesSink>(log, folder, fmt::format("job {}", job.id), said)));
-        jobs::PlannedJob planned = jobs::makeJob(request, folder / "planned", context);
-        syncFolder(folder / "planned");
+        const std::string plannedName =
+            store->shared() ? fmt::format("planned-{}-{}", config.host, Clock::now().time_since_epoch().count())
+                            : "planned";
+        jobs::PlannedJob planned = jobs::makeJob(request, folder / plannedName, context);
+        syncFolder(folder / plannedName);
         syncFolder(folder);
         sheets = static_cast<int>(planned.files.size());
         summary = jobs::summaryJson(planned);
         summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
         summary["cost"] = jobs::costJson(planned.cost);
+        summary["folder"] = plannedName;
         // What the plan said on the way, for the people at the machine (the page shows them).
         summary["notes"] = said->notes;
         summary["warnings"] = said->warnings;
@@ -880,6 +975,10 @@ struct Service::Impl {
         timedOut = p->second.timedOut;
         p->second.timeout->cancel();
         planning.erase(p);
+      }
+      {
+        std::lock_guard lock(heldMutex);
+        heldPlans.erase(id);
       }
       try {
         // (Whoever cancelled first says why: a person, the daemon's stop, or the timeout.)
@@ -987,6 +1086,10 @@ struct Service::Impl {
     device->message.clear();
     const fs::path folder = plannedFolder(job);
     Cut& started = *cut;
+    {
+      std::lock_guard lock(heldMutex);
+      heldCuts[job.id] = cut->control;
+    }
     cuts[job.id] = std::move(cut);
     started.thread =
         std::thread([this, id = job.id, control = started.control, uri = device->config.uri, machine = device->machine,
@@ -1122,6 +1225,10 @@ struct Service::Impl {
     if (c == cuts.end()) return;
     std::unique_ptr<Cut> cut = std::move(c->second);
     cuts.erase(c);
+    {
+      std::lock_guard lock(heldMutex);
+      heldCuts.erase(id);
+    }
     if (cut->thread.joinable()) cut->thread.join();
     Device& device = devices[cut->device];
     device.job.reset();
@@ -1277,6 +1384,26 @@ struct Service::Impl {
     const auto refuse = [&](const std::string& why) -> Reply {
       throw ApiError(409, fmt::format("job {} is {}{}", id, stateName(job.state), why));
     };
+    // A cut or plan of this host's is stopped whatever the store says of its
+    // job (released to another host meanwhile, the laser must still go off).
+    if (action == "cancel" && (cuts.contains(id) || planning.contains(id)) && store->shared() &&
+        !(job.host == config.host && heldByAHost(job.state))) {
+      if (auto c = cuts.find(id); c != cuts.end()) {
+        c->second->cancelledBy = who;
+        c->second->control->cancel.cancel();
+        if (c->second->waiting) {
+          c->second->waiting->set_value(false);
+          c->second->waiting.reset();
+        }
+      }
+      if (auto p = planning.find(id); p != planning.end()) p->second.cancel->cancel();
+      return {202, jobJson(job)};
+    }
+    if (store->shared() && (!joined || leaseLost) && (action == "start" || action == "resume")) {
+      throw ApiError(503, fmt::format("host {} lost its lease on the job store and is joining it again; ask again in a "
+                                      "moment",
+                                      config.host));
+    }
     // A job another host is planning or cutting is that host's to act on
     // (its driver, its planner): the action is left for it in the store,
     // and it acts within half a second (Impl::serveRequests).
@@ -1428,6 +1555,16 @@ Service::Service(asio::io_context& io, DaemonConfig config, std::shared_ptr<spdl
 }
 
 Service::~Service() {
+  // The heartbeat's timer is let go, so that the strand's pool can finish.
+  std::promise<void> quiet;
+  asio::post(impl_->strand, [this, &quiet] {
+    impl_->stopping = true;
+    if (impl_->ticker) impl_->ticker->cancel();
+    quiet.set_value();
+  });
+  quiet.get_future().wait();
+  impl_->watching = false;
+  if (impl_->watchdog.joinable()) impl_->watchdog.join();
   // Whatever is still posted finishes; the planners see their cancel.
   for (auto& [id, planning] : impl_->planning) planning.cancel->cancel();
   for (auto& [id, cut] : impl_->cuts) cut->control->cancel.cancel();
@@ -1498,7 +1635,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
       entry.emplace(impl.spool->begin());
       if (!submission.fileName.empty()) {
         const std::string name = fs::path(submission.fileName).filename().string();
-        if (name.empty() || name == "." || name == ".." || name == "planned") {
+        if (name.empty() || name == "." || name == ".." || name.starts_with("planned")) {
           throw ApiError(400, fmt::format("\"{}\" is not a mesh file's name", submission.fileName));
         }
         job.kind = JobKind::Mesh;
@@ -1733,7 +1870,7 @@ void Service::unsubscribe(size_t id) {
 void Service::shutdown(const std::string& why, std::function<void()> done) {
   impl_->onStrand([this, why, done = std::move(done)]() mutable {
     Impl& impl = *impl_;
-    impl.stopping = true;
+    impl.stopping = true;  // (the heartbeat goes on until every cut has stopped; no more claims)
     impl.stopped = std::move(done);
     impl.log->info("stopping ({}): {} cut{} and {} plan{} to stop", why, impl.cuts.size(),
                    impl.cuts.size() == 1 ? "" : "s", impl.planning.size(), impl.planning.size() == 1 ? "" : "s");

@@ -165,7 +165,8 @@ class Transaction {
 // The jobs for a device (its name, then its machine's): those submitted for
 // it, and those for any device that were planned for a device of its machine.
 constexpr const char* kForTheDevice =
-    " AND (device = ? OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = ?)))";
+    " AND (device = ? OR (any_device = 1 AND device IN (SELECT name FROM devices WHERE machine = ? AND material = "
+    "?)))";
 
 class SqliteStore final : public JobStore, private JobRows {
  public:
@@ -322,13 +323,11 @@ class SqliteStore final : public JobStore, private JobRows {
     any.reset();
     Transaction transaction(db_);
     {
-      Statement take(*statements_, fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = ?) "
-                                               "RETURNING {}",
+      Statement take(*statements_, fmt::format("DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = ? "
+                                               "OR host = '') RETURNING {}",
                                                kRequestColumns));
       take.bind(1, host_);
       while (take.step()) taken.push_back(requestOf(take));
-      Statement stale(*statements_, "DELETE FROM requests WHERE job IN (SELECT id FROM jobs WHERE host = '')");
-      stale.step();
     }
     transaction.commit();
     std::sort(taken.begin(), taken.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
@@ -379,8 +378,8 @@ class SqliteStore final : public JobStore, private JobRows {
       int index = 1;
       select.bind(index++, stateName(query.from));
       if (!query.device.empty()) {
-        select.bind(index, query.device).bind(index + 1, query.machine);
-        index += 2;
+        select.bind(index, query.device).bind(index + 1, query.machine).bind(index + 2, query.material);
+        index += 3;
       }
       select.bind(index, static_cast<int64_t>(std::min<size_t>(query.limit, INT64_MAX)));
       while (select.step()) found.push_back(jobOf(select));
