@@ -197,7 +197,7 @@ TEST(Browser, OnASharedStoreThePageShowsEachDevicesHostAndAHostThatIsGone) {
   TempDir shared, rootA, rootB;
   const auto config = [&](const std::string& host, const std::string& speed) {
     return fmt::format(
-        "store: {}\nhost: {}\nspool: {}\nlease: 2\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
+        "store: {}\nhost: {}\nspool: {}\nlease: 3\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
         "\"sim:grbl?speed={}\", auto_start: true}}]\n",
         database.uri(), host, shared.path().string(), host, speed);
   };
