@@ -804,11 +804,19 @@ TEST(Daemon, AHostWhoseLeaseRanOutWhileItCutStopsItsLaserAndLeavesTheJobInterrup
   EXPECT_EQ(state(released), "interrupted") << released.dump();
   EXPECT_TRUE(eventually([&] { return readFile(lab.a.log()).find(": stopping its ") != std::string::npos; }, 10))
       << readFile(lab.a.log());
-  EXPECT_TRUE(eventually([&] { return readFile(lab.witness).ends_with("off\n"); }, 10)) << readFile(lab.witness);
-  // And it stays off: the cut does not go on.
-  const std::string after = readFile(lab.witness);
-  std::this_thread::sleep_for(std::chrono::seconds(1));
-  EXPECT_EQ(readFile(lab.witness), after);
+  // Its laser goes off and stays off: the cut does not go on. (Seen off
+  // between two strokes is not enough: off, and unchanged for a second.)
+  std::string seen = readFile(lab.witness);
+  const bool stoppedOff = eventually(
+      [&] {
+        std::this_thread::sleep_for(std::chrono::seconds(1));
+        const std::string now = readFile(lab.witness);
+        const bool still = now == seen && now.ends_with("off\n");
+        seen = now;
+        return still;
+      },
+      15);
+  EXPECT_TRUE(stoppedOff) << seen;
   // It joins again, and nothing it did after its lease ran out counts.
   const auto laserA = [&] {
     const json devices = lab.b.clientJson("devices --daemon")["devices"];
