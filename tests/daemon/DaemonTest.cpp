@@ -25,17 +25,20 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// A `make` output folder of three sheets for the default device's bed
-// (grbl-diode-400), made once for the whole program.
-const fs::path& threeSheets() {
+// The `make` output folder of an example for the default device's bed
+// (grbl-diode-400), in a folder that lasts the whole program.
+fs::path plannedExample(const std::string& example) {
   static TempDir folder;
-  static const fs::path made = [] {
-    const fs::path out = folder.path() / "soccer";
-    const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
-                                " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
-    EXPECT_EQ(r.status, 0) << r.err;
-    return out;
-  }();
+  const fs::path out = folder.path() / fs::path(example).stem();
+  const CommandResult r = run(kCli + " make " + quoted(kSource / "examples" / example) +
+                              " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return out;
+}
+
+// Three sheets, made once for the whole program.
+const fs::path& threeSheets() {
+  static const fs::path made = plannedExample("soccer-ball.obj");
   return made;
 }
 
@@ -592,14 +595,7 @@ TEST(Daemon, OnAPostgresStoreAKillMidCutLeavesTheJobInterruptedAndASecondDaemonI
 
 // A `make` output folder of one sheet, quick to cut.
 const fs::path& oneSheet() {
-  static TempDir folder;
-  static const fs::path made = [] {
-    const fs::path out = folder.path() / "cube";
-    const CommandResult r = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
-                                " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
-    EXPECT_EQ(r.status, 0) << r.err;
-    return out;
-  }();
+  static const fs::path made = plannedExample("cube.obj");
   return made;
 }
 
