@@ -11,6 +11,7 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <chrono>
+#include <optional>
 #include <random>
 #include <thread>
 
@@ -148,12 +149,20 @@ HttpReply DaemonClient::request(const std::string& method, const std::string& ta
   message.prepare_payload();
   http::response_parser<http::string_body> parser;
   parser.body_limit(1u << 30);
+  // A daemon that refuses a body (too large, a full disk) answers before
+  // reading all of it and closes: its reply is read even when the rest of
+  // the body could not be sent.
+  std::optional<boost::system::system_error> unsent;
   try {
     connection.write(message);
+  } catch (const boost::system::system_error& error) {
+    unsent = error;
+  }
+  try {
     connection.read(parser);
   } catch (const boost::system::system_error& error) {
     throw DaemonUnreachable(fmt::format("rotafabd at {} did not answer {} {}: {}", address_.describe(), method, target,
-                                        error.code().message()));
+                                        (unsent ? *unsent : error).code().message()));
   }
   HttpReply reply;
   reply.status = static_cast<int>(parser.get().result_int());

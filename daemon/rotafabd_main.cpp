@@ -64,13 +64,29 @@ std::shared_ptr<spdlog::logger> makeLogger(const fs::path& stateDir) {
   return log;
 }
 
+// The state is the daemon user's alone, whatever the umask it was started
+// with: every job's owner, file and options are in it. Files and folders
+// made from here on (umask 077) are 0600 and 0700 (SQLite's write-ahead log and shared
+// memory too, which take the database's mode); what an earlier version
+// left readable is made private, the folder first.
+void keepStatePrivate(const fs::path& stateDir) {
+  ::chmod(stateDir.c_str(), 0700);
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(stateDir, error)) {
+    // (Not into the spool: a planned folder's files are hard links to the submitter's own.)
+    if (entry.is_regular_file(error)) ::chmod(entry.path().c_str(), 0600);
+  }
+}
+
 int serve(const service::DaemonConfig& config) {
+  ::umask(0077);
   std::error_code error;
   fs::create_directories(config.stateDir, error);
   if (error) {
     fmt::print(stderr, "error: {}: cannot create the state directory: {}\n", config.stateDir.string(), error.message());
     return cli::kUserError;
   }
+  keepStatePrivate(config.stateDir);
   int lock = -1;
   try {
     lock = lockStateDir(config.stateDir);
@@ -103,7 +119,12 @@ int serve(const service::DaemonConfig& config) {
     return cli::kUserError;
   }
   nlohmann::json where{{"pid", ::getpid()}, {"listen", server.addresses()}};
-  jobs::writeFileAtomically(config.stateDir / "rotafabd.json", where.dump(2) + "\n");
+  try {
+    jobs::writeFileAtomically(config.stateDir / "rotafabd.json", where.dump(2) + "\n");
+  } catch (const std::exception& failed) {
+    // (A full disk: the daemon serves all the same; `rotafab dashboard` needs --url.)
+    log->error("{}", failed.what());
+  }
   log->info("rotafabd serving on {}; state in {}; {} device{}", fmt::join(server.addresses(), ", "),
             config.stateDir.string(), config.devices.size(), config.devices.size() == 1 ? "" : "s");
   int stopSignal = 0;

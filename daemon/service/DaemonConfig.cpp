@@ -106,8 +106,8 @@ DaemonConfig loadConfig(const fs::path& file) {
   try {
     const auto keys =
         reader.keys(root, "",
-                    {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "devices", "upload_limit",
-                     "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
+                    {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "origins", "devices",
+                     "upload_limit", "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
                     {});
     bool listenGiven = false;
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
@@ -159,6 +159,24 @@ DaemonConfig loadConfig(const fs::path& file) {
                       "expected \"sha256$SALT$HEX\" (64 hex digits), as `rotafabd --hash-token` prints it");
         }
         config.tokens.push_back(std::move(token));
+      }
+    }
+    if (const YAML::Node origins = root["origins"]) {
+      if (!origins.IsSequence())
+        reader.fail(origins, "origins", "expected a list such as [https://rotafab.lab.example]");
+      for (size_t i = 0; i < origins.size(); ++i) {
+        const std::string key = fmt::format("origins[{}]", i);
+        std::string origin = reader.text(origins[i], key);
+        while (origin.ends_with("/")) origin.pop_back();
+        const size_t scheme = origin.find("://");
+        const bool web = origin.starts_with("https://") || origin.starts_with("http://");
+        if (!web || origin.size() == scheme + 3 || origin.find_first_of("/?#@ ", scheme + 3) != std::string::npos) {
+          reader.fail(origins[i], key,
+                      fmt::format("expected the page's address as a browser shows it, scheme and host (and port), "
+                                  "such as https://rotafab.lab.example; found '{}'",
+                                  origin));
+        }
+        config.origins.push_back(origin);
       }
     }
     if (const YAML::Node devices = root["devices"]) {

@@ -48,8 +48,15 @@ struct DaemonConfig {
   // workshop page on kPagePort, or on any free port when another program has it.
   bool defaultListen = true;
   std::vector<TokenConfig> tokens;
+  // Where browsers reach the page other than at a listener's own address:
+  // a reverse proxy's ("https://rotafab.lab.example"). A request that
+  // changes something is taken from a page of these origins or of the
+  // listener's own, and a loopback listener answers to their host names.
+  std::vector<std::string> origins;
   std::vector<DeviceConfig> devices;
   size_t uploadLimit = 256u << 20;  // bytes of one request's body
+  // Connections at once, on the Unix socket and on TCP each (of TCP's, half
+  // at most before a request shows a token or session; HttpServer.cpp).
   size_t connectionLimit = 64;
   double headerTimeout = 10;  // seconds for a request's header to arrive
   double bodyTimeout = 120;   // seconds for its body

@@ -1,24 +1,24 @@
 #include "daemon/service/HttpServer.h"
 
 #include <fmt/format.h>
-#include <openssl/rand.h>
 #include <pwd.h>
 #include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <array>
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/local/stream_protocol.hpp>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <boost/asio/thread_pool.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
-#include <charconv>
 #include <chrono>
 #include <deque>
 #include <filesystem>
-#include <fstream>
+#include <map>
 #include <optional>
 #include <regex>
 #include <set>
@@ -26,7 +26,9 @@
 #include <utility>
 
 #include "core/ProgramFolders.h"
-#include "daemon/service/Multipart.h"
+#include "daemon/service/AccessGate.h"
+#include "daemon/service/ApiInput.h"
+#include "daemon/service/UploadForm.h"
 
 namespace rotafab::service {
 namespace asio = boost::asio;
@@ -37,28 +39,19 @@ using nlohmann::json;
 
 namespace {
 
-// Who is asking, as the connection shows it.
-struct Identity {
-  bool allowed = false;
-  std::string name;  // the owner of what they submit
-  std::string refusal;
-  bool bySession = false;  // a browser's session: it may not ask for login links
-};
-
-using Clock = std::chrono::steady_clock;
-
-// A login link works once, within this time; a session lasts this long unused.
-constexpr auto kLoginLinkLasts = std::chrono::minutes(5);
-constexpr auto kSessionLasts = std::chrono::hours(24 * 7);
-
-// 32 random bytes from OpenSSL's generator, as hex: a login code or a session.
-std::string randomSecret() {
-  unsigned char bytes[32];
-  if (RAND_bytes(bytes, sizeof bytes) != 1) throw ApiError(500, "no random bytes for a secret");
-  std::string text;
-  for (unsigned char byte : bytes) text += fmt::format("{:02x}", byte);
-  return text;
-}
+// A TCP peer address's connections that no request has yet shown a token
+// or session on: a local program that opens many and sends nothing takes
+// no more than these (and all such together no more than half of
+// connection_limit), and never any of the Unix socket's, which has a limit
+// of its own.
+constexpr size_t kUnknownPerPeer = 16;
+// A connection closed on a refusal is read from (and what it sends thrown
+// away) for this long or this much at most, so that its client reads the
+// refusal rather than a reset.
+constexpr auto kLingerFor = std::chrono::seconds(2);
+constexpr size_t kLingerBytes = 1 << 20;
+// An upload is read this much at a time, and written before the next piece is read.
+constexpr size_t kUploadPiece = 64 * 1024;
 
 // The page's files (HTML, CSS, JavaScript): PREFIX/share/rotafab/web once
 // installed; the source tree's daemon/web for a program run from its build tree.
@@ -98,98 +91,42 @@ std::optional<std::string> accountName(uid_t uid) {
   return std::nullopt;
 }
 
-std::optional<long long> wholeNumber(std::string_view text) {
-  long long value = 0;
-  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (error != std::errc() || end != text.data() + text.size()) return std::nullopt;
-  return value;
-}
-
-// The path split at '/': "/api/jobs/7/start" -> api, jobs, 7, start; the query dropped.
-std::vector<std::string> pathParts(std::string_view target, std::string& query) {
-  const size_t mark = target.find('?');
-  query = mark == std::string_view::npos ? "" : std::string(target.substr(mark + 1));
-  target = target.substr(0, mark);
-  std::vector<std::string> parts;
-  while (!target.empty()) {
-    const size_t slash = target.find('/');
-    if (slash != 0) parts.emplace_back(target.substr(0, slash));
-    if (slash == std::string_view::npos) break;
-    target = target.substr(slash + 1);
-  }
-  return parts;
-}
-
-std::string queryValue(const std::string& query, std::string_view key) {
-  std::string_view rest = query;
-  while (!rest.empty()) {
-    const size_t amp = rest.find('&');
-    const std::string_view pair = rest.substr(0, amp);
-    if (pair.starts_with(key) && pair.size() > key.size() && pair[key.size()] == '=') {
-      return std::string(pair.substr(key.size() + 1));
-    }
-    if (amp == std::string_view::npos) break;
-    rest = rest.substr(amp + 1);
-  }
-  return "";
-}
-
-// The `make` options of a submission: a JSON array of command-line words,
-// or an object of option names and values ({"structure": "band", "score-folds": true}).
-std::vector<std::string> optionWords(const json& options) {
-  std::vector<std::string> words;
-  if (options.is_null()) return words;
-  if (options.is_array()) {
-    for (const json& word : options) {
-      if (!word.is_string())
-        throw ApiError(400, "options: expected a list of words such as [\"--structure\", \"band\"]");
-      words.push_back(word.get<std::string>());
-    }
-    return words;
-  }
-  if (!options.is_object()) throw ApiError(400, "options: expected a list of words or an object of options");
-  for (const auto& [key, value] : options.items()) {
-    const std::string flag = key.starts_with("--") ? key : "--" + key;
-    if (value.is_boolean()) {
-      if (value.get<bool>()) words.push_back(flag);
-    } else if (value.is_string()) {
-      words.push_back(flag), words.push_back(value.get<std::string>());
-    } else if (value.is_number()) {
-      words.push_back(flag), words.push_back(value.dump());
-    } else {
-      throw ApiError(400, fmt::format("options.{}: expected text, a number or true", key));
-    }
-  }
-  return words;
-}
-
-int priorityOf(const json& value) {
-  if (value.is_null()) return 0;
-  if (value.is_number_integer()) return value.get<int>();
-  if (value.is_string()) {
-    if (auto number = wholeNumber(value.get<std::string>()); number && *number > -1000000 && *number < 1000000) {
-      return static_cast<int>(*number);
-    }
-  }
-  throw ApiError(400, "priority: expected a whole number");
+bool isLoopback(const asio::ip::address& address) {
+  return address.is_loopback() || (address.is_v6() && address.to_v6().is_v4_mapped() &&
+                                   asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6()).is_loopback());
 }
 
 }  // namespace
 
 struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   Impl(asio::io_context& io, Service& service, std::shared_ptr<spdlog::logger> log, HttpLimits limits)
-      : io(io), service(service), log(std::move(log)), limits(limits) {}
+      : io(io), service(service), log(std::move(log)), limits(limits), gate(service.config()) {
+    for (const fs::path& folder : {service.config().stateDir, service.config().spool, pages, fs::path(kThreeFolder)}) {
+      std::string text = folder.lexically_normal().string();
+      while (text.size() > 1 && text.back() == '/') text.pop_back();
+      if (!text.empty()) hidden.push_back(text);
+    }
+  }
 
   asio::io_context& io;
   Service& service;
   std::shared_ptr<spdlog::logger> log;
   HttpLimits limits;
+  fs::path pages = pageFolder();
+  AccessGate gate;
+  std::vector<std::string> hidden;  // folders no client is told of (withoutDaemonPaths)
   std::vector<std::unique_ptr<asio::local::stream_protocol::acceptor>> unixAcceptors;
   std::vector<std::unique_ptr<asio::ip::tcp::acceptor>> tcpAcceptors;
   std::vector<fs::path> socketFiles;
   std::vector<std::string> bound;
-  size_t connections = 0;
   bool closing = false;
+  // The connections open, counted apart: the owner's socket is never short
+  // of room because of TCP, and callers nobody knows yet have less of TCP.
+  size_t unixConnections = 0, tcpConnections = 0, tcpUnknown = 0;
+  std::map<asio::ip::address, size_t> unknownByPeer;
+  // Uploads are written here, a piece at a time, never on the I/O thread
+  // (a spool on a slow disk would hold up every connection, the owner's too).
+  asio::thread_pool disk{1};
   // Every connection, to close them all at shutdown.
   struct Connection {
     virtual ~Connection() = default;
@@ -203,94 +140,19 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   static constexpr auto kNameKeptFor = std::chrono::seconds(60);
   std::unordered_map<uid_t, std::pair<std::string, std::chrono::steady_clock::time_point>> names;
 
-  Identity identify(asio::local::stream_protocol::socket& socket) {
+  std::optional<Caller> peerOf(asio::local::stream_protocol::socket& socket) {
     struct ucred credentials {};
     socklen_t size = sizeof credentials;
-    if (::getsockopt(socket.native_handle(), SOL_SOCKET, SO_PEERCRED, &credentials, &size) != 0) {
-      return {false, "", "the peer's credentials cannot be read"};
-    }
+    if (::getsockopt(socket.native_handle(), SOL_SOCKET, SO_PEERCRED, &credentials, &size) != 0) return std::nullopt;
     const auto now = std::chrono::steady_clock::now();
     auto known = names.find(credentials.uid);
     if (known == names.end() || now - known->second.second > kNameKeptFor) {
       const auto found = accountName(credentials.uid);
       // Not found, perhaps only for now: not kept, asked again next time.
-      if (!found) return {true, fmt::format("uid {}", credentials.uid), ""};
+      if (!found) return Caller{fmt::format("uid {}", credentials.uid), false};
       known = names.insert_or_assign(credentials.uid, std::pair{*found, now}).first;
     }
-    return {true, known->second.first, ""};
-  }
-
-  // Over TCP nobody gets in without a token of the configuration or the
-  // secret of a browser's session, which a one-time login link gave the page
-  // (it keeps it in its origin's storage, which no other port's page reads,
-  // and sends it as a bearer token; the event stream, which cannot send a
-  // header, as `?session=`). No cookie: nothing a browser sends by itself.
-  template <typename Request>
-  Identity identify(asio::ip::tcp::socket&, const Request& request) {
-    const auto& tokens = service.config().tokens;
-    const auto header = request[http::field::authorization];
-    const std::string_view value(header.data(), header.size());
-    std::string secret;
-    if (value.starts_with("Bearer ")) {
-      secret = std::string(value.substr(7));
-    } else {
-      const std::string_view target(request.target().data(), request.target().size());
-      if (target.starts_with("/api/events")) {
-        std::string query;
-        pathParts(target, query);
-        secret = queryValue(query, "session");
-      }
-    }
-    if (secret.empty()) {
-      return {false, "",
-              tokens.empty() ? "this listener needs a session: run `rotafab dashboard` on the daemon's machine for a "
-                               "login link"
-                             : "this listener needs a token: send `Authorization: Bearer TOKEN` (rotafab --token T), "
-                               "or a session from `rotafab dashboard`"};
-    }
-    const auto now = Clock::now();
-    if (const auto found = sessions.find(secret); found != sessions.end()) {
-      if (now - found->second.second < kSessionLasts) {
-        found->second.second = now;
-        return {true, found->second.first, "", true};
-      }
-      sessions.erase(found);
-    }
-    for (const TokenConfig& configured : tokens) {
-      if (tokenMatches(secret, configured.hash)) return {true, configured.name, "", false};
-    }
-    return {false, "",
-            "the token or session is not one this daemon knows (a session ends when the daemon starts again): run "
-            "`rotafab dashboard` for a new link"};
-  }
-
-  // One-time login links (code -> who, until when) and the sessions they
-  // opened (secret -> who, last used); in memory: a daemon started again
-  // asks everyone to sign in again.
-  std::unordered_map<std::string, std::pair<std::string, Clock::time_point>> loginCodes;
-  std::unordered_map<std::string, std::pair<std::string, Clock::time_point>> sessions;
-  fs::path pages = pageFolder();
-
-  std::string newLoginCode(const std::string& name) {
-    const auto now = Clock::now();
-    std::erase_if(loginCodes, [&](const auto& entry) { return entry.second.second < now; });
-    std::string code = randomSecret();
-    loginCodes[code] = {name, now + kLoginLinkLasts};
-    return code;
-  }
-
-  // The secret of a new session for the code's holder; none when the code is unknown, used or old.
-  std::optional<std::string> openSession(const std::string& code) {
-    const auto found = loginCodes.find(code);
-    if (found == loginCodes.end()) return std::nullopt;
-    const auto [name, until] = found->second;
-    loginCodes.erase(found);
-    const auto now = Clock::now();
-    if (until < now) return std::nullopt;
-    std::erase_if(sessions, [&](const auto& entry) { return now - entry.second.second >= kSessionLasts; });
-    std::string secret = randomSecret();
-    sessions[secret] = {name, now};
-    return secret;
+    return Caller{known->second.first, false};
   }
 
   // Where a browser on this machine reaches the daemon: its first loopback TCP listener.
@@ -308,23 +170,50 @@ namespace {
 
 template <typename Protocol>
 class Session : public HttpServer::Impl::Connection, public std::enable_shared_from_this<Session<Protocol>> {
+  static constexpr bool kTcp = std::is_same_v<Protocol, asio::ip::tcp>;
+
  public:
   using Stream = beast::basic_stream<Protocol>;
-  Session(typename Protocol::socket socket, std::shared_ptr<HttpServer::Impl> server)
-      : stream_(std::move(socket)), server_(std::move(server)) {}
+  Session(typename Protocol::socket socket, std::shared_ptr<HttpServer::Impl> server, Listener listener)
+      : stream_(std::move(socket)), server_(std::move(server)), listener_(listener) {}
 
-  void start(bool overLimit) {
-    ++server_->connections;
-    if constexpr (std::is_same_v<Protocol, asio::local::stream_protocol>) {
-      identity_ = server_->identify(stream_.socket());
+  void start() {
+    HttpServer::Impl& server = *server_;
+    const size_t limit = server.service.config().connectionLimit;
+    std::string full;
+    if constexpr (kTcp) {
+      beast::error_code error;
+      peer_ = stream_.socket().remote_endpoint(error).address();
+      counted_ = true;
+      ++server.tcpConnections;
+      ++server.tcpUnknown;
+      const size_t fromPeer = ++server.unknownByPeer[peer_];
+      if (server.tcpConnections > limit || server.tcpUnknown > std::max<size_t>(1, limit / 2)) {
+        full = fmt::format("the daemon serves {} TCP connections at once; try again shortly", limit);
+      } else if (fromPeer > kUnknownPerPeer) {
+        full = fmt::format("{} has {} connections open without a token or session; try again once they are done",
+                           peer_.to_string(), kUnknownPerPeer);
+      }
+    } else {
+      counted_ = true;
+      if (++server.unixConnections > limit) {
+        full = fmt::format("the daemon serves {} connections on its socket at once; try again shortly", limit);
+      }
+      peerCaller_ = server.peerOf(stream_.socket());
     }
-    if (overLimit) {
-      overLimit_ = true;
-    }
+    if (!full.empty()) return fail(503, full);  // at once: not a byte of the request is waited for
     readHeader(true);
   }
 
-  ~Session() override { --server_->connections; }
+  ~Session() override {
+    if (!counted_) return;
+    if constexpr (kTcp) {
+      --server_->tcpConnections;
+      if (!known_) unknownGone();
+    } else {
+      --server_->unixConnections;
+    }
+  }
 
   void close() override {
     beast::error_code ignored;
@@ -333,10 +222,19 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   }
 
  private:
+  void unknownGone() {
+    --server_->tcpUnknown;
+    if (auto found = server_->unknownByPeer.find(peer_);
+        found != server_->unknownByPeer.end() && --found->second == 0) {
+      server_->unknownByPeer.erase(found);
+    }
+  }
+
   void readHeader(bool first) {
     header_.emplace();
     header_->header_limit(static_cast<std::uint32_t>(server_->limits.headerBytes));
-    header_->body_limit(server_->service.config().uploadLimit);
+    // (The gate judges the body's size, by route; the parser is not to refuse it first.)
+    header_->body_limit(std::numeric_limits<std::uint64_t>::max());
     stream_.expires_after(first ? server_->limits.header : server_->limits.idle);
     http::async_read_header(
         stream_, buffer_, *header_,
@@ -354,69 +252,141 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     if (error == http::error::header_limit) {
       return fail(431, fmt::format("the request's header is larger than {} bytes", server_->limits.headerBytes));
     }
-    if (error == http::error::body_limit) {  // the Content-Length said so before any of the body came
-      return fail(413, fmt::format("the body is larger than the {} bytes the daemon takes",
-                                   server_->service.config().uploadLimit));
-    }
     if (error) return fail(400, fmt::format("malformed request: {}", error.message()));
-    auto& request = header_->get();
-    if (overLimit_) {
-      return fail(503, fmt::format("the daemon serves {} connections at once; try again shortly",
-                                   server_->service.config().connectionLimit));
-    }
-    if constexpr (std::is_same_v<Protocol, asio::ip::tcp>) identity_ = server_->identify(stream_.socket(), request);
-    // The page's own files are the same for everyone and hold nothing of
-    // the queue: served to anyone who reaches the listener; the API is not.
-    const std::string_view path(request.target().data(), request.target().size());
-    const bool page = !path.starts_with("/api");
-    if (!identity_.allowed && !page) return fail(401, identity_.refusal);
-    if (request.has_content_length() && *header_->content_length() > server_->service.config().uploadLimit) {
-      return fail(413, fmt::format("the body is {} bytes; the daemon takes at most {}", *header_->content_length(),
-                                   server_->service.config().uploadLimit));
-    }
-    const std::string target(request.target());
-    if (request.method() == http::verb::get && target.starts_with("/api/events")) return startEvents(target);
-    body_.emplace(std::move(*header_));
-    body_->body_limit(server_->service.config().uploadLimit);
-    stream_.expires_after(server_->limits.body);
-    const auto expect = body_->get()[http::field::expect];
-    if (beast::iequals(expect, "100-continue")) {
-      auto continued = std::make_shared<std::string>("HTTP/1.1 100 Continue\r\n\r\n");
-      asio::async_write(stream_, asio::buffer(*continued),
-                        [self = this->shared_from_this(), continued](beast::error_code written, size_t) {
-                          if (written) return self->close();
-                          self->readBody();
-                        });
-      return;
-    }
-    readBody();
-  }
-
-  void readBody() {
-    http::async_read(stream_, buffer_, *body_,
-                     [self = this->shared_from_this()](beast::error_code error, size_t) { self->onBody(error); });
-  }
-
-  void onBody(beast::error_code error) {
-    if (error == http::error::body_limit) {
-      return fail(413, fmt::format("the body is larger than the {} bytes the daemon takes",
-                                   server_->service.config().uploadLimit));
-    }
-    if (error == beast::error::timeout) {
-      server_->log->info("a client did not send its request's body in time; closed");
-      return fail(408, "the request's body did not come in time");
-    }
-    if (error) return close();
-    stream_.expires_never();
-    request_ = body_->release();
+    const auto& request = header_->get();
+    const auto field = [&](http::field name) {
+      const auto value = request[name];
+      return std::string_view(value.data(), value.size());
+    };
+    RequestHead head;
+    head.method = request.method();
+    head.target = std::string_view(request.target().data(), request.target().size());
+    head.host = field(http::field::host);
+    head.origin = field(http::field::origin);
+    head.fetchSite = std::string_view(request["Sec-Fetch-Site"].data(), request["Sec-Fetch-Site"].size());
+    head.contentType = field(http::field::content_type);
+    head.authorization = field(http::field::authorization);
+    if (const auto length = header_->content_length()) head.contentLength = *length;
+    head.chunked = header_->chunked();
+    keepAlive_ = request.keep_alive();
+    method_ = request.method();
+    host_ = std::string(head.host);
+    expectsContinue_ = beast::iequals(request[http::field::expect], "100-continue");
     try {
-      route();
+      admitted_ = server_->gate.admit(head, listener_, peerCaller_);
     } catch (const ApiError& refused) {
-      respond({refused.status, {{"error", refused.what()}}});
-    } catch (const std::exception& failure) {
-      respond({400, {{"error", failure.what()}}});
+      return fail(refused.status, refused.what());
+    }
+    if constexpr (kTcp) {
+      if (admitted_.caller && !known_) {
+        known_ = true;
+        unknownGone();
+      }
+    }
+    switch (admitted_.body) {
+      case BodyKind::None:
+        if (admitted_.route.route == Route::Events) return startEvents();
+        return dispatch(json());
+      case BodyKind::Json:
+        return readJson();
+      case BodyKind::JsonOrForm:
+        return readUpload();
     }
   }
+
+  // What the caller is told to send its body (curl waits a second for it before it sends a large one).
+  template <typename Next>
+  void continueThen(Next next) {
+    if (!expectsContinue_) return next();
+    auto continued = std::make_shared<std::string>("HTTP/1.1 100 Continue\r\n\r\n");
+    asio::async_write(stream_, asio::buffer(*continued),
+                      [self = this->shared_from_this(), continued, next](beast::error_code written, size_t) {
+                        if (written) return self->close();
+                        next();
+                      });
+  }
+
+  void readJson() {
+    json_.emplace(std::move(*header_));
+    json_->body_limit(admitted_.bodyLimit);
+    stream_.expires_after(server_->limits.body);
+    continueThen([self = this->shared_from_this()] {
+      http::async_read(self->stream_, self->buffer_, *self->json_, [self](beast::error_code error, size_t) {
+        if (self->bodyFailed(error)) return;
+        const std::string& text = self->json_->get().body();
+        json body = text.empty() ? json::object() : json::parse(text, nullptr, false);
+        if (body.is_discarded()) return self->fail(400, "the body is not valid JSON");
+        if (!body.is_object()) return self->fail(400, "the body must be a JSON object");
+        self->json_.reset();
+        self->dispatch(std::move(body));
+      });
+    });
+  }
+
+  // Whether reading a body failed (and the caller was told, or the connection closed).
+  bool bodyFailed(beast::error_code error) {
+    if (!error) return false;
+    if (error == http::error::body_limit) {
+      fail(413,
+           fmt::format("the body is larger than the {} bytes {} takes", admitted_.bodyLimit, admitted_.target.path()));
+    } else if (error == beast::error::timeout) {
+      server_->log->info("a client did not send its request's body in time; closed");
+      fail(408, "the request's body did not come in time");
+    } else {
+      close();
+    }
+    return true;
+  }
+
+  // ---- an upload, streamed into the spool ----
+
+  void readUpload() {
+    try {
+      form_ = std::make_shared<UploadForm>(server_->service.beginUpload(), admitted_.boundary);
+    } catch (const ApiError& refused) {
+      return fail(refused.status, refused.what());
+    }
+    piece_.resize(kUploadPiece);
+    upload_.emplace(std::move(*header_));
+    upload_->body_limit(admitted_.bodyLimit);
+    stream_.expires_after(server_->limits.body);
+    continueThen([self = this->shared_from_this()] { self->readPiece(); });
+  }
+
+  void readPiece() {
+    auto& body = upload_->get().body();
+    body.data = piece_.data();
+    body.size = piece_.size();
+    http::async_read(stream_, buffer_, *upload_, [self = this->shared_from_this()](beast::error_code error, size_t) {
+      if (error == http::error::need_buffer) error = {};
+      if (self->bodyFailed(error)) return;
+      const size_t got = self->piece_.size() - self->upload_->get().body().size;
+      const bool last = self->upload_->is_done();
+      // Written on the disk thread; the next piece is read once it is.
+      asio::post(self->server_->disk, [self, got, last] {
+        std::optional<Reply> refused;
+        auto submission = std::make_shared<std::optional<Submission>>();
+        try {
+          self->form_->feed(std::string_view(self->piece_.data(), got));
+          if (last) submission->emplace(self->form_->finish(self->admitted_.caller->name));
+        } catch (const ApiError& error) {
+          refused = Reply{error.status, {{"error", error.what()}}};
+        } catch (const std::exception& error) {
+          refused = Reply{500, {{"error", error.what()}}};
+        }
+        if (refused || last) self->form_.reset();  // (an unfinished entry goes with it)
+        asio::post(self->stream_.get_executor(), [self, refused, submission, last]() mutable {
+          if (refused) return self->fail(refused->status, refused->body.value("error", ""));
+          if (!last) return self->readPiece();
+          self->upload_.reset();
+          self->stream_.expires_never();
+          self->server_->service.submit(std::move(**submission), self->replier());
+        });
+      });
+    });
+  }
+
+  // ---- what each route answers ----
 
   // The reply reaches the session on its own executor, whichever thread the service answered on.
   ReplyHandler replier() {
@@ -426,109 +396,87 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     };
   }
 
-  json bodyJson() const {
-    if (request_.body().empty()) return json::object();
-    json body = json::parse(request_.body(), nullptr, false);
-    if (body.is_discarded()) throw ApiError(400, "the body is not valid JSON");
-    if (!body.is_object()) throw ApiError(400, "the body must be a JSON object");
-    return body;
+  void dispatch(json body) {
+    header_.reset();
+    try {
+      route(std::move(body));
+    } catch (const ApiError& refused) {
+      respond({refused.status, {{"error", refused.what()}}});
+    } catch (const std::exception& failure) {
+      respond({400, {{"error", failure.what()}}});
+    }
   }
 
-  void route() {
-    std::string query;
-    const auto parts = pathParts(std::string_view(request_.target().data(), request_.target().size()), query);
-    const http::verb method = request_.method();
-    const auto wrongMethod = [&](const char* allowed) {
-      throw ApiError(405, fmt::format("{} takes {}", std::string(request_.target()), allowed));
-    };
-    if (parts.empty() || parts[0] != "api") return page(parts, query);
-    if (parts.size() == 1) {
-      if (method != http::verb::get) wrongMethod("GET");
-      return respond({200, {{"name", "rotafabd"}, {"version", "0.1.0"}, {"host", server_->service.config().host}}});
-    }
-    if (parts[1] == "sessions" && parts.size() == 2) {
-      if (method != http::verb::post) wrongMethod("POST");
-      return loginLink();
-    }
-    if (parts[1] == "devices" && parts.size() == 2) {
-      if (method != http::verb::get) wrongMethod("GET");
-      return server_->service.devices(replier());
-    }
-    if (parts[1] != "jobs") throw ApiError(404, fmt::format("no such resource: {}", std::string(request_.target())));
-    if (parts.size() == 2) {
-      if (method == http::verb::get) return server_->service.list(replier());
-      if (method != http::verb::post) wrongMethod("GET and POST");
-      return server_->service.submit(submission(), replier());
-    }
-    const auto id = wholeNumber(parts[2]);
-    if (!id || *id <= 0) throw ApiError(404, fmt::format("no such job: {}", parts[2]));
-    if (parts.size() == 3) {
-      if (method != http::verb::get) wrongMethod("GET");
-      return server_->service.status(*id, replier());
-    }
-    if (parts.size() == 4 && parts[3] == "manifest") {
-      if (method != http::verb::get) wrongMethod("GET");
-      return server_->service.manifest(*id, replier());
-    }
-    if (parts.size() == 5 && parts[3] == "files") {
-      if (method != http::verb::get) wrongMethod("GET");
-      return server_->service.file(*id, parts[4], replier());
-    }
-    if (parts.size() == 5 && parts[3] == "sheets") {
-      if (method != http::verb::get) wrongMethod("GET");
-      const auto sheet = wholeNumber(parts[4]);
-      if (!sheet || *sheet < 1 || *sheet > 1000000) throw ApiError(404, fmt::format("no sheet {}", parts[4]));
-      return server_->service.sheet(*id, static_cast<int>(*sheet), replier());
-    }
-    if (parts.size() == 4) {
-      static const std::set<std::string> actions{"cancel", "pause", "resume", "start", "next", "move"};
-      if (!actions.contains(parts[3])) {
-        throw ApiError(404, fmt::format("no action {} (cancel, pause, resume, start, next, move)", parts[3]));
+  JobId jobNumber() const {
+    const auto id = wholeNumberIn(admitted_.route.job, kJobField);
+    if (!id) throw ApiError(404, fmt::format("no such job: {}", shownText(admitted_.route.job, 40)));
+    return *id;
+  }
+
+  void route(json body) {
+    Service& service = server_->service;
+    const MatchedRoute& route = admitted_.route;
+    const bool get = method_ == http::verb::get;
+    switch (route.route) {
+      case Route::PageIndex:
+      case Route::PageFile:
+      case Route::PageLibrary:
+      case Route::Favicon:
+        return page();
+      case Route::Login:
+        return login();
+      case Route::About:
+        return respond({200, {{"name", "rotafabd"}, {"version", "0.1.0"}, {"host", service.config().host}}});
+      case Route::Sessions:
+        return loginLink();
+      case Route::Devices:
+        return service.devices(replier());
+      case Route::Events:
+        return;  // (started from the header)
+      case Route::Jobs:
+        if (get) return service.list(replier());
+        return service.submit(jsonSubmission(body), replier());
+      case Route::Job:
+        return service.status(jobNumber(), replier());
+      case Route::JobManifest:
+        return service.manifest(jobNumber(), replier());
+      case Route::JobFile:
+        return service.file(jobNumber(), route.name, replier());
+      case Route::JobSheet: {
+        const JobId id = jobNumber();
+        const auto sheet = wholeNumberIn(route.name, kSheetField);
+        if (!sheet) throw ApiError(404, fmt::format("no sheet {}", shownText(route.name, 40)));
+        return service.sheet(id, static_cast<int>(*sheet), replier());
       }
-      if (method != http::verb::post) wrongMethod("POST");
-      return server_->service.act(*id, parts[3], bodyJson(), identity_.name, replier());
+      case Route::JobAction: {
+        const JobId id = jobNumber();
+        return service.act(id, route.name, checkedActionArguments(route.name, body), admitted_.caller->name, replier());
+      }
     }
-    throw ApiError(404, fmt::format("no such resource: {}", std::string(request_.target())));
   }
 
-  // The workshop page: its files, Debian's three.js, and the login link's landing.
-  void page(const std::vector<std::string>& parts, const std::string& query) {
-    if (request_.method() != http::verb::get) {
-      throw ApiError(405, fmt::format("{} takes GET", std::string(request_.target())));
-    }
+  // The workshop page's files and Debian's three.js, the same for everyone.
+  void page() {
+    const MatchedRoute& route = admitted_.route;
     const auto notFound = [&] {
       return ApiError(404, fmt::format("no such page: {} (the page is at /, the API under /api; see docs/API.md)",
-                                       std::string(request_.target())));
+                                       admitted_.target.path()));
     };
-    if (parts.size() == 1 && parts[0] == "login") {
-      // The secret goes to the page in the fragment, which the browser
-      // never sends to a server; the page keeps it and clears the address.
-      const auto secret = server_->openSession(queryValue(query, "code"));
-      Reply landing{303, nullptr};
-      landing.text = "to the workshop page\n";
-      landing.contentType = "text/plain; charset=utf-8";
-      landing.headers = {{"Location", secret ? "/#session=" + *secret : "/#signin=used"}};
-      return respond(std::move(landing));
-    }
-    if (parts.size() == 1 && parts[0] == "favicon.ico") {
+    Reply file;
+    if (route.route == Route::Favicon) {
       Reply none{204, nullptr};  // no icon: asked for by every browser of its own accord
       none.contentType = "image/x-icon";
       return respond(std::move(none));
     }
-    Reply file;
-    if (parts.empty()) {
+    if (route.route == Route::PageIndex) {
       file.file = server_->pages / "index.html";
-    } else if (parts.size() == 2 && parts[0] == "app") {
+    } else if (route.route == Route::PageFile) {
       static const std::regex kPageFile(R"([A-Za-z0-9_-]+\.(html|js|css|svg|png))");
-      if (!std::regex_match(parts[1], kPageFile)) throw notFound();
-      file.file = server_->pages / parts[1];
-    } else if (parts.size() > 2 && parts[0] == "lib" && parts[1] == "three") {
-      std::string rest;
-      for (size_t i = 2; i < parts.size(); ++i) rest += (i > 2 ? "/" : "") + parts[i];
-      if (!threeFiles().contains(rest)) throw notFound();
-      file.file = fs::path(kThreeFolder) / rest;
+      if (!std::regex_match(route.name, kPageFile)) throw notFound();
+      file.file = server_->pages / route.name;
     } else {
-      throw notFound();
+      if (!threeFiles().contains(route.name)) throw notFound();
+      file.file = fs::path(kThreeFolder) / route.name;
     }
     std::error_code error;
     if (!fs::is_regular_file(file.file, error)) {
@@ -537,14 +485,24 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     respond(std::move(file));
   }
 
+  // A login link's landing: the secret goes to the page in the fragment,
+  // which the browser never sends to a server; the page keeps it and clears the address.
+  void login() {
+    const auto secret = server_->gate.openSession(queryValue(admitted_.target.query, "code"));
+    Reply landing{303, nullptr};
+    landing.text = "to the workshop page\n";
+    landing.contentType = "text/plain; charset=utf-8";
+    landing.headers = {{"Location", secret ? "/#session=" + *secret : "/#signin=used"}};
+    respond(std::move(landing));
+  }
+
   // A one-time link that opens a browser's session for who asks (over the
   // Unix socket: this machine's user; over TCP: the token's holder).
   void loginLink() {
     std::string base;
-    if constexpr (std::is_same_v<Protocol, asio::ip::tcp>) {
-      if (identity_.bySession) throw ApiError(403, "a login link is asked for with a token or on this machine");
-      const auto host = request_[http::field::host];
-      base = "http://" + std::string(host.data(), host.size());
+    if constexpr (kTcp) {
+      if (admitted_.caller->bySession) throw ApiError(403, "a login link is asked for with a token or on this machine");
+      base = "http://" + host_;
     } else {
       const auto page = server_->loopbackPage();
       if (!page) {
@@ -554,54 +512,24 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
       }
       base = *page;
     }
-    const std::string code = server_->newLoginCode(identity_.name);
+    const std::string code = server_->gate.newLoginCode(admitted_.caller->name);
     respond({201,
              {{"url", base + "/login?code=" + code},
               {"page", base + "/"},
-              {"user", identity_.name},
-              {"expires_in", std::chrono::seconds(kLoginLinkLasts).count()}}});
+              {"user", admitted_.caller->name},
+              {"expires_in", std::chrono::seconds(AccessGate::kLoginLinkLasts).count()}}});
   }
 
-  Submission submission() const {
+  // {"path": ...} of a mesh or a `make` output folder on the daemon's machine.
+  Submission jsonSubmission(const json& body) const {
     Submission submission;
-    submission.owner = identity_.name;
-    const auto type = request_[http::field::content_type];
-    if (const auto boundary = multipartBoundary(std::string_view(type.data(), type.size()))) {
-      std::vector<FormPart> parts;
-      try {
-        parts = parseMultipart(request_.body(), *boundary);
-      } catch (const std::invalid_argument& malformed) {
-        throw ApiError(400, fmt::format("malformed multipart body: {}", malformed.what()));
-      }
-      bool file = false;
-      for (const FormPart& part : parts) {
-        if (part.name == "file" || part.name == "mesh") {
-          if (!part.fileName || part.fileName->empty()) throw ApiError(400, "the file part has no filename");
-          submission.fileName = *part.fileName;
-          submission.bytes = std::string(part.bytes);
-          file = true;
-        } else if (part.name == "options") {
-          const json options = json::parse(part.bytes, nullptr, false);
-          if (options.is_discarded()) throw ApiError(400, "options: not valid JSON");
-          submission.options = optionWords(options);
-        } else if (part.name == "device") {
-          submission.device = std::string(part.bytes);
-        } else if (part.name == "priority") {
-          submission.priority = priorityOf(json(std::string(part.bytes)));
-        } else {
-          throw ApiError(400, fmt::format("unknown form field \"{}\" (file, options, device, priority)", part.name));
-        }
-      }
-      if (!file) throw ApiError(400, "the form has no file part (the mesh, as file=@bunny.obj)");
-      return submission;
-    }
-    const json body = bodyJson();
+    submission.owner = admitted_.caller->name;
     for (const auto& [key, value] : body.items()) {
       if (key != "path" && key != "options" && key != "device" && key != "priority") {
-        throw ApiError(400, fmt::format("unknown field \"{}\" (path, options, device, priority)", key));
+        throw ApiError(400, fmt::format("unknown field \"{}\" (path, options, device, priority)", shownText(key, 40)));
       }
     }
-    if (std::is_same_v<Protocol, asio::ip::tcp> && body.contains("path")) {
+    if (kTcp && body.contains("path")) {
       throw ApiError(403,
                      "a path on the daemon's machine can be submitted over its Unix socket only; over TCP, upload "
                      "the mesh (a multipart form with file=@MESH)");
@@ -611,69 +539,110 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
                      "a submission is a multipart upload of the mesh (file=@MESH), or {\"path\": \"/abs/path\"} of a "
                      "mesh or a `make` output folder on the daemon's machine");
     }
-    submission.path = body["path"].get<std::string>();
+    submission.path = checkedText(body["path"], "path", 4096);
     submission.options = optionWords(body.value("options", json()));
-    if (body.contains("device")) {
-      if (!body["device"].is_string()) throw ApiError(400, "device: expected a device's name");
-      submission.device = body["device"].get<std::string>();
+    if (body.contains("device")) submission.device = checkedText(body["device"], "device", 64);
+    if (body.contains("priority")) {
+      submission.priority = static_cast<int>(wholeNumber(body["priority"], kPriorityField));
     }
-    submission.priority = priorityOf(body.value("priority", json()));
     return submission;
   }
 
+  // ---- replies ----
+
+  // A refusal: the caller is told, and the connection closes without its body being read.
   void fail(int status, const std::string& message) {
     keepAlive_ = false;
     respond({status, {{"error", message}}});
   }
 
-  void respond(Reply reply) {
-    if (!reply.file.empty()) {
-      std::ifstream in(reply.file, std::ios::binary);
-      std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-      if (!in.good() && !in.eof()) {
-        reply = Reply{500, {{"error", fmt::format("{} cannot be read", reply.file.string())}}};
-      } else {
-        reply.contentType = contentTypeOf(reply.file);
-        reply.text = std::move(bytes);
-        reply.headers.emplace_back("Cache-Control", "no-cache");
-      }
-    }
-    auto response = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(reply.status), 11);
-    response->set(http::field::server, "rotafabd");
+  template <typename Response>
+  void decorate(Response& response, const Reply& reply) {
+    response.set(http::field::server, "rotafabd");
     // No other page may frame this one (clicks through a frame would act
     // with the page's session), nor a file be read as another type.
-    response->set("X-Frame-Options", "DENY");
-    response->set("Content-Security-Policy", "frame-ancestors 'none'");
-    response->set("X-Content-Type-Options", "nosniff");
-    response->set("Referrer-Policy", "no-referrer");
+    response.set("X-Frame-Options", "DENY");
+    response.set("Content-Security-Policy", "frame-ancestors 'none'");
+    response.set("X-Content-Type-Options", "nosniff");
+    response.set("Referrer-Policy", "no-referrer");
+    for (const auto& [field, value] : reply.headers) response.set(field, value);
+  }
+
+  void respond(Reply reply) {
+    if (!reply.file.empty()) return respondFile(std::move(reply));
+    if (reply.status >= 400 && reply.body.is_object() && reply.body.contains("error") &&
+        reply.body["error"].is_string()) {
+      // Whatever the failure said, a caller learns nothing of where the daemon keeps its files.
+      reply.body["error"] = withoutDaemonPaths(reply.body["error"].get<std::string>(), server_->hidden);
+    }
+    auto response = std::make_shared<http::response<http::string_body>>(static_cast<http::status>(reply.status), 11);
+    decorate(*response, reply);
     response->set(http::field::content_type, reply.contentType.empty() ? "application/json" : reply.contentType);
-    for (const auto& [field, value] : reply.headers) response->set(field, value);
     response->body() = reply.text.empty() && reply.contentType.empty()
                            ? reply.body.dump(-1, ' ', false, json::error_handler_t::replace) + "\n"
                            : std::move(reply.text);
-    const bool keep = keepAlive_ && request_.keep_alive() && reply.status < 400;
+    send(std::move(response), reply.status);
+  }
+
+  // A file's bytes, read from disk as they are sent.
+  void respondFile(Reply reply) {
+    beast::error_code error;
+    http::file_body::value_type body;
+    body.open(reply.file.c_str(), beast::file_mode::scan, error);
+    if (error) {
+      server_->log->error("{}: {}", reply.file.string(), error.message());
+      return respond({500, {{"error", fmt::format("{} cannot be read", reply.file.filename().string())}}});
+    }
+    auto response = std::make_shared<http::response<http::file_body>>(
+        std::piecewise_construct, std::make_tuple(std::move(body)), std::make_tuple(http::status::ok, 11));
+    decorate(*response, reply);
+    response->set(http::field::content_type, contentTypeOf(reply.file));
+    response->set(http::field::cache_control, "no-cache");
+    send(std::move(response), 200);
+  }
+
+  template <typename Response>
+  void send(std::shared_ptr<Response> response, int status) {
+    const bool keep = keepAlive_ && status < 400;
     response->keep_alive(keep);
     response->prepare_payload();
     stream_.expires_after(server_->limits.body);
     http::async_write(stream_, *response,
                       [self = this->shared_from_this(), response, keep](beast::error_code error, size_t) {
-                        if (error || !keep) return self->close();
-                        self->request_ = {};
+                        if (error) return self->close();
+                        if (!keep) return self->linger();
                         self->readHeader(false);
                       });
   }
 
+  // The reply sent, the connection is closed for sending; what the caller
+  // still sends (a body never read) is read and thrown away for a moment, so
+  // that its client sees the reply rather than a reset, then it is closed.
+  void linger() {
+    beast::error_code ignored;
+    stream_.socket().shutdown(Protocol::socket::shutdown_send, ignored);
+    stream_.expires_after(kLingerFor);
+    drainSome();
+  }
+
+  void drainSome() {
+    stream_.async_read_some(asio::buffer(drain_), [self = this->shared_from_this()](beast::error_code error, size_t n) {
+      self->drained_ += n;
+      if (error || self->drained_ > kLingerBytes) return self->close();
+      self->drainSome();
+    });
+  }
+
   // ---- the event stream (server-sent events) ----
 
-  void startEvents(const std::string& target) {
-    std::string query;
-    pathParts(target, query);
-    const std::string job = queryValue(query, "job");
+  void startEvents() {
+    const std::string job = queryValue(admitted_.target.query, "job");
     if (!job.empty()) {
-      const auto id = wholeNumber(job);
-      if (!id) return fail(400, fmt::format("job={}: expected a job number", job));
+      const auto id = wholeNumberIn(job, kJobField);
+      if (!id) return fail(400, fmt::format("job={}: expected a job number", shownText(job, 40)));
       onlyJob_ = *id;
     }
+    header_.reset();
     stream_.expires_never();
     queue_.push_back(
         "HTTP/1.1 200 OK\r\nServer: rotafabd\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
@@ -689,7 +658,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
       std::string text = fmt::format("event: {}\ndata: {}\n\n", event.type,
                                      event.data.dump(-1, ' ', false, json::error_handler_t::replace));
       asio::post(executor, [weak, text = std::move(text)]() mutable {
-        if (auto self = weak.lock()) self->send(std::move(text));
+        if (auto self = weak.lock()) self->sendEvent(std::move(text));
       });
     });
     subscribed_ = true;
@@ -704,12 +673,12 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     timer_->async_wait([weak = std::weak_ptr<Session>(this->shared_from_this())](beast::error_code error) {
       auto self = weak.lock();
       if (error || !self || self->ended_) return;
-      self->send(": keep-alive\n\n");
+      self->sendEvent(": keep-alive\n\n");
       self->heartbeat();
     });
   }
 
-  void send(std::string text) {
+  void sendEvent(std::string text) {
     if (ended_) return;
     // A client that does not read falls behind: it is dropped, not waited for.
     if (queue_.size() > 1000) return endEvents();
@@ -737,12 +706,21 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
 
   Stream stream_;
   std::shared_ptr<HttpServer::Impl> server_;
-  beast::flat_buffer buffer_;
+  Listener listener_;
+  asio::ip::address peer_;
+  std::optional<Caller> peerCaller_;
+  bool counted_ = false, known_ = false, keepAlive_ = true, expectsContinue_ = false;
+  beast::flat_buffer buffer_{64 * 1024};
   std::optional<http::request_parser<http::empty_body>> header_;
-  std::optional<http::request_parser<http::string_body>> body_;
-  http::request<http::string_body> request_;
-  Identity identity_;
-  bool overLimit_ = false, keepAlive_ = true;
+  std::optional<http::request_parser<http::string_body>> json_;
+  std::optional<http::request_parser<http::buffer_body>> upload_;
+  Admission admitted_;
+  http::verb method_ = http::verb::unknown;
+  std::string host_;
+  std::shared_ptr<UploadForm> form_;
+  std::vector<char> piece_;
+  std::array<char, 4096> drain_{};
+  size_t drained_ = 0;
   // The event stream's.
   std::optional<int64_t> onlyJob_;
   std::deque<std::string> queue_;
@@ -752,21 +730,20 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
 };
 
 template <typename Acceptor, typename Protocol>
-void acceptLoop(Acceptor& acceptor, std::shared_ptr<HttpServer::Impl> server) {
-  acceptor.async_accept([&acceptor, server](beast::error_code error, typename Protocol::socket socket) {
+void acceptLoop(Acceptor& acceptor, std::shared_ptr<HttpServer::Impl> server, Listener listener) {
+  acceptor.async_accept([&acceptor, server, listener](beast::error_code error, typename Protocol::socket socket) {
     if (error == asio::error::operation_aborted || server->closing) return;
     if (!error) {
-      const bool overLimit = server->connections >= server->service.config().connectionLimit;
-      auto session = std::make_shared<Session<Protocol>>(std::move(socket), server);
-      if (server->open.size() >= 2 * server->service.config().connectionLimit) {
+      auto session = std::make_shared<Session<Protocol>>(std::move(socket), server, listener);
+      if (server->open.size() >= 4 * server->service.config().connectionLimit) {
         std::erase_if(server->open, [](const auto& weak) { return weak.expired(); });
       }
       server->open.push_back(session);
-      session->start(overLimit);
+      session->start();
     } else {
       server->log->warn("accept: {}", error.message());
     }
-    acceptLoop<Acceptor, Protocol>(acceptor, server);
+    acceptLoop<Acceptor, Protocol>(acceptor, server, listener);
   });
 }
 
@@ -775,16 +752,23 @@ void acceptLoop(Acceptor& acceptor, std::shared_ptr<HttpServer::Impl> server) {
 HttpServer::HttpServer(asio::io_context& io, Service& service, std::shared_ptr<spdlog::logger> log, HttpLimits limits)
     : impl_(std::make_shared<Impl>(io, service, std::move(log), limits)) {}
 
-HttpServer::~HttpServer() { close(); }
+HttpServer::~HttpServer() {
+  close();
+  impl_->disk.join();
+}
 
 void HttpServer::listen() {
-  for (const std::string& address : impl_->service.config().listen) {
+  const DaemonConfig& config = impl_->service.config();
+  for (const std::string& address : config.listen) {
     try {
       if (address.starts_with("unix:")) {
         const fs::path path = address.substr(5);
         std::error_code error;
+        // The socket's folder: made private when the daemon makes it (or it
+        // is the default's, the daemon's own); one the user named is left as found.
+        const bool existed = fs::is_directory(path.parent_path(), error);
         fs::create_directories(path.parent_path(), error);
-        ::chmod(path.parent_path().c_str(), 0700);
+        if (!existed || config.defaultListen) ::chmod(path.parent_path().c_str(), 0700);
         // A socket file left by a daemon that was killed: nobody answers on it (the state lock says no daemon runs).
         fs::remove(path, error);
         auto acceptor = std::make_unique<asio::local::stream_protocol::acceptor>(impl_->io);
@@ -799,7 +783,8 @@ void HttpServer::listen() {
         acceptor->listen(asio::socket_base::max_listen_connections);
         impl_->socketFiles.push_back(path);
         impl_->bound.push_back(address);
-        acceptLoop<asio::local::stream_protocol::acceptor, asio::local::stream_protocol>(*acceptor, impl_);
+        acceptLoop<asio::local::stream_protocol::acceptor, asio::local::stream_protocol>(*acceptor, impl_,
+                                                                                         Listener{true, false});
         impl_->unixAcceptors.push_back(std::move(acceptor));
       } else {
         const std::string rest = address.substr(6);
@@ -814,7 +799,7 @@ void HttpServer::listen() {
         acceptor->set_option(asio::socket_base::reuse_address(true));
         beast::error_code bindError;
         acceptor->bind(endpoint, bindError);
-        if (bindError == asio::error::address_in_use && impl_->service.config().defaultListen) {
+        if (bindError == asio::error::address_in_use && config.defaultListen) {
           // The default port taken (another daemon, another program): any
           // free one, which rotafabd.json records and `rotafab dashboard` reads.
           impl_->log->warn("{}: the port is in use; the page is on another port (rotafabd.json, rotafab dashboard)",
@@ -826,7 +811,8 @@ void HttpServer::listen() {
         acceptor->listen(asio::socket_base::max_listen_connections);
         const auto local = acceptor->local_endpoint();
         impl_->bound.push_back(fmt::format("tcp://{}:{}", local.address().to_string(), local.port()));
-        acceptLoop<asio::ip::tcp::acceptor, asio::ip::tcp>(*acceptor, impl_);
+        acceptLoop<asio::ip::tcp::acceptor, asio::ip::tcp>(*acceptor, impl_,
+                                                           Listener{false, isLoopback(endpoint.address())});
         impl_->tcpAcceptors.push_back(std::move(acceptor));
       }
     } catch (const std::exception& error) {

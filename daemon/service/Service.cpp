@@ -21,6 +21,9 @@
 #include "core/UserError.h"
 #include "core/WorkContext.h"
 #include "daemon/MakeOptions.h"
+#include "daemon/service/ApiInput.h"
+#include "daemon/service/DiskReserve.h"
+#include "daemon/service/UploadForm.h"
 #include "devices/Device.h"
 #include "devices/DriverEntry.h"
 #include "devices/JobRun.h"
@@ -181,6 +184,7 @@ struct Service::Impl {
     std::string cancelledBy;  // who asked; empty: the daemon stopping
     std::shared_ptr<asio::steady_timer> timeout;
     bool timedOut = false;
+    std::string stoppedBecause;  // stopped by the daemon for this (a full disk): queued to be planned again
   };
   struct Cut {
     std::shared_ptr<RunControl> control;
@@ -190,6 +194,7 @@ struct Service::Impl {
     json progress;
     std::optional<std::promise<bool>> waiting;  // set while the job waits for `next`
     std::string cancelledBy;
+    std::string stoppedBecause;  // stopped by the daemon for this (a full disk): interrupted
     Clock::time_point lastStored{}, lastSent{};
   };
 
@@ -240,7 +245,21 @@ struct Service::Impl {
   asio::steady_timer groupTimer{syncStrand};
   bool groupTimerSet = false;
   size_t nextSubscriber = 1;
-  bool stopping = false;
+  std::atomic<bool> stopping{false};
+  // A full disk (DiskReserve.h): set once a write of the job store finds no
+  // room (or the daemon starts without any), until the disk has room again.
+  // Meanwhile nothing new is taken on, and what ends is recorded with the
+  // reserve's room; a transition that even that cannot record is kept here
+  // (the API shows it) and written once it can be.
+  std::optional<DiskReserve> reserve;
+  std::atomic<bool> diskFull{false};
+  asio::steady_timer diskTimer{strand};
+  struct Unrecorded {
+    JobState to;
+    std::string reason;
+    JobChange change;
+  };
+  std::map<JobId, std::vector<Unrecorded>> unrecorded;
   // On a shared store: whether this host is in it (joined, lease renewed),
   // when its lease was last renewed, and the timer that renews it and
   // looks for work other hosts added.
@@ -370,7 +389,25 @@ struct Service::Impl {
     return out;
   }
 
-  json jobJson(const JobRecord& job) const {
+  // The job as the store has it, with the transitions a full disk kept from being recorded.
+  JobRecord withUnrecorded(JobRecord job) const {
+    const auto found = unrecorded.find(job.id);
+    if (found == unrecorded.end()) return job;
+    for (const Unrecorded& change : found->second) {
+      job.state = change.to;
+      job.message = change.reason + " (not yet recorded: the disk is full)";
+      if (change.change.device) job.device = *change.change.device;
+      if (change.change.summary) job.summary = *change.change.summary;
+      if (change.change.sheets) job.sheets = *change.change.sheets;
+      if (change.change.sheet) job.sheet = *change.change.sheet;
+      if (change.change.stroke) job.stroke = *change.change.stroke;
+      if (change.change.strokes) job.strokes = *change.change.strokes;
+    }
+    return job;
+  }
+
+  json jobJson(const JobRecord& stored) const {
+    const JobRecord job = withUnrecorded(stored);
     json out{{"id", job.id},
              {"state", stateName(job.state)},
              {"kind", kindName(job.kind)},
@@ -406,9 +443,125 @@ struct Service::Impl {
     try {
       store->putDevice(deviceRecord(device));
     } catch (const std::exception& error) {
-      log->error("{}", error.what());
+      storeTrouble(fmt::format("device {}", device.config.name), error);
     }
     publish("device", deviceJson(device));
+  }
+
+  // ---- a full disk ----
+
+  static constexpr std::string_view kDiskFull = "the disk that holds the daemon's state is full";
+
+  std::string diskFullRefusal() const {
+    return fmt::format(
+        "{}: nothing new is taken on until there is room again (free some space on it; the daemon "
+        "goes on by itself)",
+        kDiskFull);
+  }
+
+  // A write to the store failed: a full disk is a state of its own
+  // (diskBecameFull); anything else is logged.
+  void storeTrouble(const std::string& what, const std::exception& error) {
+    if (saysDiskFull(error.what())) return diskBecameFull(error.what());
+    log->error("{}: {}", what, error.what());
+  }
+
+  // A cut this daemon stops by itself, for `because` (empty: its stop): laser off, left interrupted.
+  static void stopCutByItself(Cut& cut, const std::string& because) {
+    if (cut.stoppedBecause.empty()) cut.stoppedBecause = because;
+    cut.control->shutdown = true;
+    cut.control->cancel.cancel();
+    if (cut.waiting) {
+      cut.waiting->set_value(false);
+      cut.waiting.reset();
+    }
+  }
+
+  // A write of the store found no room: the reserve's room is given back
+  // (so that what ends now can be recorded), every cut stops with its laser
+  // off and is left interrupted (its progress could no longer be kept),
+  // every plan stops and is queued again, and nothing new is taken on until
+  // the disk has room again (watchDisk). Said once in the log, not at every write.
+  void diskBecameFull(const std::string& why) {
+    if (diskFull.exchange(true)) return;
+    const bool released = reserve && reserve->release();
+    log->error(
+        "{} ({}){}: {} cut{} stopped, laser off, and left interrupted; {} plan{} queued again; nothing new is "
+        "taken on until there is room again",
+        kDiskFull, why, released ? "; the daemon's 8 MiB reserve was given back to record what ends" : "", cuts.size(),
+        cuts.size() == 1 ? "" : "s", planning.size(), planning.size() == 1 ? "" : "s");
+    for (auto& [id, cut] : cuts) stopCutByItself(*cut, std::string(kDiskFull));
+    for (auto& [id, plan] : planning) {
+      if (plan.cancelledBy.empty()) plan.stoppedBecause = kDiskFull;
+      plan.cancel->cancel();
+    }
+    watchDisk();
+  }
+
+  // While the disk is full: every 2 s, what was kept from the store is
+  // written if it can be, and once the disk has room for the reserve and as
+  // much again, the reserve is made again and the queue goes on.
+  void watchDisk() {
+    diskTimer.expires_after(std::chrono::seconds(2));
+    diskTimer.async_wait([this](const boost::system::error_code& error) {
+      if (error) return;
+      writeUnrecorded();
+      if (reserve->roomy() && reserve->hold()) {
+        diskFull = false;
+        log->info("the disk that holds the daemon's state has room again: the queue goes on");
+        writeUnrecorded();
+        pump();
+        return;
+      }
+      watchDisk();
+    });
+  }
+
+  // A transition the store must record; on a full disk, with the reserve's
+  // room. With `keepIfFull` (the end of a cut or a plan, which has happened
+  // whatever the disk says) one that even that cannot record is kept in
+  // `unrecorded`, shown as done, and written once it can be; otherwise the
+  // StoreError goes to the caller (an operator's action is refused, 507).
+  JobRecord record(JobId id, JobState to, const std::string& reason, const JobChange& change = {},
+                   bool keepIfFull = false) {
+    if (!unrecorded.contains(id)) {
+      try {
+        return store->transition(id, to, reason, change);
+      } catch (const StoreError& error) {
+        if (!saysDiskFull(error.what())) throw;
+        diskBecameFull(error.what());
+      }
+      try {
+        return store->transition(id, to, reason, change);
+      } catch (const StoreError& error) {
+        if (!saysDiskFull(error.what()) || !keepIfFull) throw;
+      }
+    } else if (!keepIfFull) {
+      throw StoreError(
+          fmt::format("{}: job {} has a change not yet recorded; ask again once there is room", kDiskFull, id));
+    }
+    unrecorded[id].push_back({to, reason, change});
+    log->error("job {}: {}: not yet recorded ({}): {}", id, stateName(to), kDiskFull, reason);
+    return withUnrecorded(store->job(id).value());
+  }
+
+  void writeUnrecorded() {
+    for (auto entry = unrecorded.begin(); entry != unrecorded.end();) {
+      auto& [id, changes] = *entry;
+      while (!changes.empty()) {
+        const Unrecorded change = changes.front();
+        try {
+          const JobRecord recorded = store->transition(id, change.to, change.reason, change.change);
+          changes.erase(changes.begin());
+          if (changes.empty()) jobChanged(recorded);
+        } catch (const std::exception& error) {
+          if (saysDiskFull(error.what())) break;
+          log->error("job {}: {}", id, error.what());
+          changes.erase(changes.begin());
+        }
+      }
+      entry = changes.empty() ? unrecorded.erase(entry) : std::next(entry);
+    }
   }
 
   // ---- start ----
@@ -419,6 +572,16 @@ struct Service::Impl {
     if (error) {
       throw StoreError(
           fmt::format("{}: cannot create the state directory: {}", config.stateDir.string(), error.message()));
+    }
+    // Before the store is opened (its start writes), room for what must be written.
+    reserve.emplace(config.stateDir / "rotafabd.reserve");
+    if (!reserve->enough() || !reserve->hold()) {
+      reserve->release();
+      diskFull = true;
+      log->error(
+          "{}: the daemon starts to answer and to cancel, with what room there is; nothing new is taken on "
+          "until there is room again",
+          kDiskFull);
     }
     store = config.store.empty() ? openSqliteStore(config.stateDir / "jobs.sqlite3") : openPostgresStore(config.store);
     spool = std::make_unique<Spool>(config.spool.empty() ? config.stateDir / "spool" : config.spool,
@@ -598,22 +761,18 @@ struct Service::Impl {
     joined = false;
     leaseLost = true;
     for (auto& [id, plan] : planning) plan.cancel->cancel();
-    for (auto& [id, cut] : cuts) {
-      cut->control->shutdown = true;
-      cut->control->cancel.cancel();
-      if (cut->waiting) {
-        cut->waiting->set_value(false);
-        cut->waiting.reset();
-      }
-    }
+    for (auto& [id, cut] : cuts) stopCutByItself(*cut, "");
   }
 
   // The actions other hosts left for this host's jobs, done as if asked here.
   void serveRequests() {
     for (const ActionRequest& request : store->takeRequests()) {
       const json arguments = json::parse(request.arguments, nullptr, false);
+      // (Checked again here: the store is an edge too, for what another host's daemon left in it.)
       const Reply reply = guarded([&] {
-        return act(request.job, request.action, arguments.is_discarded() ? json::object() : arguments, request.who);
+        return act(request.job, request.action,
+                   checkedActionArguments(request.action, arguments.is_discarded() ? json::object() : arguments),
+                   request.who);
       });
       if (reply.status >= 400) {
         const std::string why = reply.body.value("error", "refused");
@@ -702,7 +861,7 @@ struct Service::Impl {
   // Each job is claimed from the store (JobStore::claim), so that on a
   // shared store no two hosts plan or cut the same one.
   void pump() {
-    if (stopping || !joined || leaseLost) return;
+    if (stopping || !joined || leaseLost || diskFull) return;
     try {
       if (planning.size() < config.planners) {
         // Any host plans any job, against its device's profiles wherever that device is.
@@ -737,20 +896,26 @@ struct Service::Impl {
                 claim.reason = planningReason(*device);
                 claim.change.device = device->name;
               }
+              // (A job no device can take fails here and takes no planner:
+              // the jobs behind it are looked at in this same pass.)
+              if (device) ++taken;
               targets[job.id] = std::move(device);
               refusals[job.id] = why;
-              ++taken;
               return claim;
             });
         if (lookAgain) refreshOthers();
+        bool failedAny = false;
         for (const JobRecord& job : claimed) {
           if (const auto& device = targets[job.id]) {
             startPlanning(job, *device);
           } else {
             jobChanged(job);
-            jobChanged(store->transition(job.id, JobState::Failed, refusals[job.id]));
+            jobChanged(record(job.id, JobState::Failed, refusals[job.id], {}, true));
+            failedAny = true;
           }
         }
+        // More rows than were looked at may wait behind those that failed: looked at next, not at the next submission.
+        if (failedAny && planning.size() < config.planners) onStrand([this] { pump(); });
       }
       for (Device& device : devices) {
         if (!device.config.autoStart || device.state != "idle" || device.job) continue;
@@ -769,7 +934,7 @@ struct Service::Impl {
             // Claimed but not started: not left running with nothing cutting it.
             log->error("job {}: {}", job.id, error.what());
             jobChanged(
-                store->transition(job.id, JobState::Failed, fmt::format("its cut could not start: {}", error.what())));
+                record(job.id, JobState::Failed, fmt::format("its cut could not start: {}", error.what()), {}, true));
           }
         }
       }
@@ -888,7 +1053,7 @@ struct Service::Impl {
         p->second.cancel->cancel();
       }
     });
-    planning[job.id] = Planning{cancel, json(), "", timeout};
+    planning[job.id] = Planning{cancel, json(), "", timeout, false, ""};
     {
       std::lock_guard lock(heldMutex);
       heldPlans[job.id] = cancel;
@@ -906,6 +1071,7 @@ struct Service::Impl {
     json summary;
     std::optional<std::string> failure;
     bool cancelled = false;
+    std::string plannedName;
     try {
       if (job.kind == JobKind::Planned) {
         summary = planOfFolder(folder, machine);
@@ -947,9 +1113,9 @@ struct Service::Impl {
             },
             std::make_shared<spdlog::logger>(
                 "plan", std::make_shared<JobNotesSink>(log, folder, fmt::format("job {}", job.id), said)));
-        const std::string plannedName =
-            store->shared() ? fmt::format("planned-{}-{}", config.host, Clock::now().time_since_epoch().count())
-                            : "planned";
+        plannedName = store->shared()
+                          ? fmt::format("planned-{}-{}", config.host, Clock::now().time_since_epoch().count())
+                          : "planned";
         jobs::PlannedJob planned = jobs::makeJob(request, folder / plannedName, context);
         syncFolder(folder / plannedName);
         syncFolder(folder);
@@ -966,12 +1132,22 @@ struct Service::Impl {
       cancelled = true;
     } catch (const std::exception& error) {
       failure = inSubmittersWords(error.what(), folder);
+      if (saysDiskFull(error.what())) {
+        // What the plan wrote goes, so that its room is the disk's again.
+        std::error_code ignored;
+        if (!plannedName.empty()) fs::remove_all(folder / plannedName, ignored);
+        failure = fmt::format(
+            "the disk is full: its plan could not be written ({}); free some space, then submit it "
+            "again",
+            *failure);
+      }
     }
     onStrand([this, id = job.id, sheets, summary, failure, cancelled] {
-      std::string by;
+      std::string by, stoppedBecause;
       bool timedOut = false;
       if (auto p = planning.find(id); p != planning.end()) {
         by = p->second.cancelledBy;
+        stoppedBecause = p->second.stoppedBecause;
         timedOut = p->second.timedOut;
         p->second.timeout->cancel();
         planning.erase(p);
@@ -988,19 +1164,24 @@ struct Service::Impl {
               "or raise plan_timeout in the daemon's configuration",
               config.planTimeout);
           log->warn("job {}: {}", id, why);
-          jobChanged(store->transition(id, JobState::Failed, why));
+          jobChanged(record(id, JobState::Failed, why, {}, true));
+        } else if (cancelled && by.empty() && !stoppedBecause.empty()) {
+          jobChanged(
+              record(id, JobState::Queued,
+                     fmt::format("{}: its plan was stopped; it is planned again once there is room", stoppedBecause),
+                     {}, true));
         } else if (cancelled && by.empty()) {
-          store->transition(id, JobState::Queued, "the daemon stopped while it planned; it is planned again");
+          record(id, JobState::Queued, "the daemon stopped while it planned; it is planned again", {}, true);
         } else if (cancelled) {
-          jobChanged(store->transition(id, JobState::Cancelled, fmt::format("cancelled while planning by {}", by)));
+          jobChanged(record(id, JobState::Cancelled, fmt::format("cancelled while planning by {}", by), {}, true));
         } else if (failure) {
           log->warn("job {}: {}", id, *failure);
-          jobChanged(store->transition(id, JobState::Failed, *failure));
+          jobChanged(record(id, JobState::Failed, *failure, {}, true));
         } else {
           JobChange change;
           change.sheets = sheets;
           change.summary = summary.dump();
-          const JobRecord ready = store->transition(id, JobState::Ready, plannedReason(sheets, id), change);
+          const JobRecord ready = record(id, JobState::Ready, plannedReason(sheets, id), change, true);
           log->info("job {}: planned, {} sheets", id, sheets);
           jobChanged(ready);
         }
@@ -1048,6 +1229,7 @@ struct Service::Impl {
   }
 
   void startCut(const JobRecord& job, int fromSheet, const std::string& reason) {
+    if (diskFull) throw ApiError(507, diskFullRefusal());
     Device* device = &localDeviceFor(job);
     if (device->job) {
       throw ApiError(409, fmt::format("{} is busy with job {}; job {} can start once it is done", device->config.name,
@@ -1069,8 +1251,8 @@ struct Service::Impl {
     if (fromSheet < 1 || fromSheet > job.sheets) {
       throw ApiError(400, fmt::format("job {} has sheets 1 to {}, not {}", job.id, job.sheets, fromSheet));
     }
-    launchCut(store->transition(job.id, JobState::Running, reason, cutFromSheet(fromSheet, device->config.name)),
-              *device, fromSheet);
+    launchCut(record(job.id, JobState::Running, reason, cutFromSheet(fromSheet, device->config.name)), *device,
+              fromSheet);
   }
 
   // A job this host moved to running on `device`: its cut on a thread of its own.
@@ -1138,7 +1320,7 @@ struct Service::Impl {
                             fmt::format("sheet {} cut; waiting for sheet {} to be loaded", job.sheet, job.sheet + 1));
             jobChanged(job);
           } catch (const std::exception& error) {
-            log->error("job {}: {}", id, error.what());
+            storeTrouble(fmt::format("job {}", id), error);
           }
         });
         return answer.get();
@@ -1164,7 +1346,7 @@ struct Service::Impl {
             store->addEvent(id, "sheet", fmt::format("sheet {} of {} started", sheet, sheets));
             jobChanged(store->job(id).value());
           } catch (const std::exception& error) {
-            log->error("job {}: {}", id, error.what());
+            storeTrouble(fmt::format("job {}", id), error);
           }
         });
       };
@@ -1210,7 +1392,8 @@ struct Service::Impl {
       try {
         store->update(id, change);
       } catch (const std::exception& error) {
-        log->error("job {}: {}", id, error.what());
+        // (Its progress no longer kept, a cut on a full disk stops: a kill would lose where it was.)
+        storeTrouble(fmt::format("job {}", id), error);
       }
     }
     if (now - cut.lastSent >= std::chrono::milliseconds(200) || progress.stroke == progress.strokes) {
@@ -1240,15 +1423,15 @@ struct Service::Impl {
         JobChange change;
         change.sheet = job.sheets;
         change.stroke = job.strokes;
-        ended = store->transition(id, JobState::Done,
-                                  fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {:.1f} in burnt",
-                                              device.config.name, summary.sheets, summary.sheets == 1 ? "" : "s",
-                                              cut->firstSheet, summary.strokes, summary.burnt),
-                                  change);
+        ended = record(id, JobState::Done,
+                       fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {:.1f} in burnt",
+                                   device.config.name, summary.sheets, summary.sheets == 1 ? "" : "s", cut->firstSheet,
+                                   summary.strokes, summary.burnt),
+                       change, true);
       } else if (failure) {
         device.state = "fault";
         device.message = *failure;
-        ended = store->transition(id, JobState::Failed, *failure);
+        ended = record(id, JobState::Failed, *failure, {}, true);
       } else {
         JobChange change;
         if (fault->sheet > 0) {
@@ -1264,25 +1447,26 @@ struct Service::Impl {
         const std::string laser = devices::laserStateAfter(*fault);
         const int goOn = std::max(1, fault->sheet);
         if (fault->kind == devices::FaultKind::Cancelled && cut->control->shutdown) {
-          ended =
-              store->transition(id, JobState::Interrupted,
-                                fmt::format("the daemon stopped {}; {}; go on with `rotafab resume {} --from-sheet {}`",
-                                            where, laser, id, goOn),
-                                change);
+          const std::string stopped = cut->stoppedBecause.empty()
+                                          ? std::string("the daemon stopped")
+                                          : cut->stoppedBecause + ": the daemon stopped the cut";
+          ended = record(
+              id, JobState::Interrupted,
+              fmt::format("{} {}; {}; go on with `rotafab resume {} --from-sheet {}`", stopped, where, laser, id, goOn),
+              change, true);
         } else if (fault->kind == devices::FaultKind::Cancelled) {
-          ended =
-              store->transition(id, JobState::Cancelled,
-                                fmt::format("cancelled{} {}; {}",
-                                            cut->cancelledBy.empty() ? "" : " by " + cut->cancelledBy, where, laser),
-                                change);
+          ended = record(id, JobState::Cancelled,
+                         fmt::format("cancelled{} {}; {}", cut->cancelledBy.empty() ? "" : " by " + cut->cancelledBy,
+                                     where, laser),
+                         change, true);
         } else {
           device.state = "fault";
           device.message = fault->what();
-          ended = store->transition(
+          ended = record(
               id, JobState::Failed,
               fmt::format("{} ({}; stopped {}; {}); to go on once it is fixed: `rotafab resume {} --from-sheet {}`",
                           fault->what(), devices::faultName(fault->kind), where, laser, id, goOn),
-              change);
+              change, true);
         }
       }
       log->info("job {}: {}: {}", id, stateName(ended.state), ended.message);
@@ -1453,7 +1637,7 @@ struct Service::Impl {
         return {202, jobJson(job)};
       }
       if (job.state == JobState::Done || job.state == JobState::Cancelled) refuse("; there is nothing to cancel");
-      const JobRecord cancelled = store->transition(id, JobState::Cancelled, fmt::format("cancelled by {}", who));
+      const JobRecord cancelled = record(id, JobState::Cancelled, fmt::format("cancelled by {}", who));
       jobChanged(cancelled);
       pump();
       return {200, jobJson(cancelled)};
@@ -1463,7 +1647,7 @@ struct Service::Impl {
       Cut& cut = *cuts.at(id);
       if (cut.waiting) refuse(", waiting for the next sheet: nothing moves, so there is nothing to pause");
       if (auto* run = cut.control->run.load()) run->pause();
-      const JobRecord paused = store->transition(id, JobState::Paused, fmt::format("paused by {}", who));
+      const JobRecord paused = record(id, JobState::Paused, fmt::format("paused by {}", who));
       devices[cut.device].state = "paused";
       deviceChanged(devices[cut.device]);
       jobChanged(paused);
@@ -1473,7 +1657,7 @@ struct Service::Impl {
       if (job.state == JobState::Paused) {
         Cut& cut = *cuts.at(id);
         if (auto* run = cut.control->run.load()) run->resume();
-        const JobRecord running = store->transition(id, JobState::Running, fmt::format("resumed by {}", who));
+        const JobRecord running = record(id, JobState::Running, fmt::format("resumed by {}", who));
         devices[cut.device].state = "running";
         deviceChanged(devices[cut.device]);
         jobChanged(running);
@@ -1560,6 +1744,7 @@ Service::~Service() {
   asio::post(impl_->strand, [this, &quiet] {
     impl_->stopping = true;
     if (impl_->ticker) impl_->ticker->cancel();
+    impl_->diskTimer.cancel();
     quiet.set_value();
   });
   quiet.get_future().wait();
@@ -1594,6 +1779,7 @@ void Service::start() {
   });
   done.get();
   impl_->onStrand([this] {
+    if (impl_->diskFull) impl_->watchDisk();
     impl_->checkDevices();
     impl_->pump();
   });
@@ -1627,23 +1813,22 @@ void Service::submit(Submission submission, ReplyHandler done) {
     refused.status = 0;
     try {
       if (impl.stopping) throw ApiError(503, "the daemon is stopping");
+      if (impl.diskFull) throw ApiError(507, impl.diskFullRefusal());
       if (!submission.device.empty()) {
         // (Any host's: on a shared store a job may be submitted here for a device of another.)
         std::string why;
         if (!impl.deviceFor(submission.device, "", why)) throw ApiError(400, why);
       }
-      entry.emplace(impl.spool->begin());
-      if (!submission.fileName.empty()) {
-        const std::string name = fs::path(submission.fileName).filename().string();
-        if (name.empty() || name == "." || name == ".." || name.starts_with("planned")) {
-          throw ApiError(400, fmt::format("\"{}\" is not a mesh file's name", submission.fileName));
-        }
+      if (submission.upload) {
+        // (Its mesh already written, a piece at a time, as it arrived: UploadForm.h.)
+        entry.emplace(std::move(*submission.upload));
+        submission.upload.reset();
         job.kind = JobKind::Mesh;
-        job.source = name;
+        job.source = submission.fileName;
         bool machine = false, material = false;
-        parseMakeOptions(name, submission.options, machine, material);
-        entry->addFile(name, submission.bytes);
+        parseMakeOptions(job.source, submission.options, machine, material);
       } else {
+        entry.emplace(impl.spool->begin());
         const fs::path path = submission.path;
         std::error_code error;
         if (path.empty() || !path.is_absolute()) {
@@ -1660,7 +1845,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
                                             path.string()));
           }
           job.kind = JobKind::Planned;
-          job.source = path.string();
+          job.source = shownText(path.string(), 1000);
           // A folder that is not a make output, or whose sheets are wrong, is refused at once.
           std::ifstream manifestFile(path / "manifest.json");
           char first = 0;
@@ -1672,13 +1857,19 @@ void Service::submit(Submission submission, ReplyHandler done) {
           impl.planOnSubmission(job, entry->folder(), path);
         } else if (fs::is_regular_file(path, error)) {
           job.kind = JobKind::Mesh;
-          job.source = path.filename().string();
+          job.source = cleanFileName(path.filename().string());
+          if (job.source.empty() || job.source.starts_with("planned")) {
+            throw ApiError(400, fmt::format("{}: not a mesh file's name", shownText(path.string(), 1000)));
+          }
           bool machine = false, material = false;
           parseMakeOptions(job.source, submission.options, machine, material);
-          std::ifstream in(path, std::ios::binary);
-          const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-          if (!in && !in.eof()) throw ApiError(400, fmt::format("{}: cannot read the file", path.string()));
-          entry->addFile(job.source, bytes);
+          // Copied a piece at a time: a mesh of any size is never whole in the daemon's memory.
+          try {
+            entry->copyFile(job.source, path);
+          } catch (const std::exception& failed) {
+            if (saysDiskFull(failed.what())) throw;
+            throw ApiError(400, fmt::format("{}: cannot read the file", shownText(path.string(), 1000)));
+          }
         } else {
           throw ApiError(400, fmt::format("{}: no such file or folder on the daemon's machine", path.string()));
         }
@@ -1690,20 +1881,34 @@ void Service::submit(Submission submission, ReplyHandler done) {
       refused = {400, {{"error", error.what()}}};
     } catch (const std::exception& error) {
       const std::string what = error.what();
-      const bool full = what.find("No space left") != std::string::npos || what.find("full") != std::string::npos;
+      const bool full = saysDiskFull(what);
       refused = {full ? 507 : 500,
                  {{"error", full ? fmt::format("the spool's disk is full; the job was not accepted ({})", what)
                                  : fmt::format("the job was not accepted: {}", what)}}};
       impl.log->error("submission refused: {}", what);
     }
     if (refused.status != 0) {
-      entry.reset();  // the half-written entry goes
+      // The half-written entry, or the refused upload, goes before the caller is told.
+      entry.reset();
+      submission.upload.reset();
       done(refused);
       return;
     }
     // Synced to disk with whatever else came in meanwhile, then added with it.
     written.pending = std::make_shared<Impl::Pending>(Impl::Pending{std::move(*entry), job, std::move(done)});
   });
+}
+
+Spool::Entry Service::beginUpload() {
+  if (impl_->stopping) throw ApiError(503, "the daemon is stopping");
+  if (impl_->diskFull) throw ApiError(507, impl_->diskFullRefusal());
+  try {
+    return impl_->spool->begin();
+  } catch (const std::exception& error) {
+    impl_->log->error("an upload cannot be kept: {}", error.what());
+    if (saysDiskFull(error.what())) throw ApiError(507, "the spool's disk is full; the job was not accepted");
+    throw ApiError(500, "the daemon cannot keep an upload in its spool (its log says why)");
+  }
 }
 
 void Service::list(ReplyHandler done) {
@@ -1875,14 +2080,7 @@ void Service::shutdown(const std::string& why, std::function<void()> done) {
     impl.log->info("stopping ({}): {} cut{} and {} plan{} to stop", why, impl.cuts.size(),
                    impl.cuts.size() == 1 ? "" : "s", impl.planning.size(), impl.planning.size() == 1 ? "" : "s");
     for (auto& [id, planning] : impl.planning) planning.cancel->cancel();
-    for (auto& [id, cut] : impl.cuts) {
-      cut->control->shutdown = true;
-      cut->control->cancel.cancel();
-      if (cut->waiting) {
-        cut->waiting->set_value(false);
-        cut->waiting.reset();
-      }
-    }
+    for (auto& [id, cut] : impl.cuts) Impl::stopCutByItself(*cut, "");
     impl.finishIfStopping();
   });
 }

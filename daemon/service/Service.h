@@ -24,36 +24,17 @@
 #include <string>
 #include <vector>
 
+#include "daemon/service/ApiError.h"
 #include "daemon/service/DaemonConfig.h"
 #include "daemon/service/JobStore.h"
 #include "daemon/service/Spool.h"
+#include "daemon/service/Submission.h"
 
 namespace spdlog {
 class logger;
 }
 
 namespace rotafab::service {
-
-// A refusal for the API's client: an HTTP status (4xx: the request; 5xx: the daemon) and one line.
-class ApiError : public std::runtime_error {
- public:
-  ApiError(int status, const std::string& message, nlohmann::json details = nullptr)
-      : std::runtime_error(message), status(status), details(std::move(details)) {}
-  int status;
-  nlohmann::json details;  // fields the error's body has beside "error" (an object, or null)
-};
-
-// What the API hands over for a submission.
-struct Submission {
-  std::string owner;
-  std::string device;  // empty: any device whose machine profile fits
-  int priority = 0;
-  std::vector<std::string> options;  // `make` options, as command-line words
-  // Either an upload (the mesh's file name and bytes) or a path on the
-  // daemon's machine: a mesh file or a `make` output folder.
-  std::string fileName, bytes;
-  std::filesystem::path path;
-};
 
 // A reply: the JSON body, or the ApiError it became.
 struct Reply {
@@ -90,6 +71,11 @@ class Service {
 
   // The API. Each may be called from any thread; `done` is called once, on
   // the service's strand or pool (the caller posts it where it needs it).
+  //
+  // A new spool entry for an upload to be written into (UploadForm.h), which
+  // submit() takes with it; ApiError when the daemon takes no submission now
+  // (it is stopping: 503; the disk of its state is full: 507).
+  Spool::Entry beginUpload();
   void submit(Submission submission, ReplyHandler done);
   void list(ReplyHandler done);
   void status(JobId id, ReplyHandler done);
@@ -102,7 +88,8 @@ class Service {
   // in order, each with its operation and pass, and the time it takes.
   void sheet(JobId id, int sheet, ReplyHandler done);
   // cancel, pause, resume, start, next, move; `arguments`: resume's
-  // from_sheet, move's before or priority; `who` for the record.
+  // from_sheet, move's before or priority, as checkedActionArguments()
+  // (ApiInput.h) left them; `who` for the record.
   void act(JobId id, const std::string& action, const nlohmann::json& arguments, const std::string& who,
            ReplyHandler done);
 

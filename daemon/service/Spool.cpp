@@ -6,9 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
-#include <fstream>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -70,25 +68,66 @@ Spool::Entry::~Entry() {
   fs::remove_all(folder_, ignored);
 }
 
-void Spool::Entry::addFile(std::string_view name, std::string_view bytes) {
-  const fs::path file = folder_ / std::string(name);
+Spool::Entry::File Spool::Entry::create(std::string_view name) {
+  fs::path file = folder_ / std::string(name);
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
   if (fd < 0)
     throw std::runtime_error(fmt::format("{}: cannot create the file: {}", file.string(), std::strerror(errno)));
+  return File(fd, std::move(file));
+}
+
+Spool::Entry::File::File(File&& other) noexcept : fd_(other.fd_), path_(std::move(other.path_)) { other.fd_ = -1; }
+
+Spool::Entry::File::~File() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void Spool::Entry::File::write(std::string_view bytes) {
   size_t written = 0;
   while (written < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + written, bytes.size() - written);
+    const ssize_t n = ::write(fd_, bytes.data() + written, bytes.size() - written);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
-      const int error = errno;
-      ::close(fd);
-      throw std::runtime_error(fmt::format("{}: cannot write the file: {}", file.string(), std::strerror(error)));
+      throw std::runtime_error(
+          fmt::format("{}: cannot write the file: {}", path_.string(), std::strerror(n < 0 ? errno : ENOSPC)));
     }
     written += static_cast<size_t>(n);
   }
-  if (::close(fd) != 0) {
-    throw std::runtime_error(fmt::format("{}: cannot write the file: {}", file.string(), std::strerror(errno)));
+}
+
+void Spool::Entry::File::close() {
+  const int fd = fd_;
+  fd_ = -1;
+  if (fd >= 0 && ::close(fd) != 0) {
+    throw std::runtime_error(fmt::format("{}: cannot write the file: {}", path_.string(), std::strerror(errno)));
   }
+}
+
+void Spool::Entry::addFile(std::string_view name, std::string_view bytes) {
+  File file = create(name);
+  file.write(bytes);
+  file.close();
+}
+
+void Spool::Entry::copyFile(std::string_view name, const fs::path& from) {
+  const int in = ::open(from.c_str(), O_RDONLY | O_CLOEXEC);
+  if (in < 0)
+    throw std::runtime_error(fmt::format("{}: cannot read the file: {}", from.string(), std::strerror(errno)));
+  struct Closed {
+    int fd;
+    ~Closed() { ::close(fd); }
+  } closed{in};
+  File file = create(name);
+  std::string buffer(1 << 16, '\0');
+  for (;;) {
+    const ssize_t n = ::read(in, buffer.data(), buffer.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0)
+      throw std::runtime_error(fmt::format("{}: cannot read the file: {}", from.string(), std::strerror(errno)));
+    if (n == 0) break;
+    file.write(std::string_view(buffer.data(), static_cast<size_t>(n)));
+  }
+  file.close();
 }
 
 void Spool::Entry::addFolder(const fs::path& from) {
@@ -98,11 +137,7 @@ void Spool::Entry::addFolder(const fs::path& from) {
     const fs::path target = folder_ / file.path().filename();
     if (::link(file.path().c_str(), target.c_str()) == 0) continue;
     // Another file system, or a file the daemon may not link: a copy.
-    std::ifstream in(file.path(), std::ios::binary);
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-    if (!in && !in.eof()) throw std::runtime_error(fmt::format("{}: cannot read the file", file.path().string()));
-    addFile(file.path().filename().string(), bytes.str());
+    copyFile(file.path().filename().string(), file.path());
   }
   if (error) throw std::runtime_error(fmt::format("{}: cannot read the folder: {}", from.string(), error.message()));
 }

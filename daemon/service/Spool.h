@@ -33,8 +33,30 @@ class Spool {
     Entry& operator=(const Entry&) = delete;
     Entry(Entry&& other) noexcept;
     ~Entry();
+    // A file of the entry written a piece at a time, as its bytes arrive (an upload).
+    class File {
+     public:
+      File(File&& other) noexcept;
+      File(const File&) = delete;
+      File& operator=(const File&) = delete;
+      ~File();
+      // Throws std::runtime_error naming the file and why ("No space left on device").
+      void write(std::string_view bytes);
+      // Closes it; throws as write() when the file system says so only then.
+      void close();
+
+     private:
+      friend class Entry;
+      File(int fd, std::filesystem::path path) : fd_(fd), path_(std::move(path)) {}
+      int fd_;
+      std::filesystem::path path_;
+    };
+    // A new file in the entry. Throws std::runtime_error naming it.
+    File create(std::string_view name);
     // Writes one file into the entry. Throws std::runtime_error naming it ("No space left on device").
     void addFile(std::string_view name, std::string_view bytes);
+    // A copy of `from`, read and written a piece at a time (never whole in memory). Throws as addFile.
+    void copyFile(std::string_view name, const std::filesystem::path& from);
     // The files of a folder (not its subfolders), linked or copied into the entry.
     void addFolder(const std::filesystem::path& from);
     [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }

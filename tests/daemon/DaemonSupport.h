@@ -5,9 +5,11 @@
 // built `rotafab` as its client, and raw bytes on its socket for what no
 // client would send.
 
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/socket.h>
@@ -149,6 +151,7 @@ class Daemon {
   }
 
   void signal(int number) const { ::kill(pid_, number); }
+  [[nodiscard]] pid_t pid() const { return pid_; }
 
   // Waits for the process to end; its exit status (128 + signal when killed), or -1 after `seconds`.
   int wait(double seconds = 30) {
@@ -248,5 +251,98 @@ class Daemon {
   std::filesystem::path root_, configFile_;
   pid_t pid_ = 0;
 };
+
+struct HttpReply {
+  int status = 0;
+  std::string head, body;
+  [[nodiscard]] std::string header(const std::string& name) const {
+    const std::string key = "\r\n" + name + ": ";
+    const size_t at = head.find(key);
+    if (at == std::string::npos) return "";
+    const size_t start = at + key.size();
+    return head.substr(start, head.find("\r\n", start) - start);
+  }
+};
+
+// A connection to 127.0.0.1:port; -1 when refused.
+inline int connectTcp(int port) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// One request on a new TCP connection to 127.0.0.1:port.
+inline HttpReply overTcp(int port, const std::string& method, const std::string& target,
+                         const std::string& extraHeaders = "", const std::string& body = "") {
+  const int fd = connectTcp(port);
+  if (fd < 0) return {};
+  const std::string text = rotafab::test::exchange(
+      fd, fmt::format("{} {} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nConnection: close\r\n{}Content-Length: {}\r\n\r\n{}",
+                      method, target, port, extraHeaders, body.size(), body));
+  ::close(fd);
+  HttpReply reply;
+  if (text.starts_with("HTTP/1.1 ")) reply.status = std::stoi(text.substr(9, 3));
+  const size_t split = text.find("\r\n\r\n");
+  reply.head = text.substr(0, split);
+  if (split != std::string::npos) reply.body = text.substr(split + 4);
+  return reply;
+}
+
+// The port of the daemon's loopback TCP listener, as rotafabd.json records
+// it (written just after the socket answers: waited for).
+inline int pagePort(const Daemon& daemon) {
+  int port = 0;
+  eventually(
+      [&] {
+        const nlohmann::json where =
+            nlohmann::json::parse(readFile(daemon.stateDir() / "rotafabd.json"), nullptr, false);
+        if (!where.is_object()) return false;
+        for (const nlohmann::json& address : where["listen"]) {
+          const std::string text = address.get<std::string>();
+          if (text.starts_with("tcp://127.0.0.1:")) port = std::stoi(text.substr(16));
+        }
+        return port > 0;
+      },
+      10);
+  return port;
+}
+
+// The `make` output folder of an example for the default device's bed
+// (grbl-diode-400), in a folder that lasts the whole program.
+inline std::filesystem::path plannedExample(const std::string& example) {
+  static TempDir folder;
+  const std::filesystem::path out = folder.path() / std::filesystem::path(example).stem();
+  const CommandResult r = run(kCli + " make " + quoted(kSource / "examples" / example) +
+                              " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
+  EXPECT_EQ(r.status, 0) << r.err;
+  return out;
+}
+
+// Three sheets, made once for the whole program.
+inline const std::filesystem::path& threeSheets() {
+  static const std::filesystem::path made = plannedExample("soccer-ball.obj");
+  return made;
+}
+
+inline std::string state(const nlohmann::json& job) { return job.is_object() ? job.value("state", "") : ""; }
+
+// Submits the three sheets, starts them once planned, and returns the job's
+// number once its cut has reached its third stroke (an empty id on failure).
+inline long long cuttingThreeSheets(Daemon& daemon) {
+  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
+  EXPECT_EQ(state(daemon.waitForJob(id, [](const nlohmann::json& j) { return state(j) == "ready"; })), "ready");
+  EXPECT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  const nlohmann::json cutting = daemon.waitForJob(
+      id, [](const nlohmann::json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
+  EXPECT_GE(cutting.value("/progress/stroke"_json_pointer, 0), 3) << cutting.dump();
+  return ::testing::Test::HasFailure() ? 0 : id;
+}
 
 }  // namespace rotafab::test

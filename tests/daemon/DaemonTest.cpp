@@ -25,37 +25,6 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// The `make` output folder of an example for the default device's bed
-// (grbl-diode-400), in a folder that lasts the whole program.
-fs::path plannedExample(const std::string& example) {
-  static TempDir folder;
-  const fs::path out = folder.path() / fs::path(example).stem();
-  const CommandResult r = run(kCli + " make " + quoted(kSource / "examples" / example) +
-                              " --structure band --machine grbl-diode-400 --evaluations 1 --out " + quoted(out));
-  EXPECT_EQ(r.status, 0) << r.err;
-  return out;
-}
-
-// Three sheets, made once for the whole program.
-const fs::path& threeSheets() {
-  static const fs::path made = plannedExample("soccer-ball.obj");
-  return made;
-}
-
-std::string state(const json& job) { return job.is_object() ? job.value("state", "") : ""; }
-
-// Submits the three sheets, starts them once planned, and returns the job's
-// number once its cut has reached its third stroke (an empty id on failure).
-long long cuttingThreeSheets(Daemon& daemon) {
-  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
-  EXPECT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
-  EXPECT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
-  const json cutting =
-      daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"]["stroke"] >= 3; });
-  EXPECT_GE(cutting.value("/progress/stroke"_json_pointer, 0), 3) << cutting.dump();
-  return ::testing::Test::HasFailure() ? 0 : id;
-}
-
 TEST(Daemon, AMeshIsSubmittedPlannedStartedAndCutToItsEndThroughTheClient) {
   TempDir root;
   Daemon daemon(root.path());
@@ -380,7 +349,10 @@ TEST(Daemon, HostileRequestsAreRefusedWhileOtherClientsAreServed) {
           "larger than 16384 bytes");
   refused(daemon.raw("POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\nContent-Length: "
                      "5000000\r\n\r\n{}"),
-          413, "larger than the 100000 bytes the daemon takes");
+          413, "POST /api/jobs takes at most 65536");
+  refused(daemon.raw("POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: multipart/form-data; boundary=b\r\n"
+                     "Content-Length: 5000000\r\n\r\n--b"),
+          413, "takes at most 100000");
   refused(daemon.get("/api/nothing"), 404, "no such resource");
   refused(daemon.raw("DELETE /api/jobs HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n"), 405, "GET and POST");
   refused(daemon.post("/api/jobs", R"({"path": "relative/cube.obj"})"), 400, "expected an absolute path");

@@ -2,69 +2,12 @@
 // it: the default loopback listener, the one-time login link and its
 // session, the page's files, and the sheets and files the page draws.
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
-
 #include "daemon/DaemonSupport.h"
 
 namespace rotafab::test {
 namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
-
-struct HttpReply {
-  int status = 0;
-  std::string head, body;
-  [[nodiscard]] std::string header(const std::string& name) const {
-    const std::string key = "\r\n" + name + ": ";
-    const size_t at = head.find(key);
-    if (at == std::string::npos) return "";
-    const size_t start = at + key.size();
-    return head.substr(start, head.find("\r\n", start) - start);
-  }
-};
-
-// One request on a new TCP connection to 127.0.0.1:port.
-HttpReply overTcp(int port, const std::string& method, const std::string& target, const std::string& extraHeaders = "",
-                  const std::string& body = "") {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  if (::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof address) != 0) {
-    ::close(fd);
-    return {};
-  }
-  const std::string text = rotafab::test::exchange(
-      fd, fmt::format("{} {} HTTP/1.1\r\nHost: 127.0.0.1:{}\r\nConnection: close\r\n{}Content-Length: {}\r\n\r\n{}",
-                      method, target, port, extraHeaders, body.size(), body));
-  ::close(fd);
-  HttpReply reply;
-  if (text.starts_with("HTTP/1.1 ")) reply.status = std::stoi(text.substr(9, 3));
-  const size_t split = text.find("\r\n\r\n");
-  reply.head = text.substr(0, split);
-  if (split != std::string::npos) reply.body = text.substr(split + 4);
-  return reply;
-}
-
-// The port of the daemon's loopback TCP listener, as rotafabd.json records
-// it (written just after the socket answers: waited for).
-int pagePort(const Daemon& daemon) {
-  int port = 0;
-  eventually(
-      [&] {
-        const json where = json::parse(readFile(daemon.stateDir() / "rotafabd.json"), nullptr, false);
-        if (!where.is_object()) return false;
-        for (const json& address : where["listen"]) {
-          const std::string text = address.get<std::string>();
-          if (text.starts_with("tcp://127.0.0.1:")) port = std::stoi(text.substr(16));
-        }
-        return port > 0;
-      },
-      10);
-  return port;
-}
 
 // The session secret a login link gives the page (in the address's
 // fragment, which a browser never sends), or "".
@@ -109,10 +52,20 @@ TEST(Page, TheDefaultDaemonServesThePageOnLoopbackAndItsQueueToASessionOnly) {
   }
   EXPECT_NE(overTcp(port, "GET", "/app/app.js").header("Content-Type").find("javascript"), std::string::npos);
   EXPECT_EQ(overTcp(port, "GET", "/favicon.ico").status, 204);
-  // Nothing beyond the page's own files and the three.js it loads.
-  for (const char* outside : {"/app/../../CMakeLists.txt", "/lib/three/../../jquery/jquery.js", "/etc/passwd",
-                              "/lib/three/package.json", "/app/.hidden.js"}) {
-    EXPECT_EQ(overTcp(port, "GET", outside).status, 404) << outside;
+  // Nothing beyond the page's own files and the three.js it loads: a path
+  // that climbs above the root is malformed, one that leaves the page's
+  // folders is the API's (a token is asked for), one inside them unknown.
+  for (const auto& [outside, status] :
+       std::vector<std::pair<std::string, int>>{{"/app/../../CMakeLists.txt", 400},
+                                                {"/lib/three/../../jquery/jquery.js", 401},
+                                                {"/etc/passwd", 401},
+                                                {"/lib/three/package.json", 404},
+                                                {"/app/.hidden.js", 404},
+                                                {"/app/%2e%2e/%2e%2e/CMakeLists.txt", 400},
+                                                {"/app/..%2f..%2fCMakeLists.txt", 400}}) {
+    const HttpReply reply = overTcp(port, "GET", outside);
+    EXPECT_EQ(reply.status, status) << outside;
+    EXPECT_EQ(reply.body.find("project("), std::string::npos) << outside;
   }
   // Nobody reaches the queue without a token or a session.
   const HttpReply api = overTcp(port, "GET", "/api/jobs");
@@ -145,7 +98,7 @@ TEST(Page, TheDefaultDaemonServesThePageOnLoopbackAndItsQueueToASessionOnly) {
   EXPECT_TRUE(std::string(head).starts_with("HTTP/1.1 200")) << head;
   ::close(fd);
   // A session cannot mint further links; a login link is for this machine's user or a token's holder.
-  EXPECT_EQ(overTcp(port, "POST", "/api/sessions", bearer, "{}").status, 403);
+  EXPECT_EQ(overTcp(port, "POST", "/api/sessions", bearer + "Content-Type: application/json\r\n", "{}").status, 403);
 }
 
 TEST(Page, TwoDaemonsWithTheDefaultsBothServeThePage) {
@@ -216,9 +169,13 @@ TEST(Page, ASheetIsItsStrokesInTheOrderTheLaserBurnsThem) {
   const RawReply obj = daemon.get(fmt::format("/api/jobs/{}/files/structure.obj", id));
   EXPECT_EQ(obj.status, 200);
   EXPECT_NE(obj.text.find("\ng panel-6\n"), std::string::npos);
-  for (const char* name : {"cube.obj", "..%2Fjobs.sqlite", "sheet-001.eps", "manifest.json.tmp"}) {
+  for (const auto& [name, status] : std::vector<std::pair<std::string, int>>{{"cube.obj", 404},
+                                                                             {"..%2Fjobs.sqlite", 400},
+                                                                             {"..%2Fspool", 400},
+                                                                             {"sheet-001.eps", 404},
+                                                                             {"manifest.json.tmp", 404}}) {
     const RawReply refused = daemon.get(fmt::format("/api/jobs/{}/files/{}", id, name));
-    EXPECT_EQ(refused.status, 404) << name;
+    EXPECT_EQ(refused.status, status) << name;
   }
   EXPECT_EQ(daemon.get(fmt::format("/api/jobs/{}/sheets/2", id)).status, 404);
   EXPECT_NE(daemon.get(fmt::format("/api/jobs/{}/sheets/2", id)).body.value("error", "").find("sheets 1 to 1"),

@@ -74,9 +74,10 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
   expectRefused(
       "listen: [tcp://0.0.0.0:8730]\n",
       "1:10: listen[0]: tcp://0.0.0.0:8730 is reachable from other machines: give tokens (rotafabd --hash-token)");
-  expectRefused("statedir: /tmp\n",
-                "1:1: statedir: unknown key (expected one of: state_dir, store, host, spool, lease, listen, tokens, "
-                "devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
+  expectRefused(
+      "statedir: /tmp\n",
+      "1:1: statedir: unknown key (expected one of: state_dir, store, host, spool, lease, listen, tokens, "
+      "origins, devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
   expectRefused("host: cutter room\n",
                 "1:7: host: expected a name of letters, digits, '.', '_' and '-', such as cutter-room-2");
   expectRefused("lease: 0.5\n", "1:8: lease: must be between 1 and 3600, not 0.5");
@@ -86,6 +87,14 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
       "tokens: [{name: alice, hash: plain}]\n",
       "1:30: tokens[0].hash: expected \"sha256$SALT$HEX\" (64 hex digits), as `rotafabd --hash-token` prints it");
   expectRefused("devices: [a\n", "2:1: syntax: end of sequence flow not found");
+  expectRefused("origins: [rotafab.lab.example]\n",
+                "1:11: origins[0]: expected the page's address as a browser shows it, scheme and host (and port), "
+                "such as https://rotafab.lab.example; found 'rotafab.lab.example'");
+  expectRefused("origins: [\"https://lab.example/page\"]\n",
+                "1:11: origins[0]: expected the page's address as a browser shows it, scheme and host (and port), "
+                "such as https://rotafab.lab.example; found 'https://lab.example/page'");
+  EXPECT_EQ(loadConfig(dir.write("origins.yaml", "origins: [\"https://lab.example:8443/\"]\n")).origins,
+            std::vector<std::string>{"https://lab.example:8443"});
   EXPECT_EQ(loadConfig(dir.write("plan.yaml", "plan_timeout: 90\n")).planTimeout, 90);
   EXPECT_EQ(defaults.planTimeout, 3600);
   const DaemonConfig shared = loadConfig(dir.write("shared.yaml", "host: room-2\nspool: /mnt/fab/spool\nlease: 4\n"));
