@@ -110,8 +110,10 @@ Admission AccessGate::admit(const RequestHead& head, const Listener& listener, c
       [[fallthrough]];
     case BodyKind::Json:
       // (A form of another site's page can send text/plain, urlencoded and
-      // multipart bodies without asking first; JSON it cannot.)
-      if (type != "application/json") {
+      // multipart bodies without asking first; JSON it cannot. No page
+      // reaches the Unix socket: there, a body is read as JSON whatever
+      // its type, as `curl -d` sends it. No body at all is no arguments.)
+      if (hasBody && !listener.unixSocket && type != "application/json") {
         throw ApiError(
             415, fmt::format(
                      "{} takes a JSON body, with Content-Type: application/json{}", said,

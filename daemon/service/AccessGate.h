@@ -18,9 +18,9 @@
 //      one of the configuration's `origins`, behind a reverse proxy), and
 //      Sec-Fetch-Site, when sent, is same-origin;
 //   6. the body the endpoint takes: none, JSON of at most 64 KiB, or a
-//      multipart form of at most upload_limit; a content type a cross-site
-//      form can send (text/plain, urlencoded) is refused, as is a body
-//      larger than the endpoint takes, from its Content-Length.
+//      multipart form of at most upload_limit; over TCP, a content type a
+//      cross-site form can send (text/plain, urlencoded) is refused, as is
+//      everywhere a body larger than the endpoint takes, from its Content-Length.
 // Throws ApiError with the refusal; the server sends it and closes the
 // connection without reading the body.
 //

@@ -9,7 +9,7 @@
 namespace rotafab::service {
 namespace {
 
-std::string lower(std::string_view text) {
+std::string asciiLower(std::string_view text) {
   std::string out(text);
   std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
   return out;
@@ -17,7 +17,7 @@ std::string lower(std::string_view text) {
 
 // A parameter of a header value: name="value" or name=value.
 std::optional<std::string> parameter(std::string_view header, std::string_view name) {
-  const std::string lowered = lower(header);
+  const std::string lowered = asciiLower(header);
   size_t at = 0;
   while ((at = lowered.find(name, at)) != std::string::npos) {
     const bool starts = at == 0 || lowered[at - 1] == ';' || lowered[at - 1] == ' ' || lowered[at - 1] == '\t';
@@ -42,7 +42,7 @@ std::optional<std::string> parameter(std::string_view header, std::string_view n
 }  // namespace
 
 std::optional<std::string> multipartBoundary(std::string_view contentType) {
-  if (!lower(contentType).starts_with("multipart/form-data")) return std::nullopt;
+  if (!asciiLower(contentType).starts_with("multipart/form-data")) return std::nullopt;
   auto boundary = parameter(contentType, "boundary");
   if (!boundary || boundary->empty() || boundary->size() > 70) return std::nullopt;
   return boundary;
@@ -143,7 +143,7 @@ void MultipartReader::readHeaders(std::string_view headers) {
     headers = end == std::string_view::npos ? std::string_view() : headers.substr(end + 2);
     const size_t colon = line.find(':');
     if (colon == std::string_view::npos) throw std::invalid_argument("a part's header has no colon");
-    if (lower(line.substr(0, colon)) != "content-disposition") continue;
+    if (asciiLower(line.substr(0, colon)) != "content-disposition") continue;
     const std::string_view value = line.substr(colon + 1);
     if (auto name = parameter(value, "name")) head.name = *name, named = true;
     head.fileName = parameter(value, "filename");

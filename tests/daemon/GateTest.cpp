@@ -203,6 +203,17 @@ TEST(AccessGate, ARequestAnotherSitesPageCanSendChangesNothing) {
   EXPECT_EQ(startWith("application/json", "http://127.0.0.1:8730", "same-site"), 403);
   // A page served under another name (DNS rebinding) is refused by its Host.
   EXPECT_EQ(startWith("application/json", "http://evil.example:8730", "same-origin", "evil.example:8730"), 421);
+  // An action without arguments needs no body, and so no type.
+  EXPECT_EQ(refusal([&] {
+              RequestHead head;
+              head.method = http::verb::post;
+              head.target = "/api/jobs/1/pause";
+              head.host = "127.0.0.1:8730";
+              head.authorization = "Bearer right-token";
+              head.contentLength = 0;
+              gate.admit(head, tcp, std::nullopt);
+            }),
+            0);
   // The page's own requests, and a client's without Origin.
   EXPECT_EQ(startWith("application/json", "http://127.0.0.1:8730", "same-origin"), 0);
   EXPECT_EQ(startWith("Application/JSON; charset=utf-8", "", ""), 0);
@@ -234,6 +245,9 @@ TEST(AccessGate, ABodyIsJudgedByItsHeaderBeforeAByteOfItIsRead) {
   EXPECT_EQ(refusal([&] { admit(http::verb::post, "/api/jobs", "multipart/form-data", 10); }), 400);
   EXPECT_EQ(refusal([&] { admit(http::verb::delete_, "/api/jobs", "", std::nullopt); }), 405);
   EXPECT_EQ(refusal([&] { admit(http::verb::post, "/api/jobs/1/explode", "application/json", 2); }), 404);
+  // `curl -d '{"from_sheet": 3}'` over the socket, which no page reaches: read as JSON.
+  EXPECT_EQ(admit(http::verb::post, "/api/jobs/1/resume", "application/x-www-form-urlencoded", 17).body,
+            BodyKind::Json);
   const Admission form = admit(http::verb::post, "/api/jobs", "multipart/form-data; boundary=b", 1000);
   EXPECT_EQ(form.body, BodyKind::JsonOrForm);
   EXPECT_EQ(form.boundary, "b");
