@@ -7,6 +7,7 @@
 #include <cctype>
 
 #include "daemon/service/ApiError.h"
+#include "daemon/service/ApiInput.h"
 #include "daemon/service/Multipart.h"
 
 namespace rotafab::service {
@@ -14,15 +15,9 @@ namespace http = boost::beast::http;
 
 namespace {
 
-std::string lower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
-  return out;
-}
-
 // The media type of a Content-Type, lower case, without its parameters.
 std::string mediaType(std::string_view contentType) {
-  std::string type = lower(contentType.substr(0, contentType.find(';')));
+  std::string type = asciiLower(contentType.substr(0, contentType.find(';')));
   while (!type.empty() && (type.back() == ' ' || type.back() == '\t')) type.pop_back();
   while (!type.empty() && (type.front() == ' ' || type.front() == '\t')) type.erase(type.begin());
   return type;
@@ -59,13 +54,13 @@ std::string hostName(std::string_view hostAndPort) {
   }
   if (hostAndPort.starts_with("[")) {
     const size_t close = hostAndPort.find(']');
-    return lower(hostAndPort.substr(1, close == std::string_view::npos ? std::string_view::npos : close - 1));
+    return asciiLower(hostAndPort.substr(1, close == std::string_view::npos ? std::string_view::npos : close - 1));
   }
-  return lower(hostAndPort.substr(0, hostAndPort.find(':')));
+  return asciiLower(hostAndPort.substr(0, hostAndPort.find(':')));
 }
 
 AccessGate::AccessGate(const DaemonConfig& config) : tokens_(config.tokens), uploadLimit_(config.uploadLimit) {
-  for (const std::string& origin : config.origins) origins_.push_back(lower(origin));
+  for (const std::string& origin : config.origins) origins_.push_back(asciiLower(origin));
 }
 
 Admission AccessGate::admit(const RequestHead& head, const Listener& listener, const std::optional<Caller>& peer) {
@@ -135,7 +130,7 @@ std::optional<Caller> AccessGate::callerOverTcp(const RequestHead& head, const R
   const std::string_view value = head.authorization;
   std::string secret;
   bool inAddress = false;
-  if (value.size() > 7 && lower(value.substr(0, 7)) == "bearer ") {
+  if (value.size() > 7 && asciiLower(value.substr(0, 7)) == "bearer ") {
     secret = std::string(value.substr(7));
   } else if (route == Route::Events) {
     // A browser's event stream cannot send a header: its session in the
@@ -186,14 +181,14 @@ void AccessGate::checkHost(const RequestHead& head) const {
 }
 
 void AccessGate::checkSameOrigin(const RequestHead& head) const {
-  const std::string site = lower(head.fetchSite);
+  const std::string site = asciiLower(head.fetchSite);
   if (!site.empty() && site != "same-origin" && site != "none") {
     throw ApiError(403, fmt::format("a request from another site's page ({}) may not change anything here",
                                     std::string(head.fetchSite)));
   }
   if (head.origin.empty()) return;  // not a browser's (browsers send Origin with every POST)
-  const std::string origin = lower(head.origin);
-  if (origin == "http://" + lower(head.host)) return;
+  const std::string origin = asciiLower(head.origin);
+  if (origin == "http://" + asciiLower(head.host)) return;
   if (std::find(origins_.begin(), origins_.end(), origin) != origins_.end()) return;
   throw ApiError(403, fmt::format("Origin: {}: a page of another origin may not change anything here (this "
                                   "listener's own is http://{}; behind a reverse proxy, list the page's address "

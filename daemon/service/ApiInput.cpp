@@ -63,6 +63,14 @@ std::string_view cutAt(std::string_view text, size_t most) {
 
 }  // namespace
 
+std::string asciiLower(std::string_view text) {
+  std::string out(text);
+  for (char& c : out) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  return out;
+}
+
 int64_t wholeNumber(const json& value, const NumberField& field) {
   if (value.is_number_unsigned()) {
     const auto number = value.get<uint64_t>();

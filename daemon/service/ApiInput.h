@@ -33,6 +33,10 @@ int64_t wholeNumber(const nlohmann::json& value, const NumberField& field);
 // The same for text; none when it is not a whole number in range (a path's segment: a 404 for its caller).
 std::optional<int64_t> wholeNumberIn(std::string_view text, const NumberField& field);
 
+// ASCII letters in lower case, the rest as it is: header names, media
+// types, host names and schemes, which HTTP compares without case.
+std::string asciiLower(std::string_view text);
+
 // Text of at most `most` bytes, valid UTF-8, without control characters; throws ApiError(400) naming the field.
 std::string checkedText(const nlohmann::json& value, std::string_view field, size_t most = 200);
 

@@ -6,14 +6,10 @@
 #include <cctype>
 #include <stdexcept>
 
+#include "daemon/service/ApiInput.h"
+
 namespace rotafab::service {
 namespace {
-
-std::string asciiLower(std::string_view text) {
-  std::string out(text);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return std::tolower(c); });
-  return out;
-}
 
 // A parameter of a header value: name="value" or name=value.
 std::optional<std::string> parameter(std::string_view header, std::string_view name) {

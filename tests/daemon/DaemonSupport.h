@@ -314,6 +314,13 @@ inline int pagePort(const Daemon& daemon) {
   return port;
 }
 
+// The configuration's one device: a simulated GRBL diode laser running at
+// `speed` times real time, whose laser's changes ("on", "off") are written to `witness`.
+inline std::string witnessedLaser(double speed, const std::filesystem::path& witness) {
+  return fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed={}&witness={}\"}}]\n",
+                     speed, witness.string());
+}
+
 // The `make` output folder of an example for the default device's bed
 // (grbl-diode-400), in a folder that lasts the whole program.
 inline std::filesystem::path plannedExample(const std::string& example) {

@@ -192,9 +192,7 @@ TEST(Daemon, AKillAtAnyInstantLosesNoAcceptedJobAndRestartsNoCut) {
 TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
   TempDir root;
   const fs::path witness = root.path() / "laser";
-  Daemon daemon(root.path(), fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: "
-                                         "\"sim:grbl?speed=5&witness={}\"}}]\n",
-                                         witness.string()));
+  Daemon daemon(root.path(), witnessedLaser(5, witness));
   daemon.start();
   const long long id = cuttingThreeSheets(daemon);
   ASSERT_NE(id, 0);

@@ -110,10 +110,7 @@ TEST(Security, EveryRouteInEverySpellingOverTcpAsksForATokenBeforeAnythingElse) 
 TEST(Security, AnotherSitesPageCannotStartACutNorReadTheQueue) {
   TempDir root;
   const fs::path witness = root.path() / "laser";
-  Daemon daemon(root.path(),
-                tcpConfig(root.path(), fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: "
-                                                   "\"sim:grbl?speed=50&witness={}\"}}]\n",
-                                                   witness.string())));
+  Daemon daemon(root.path(), tcpConfig(root.path(), witnessedLaser(50, witness)));
   daemon.start();
   const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
   ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
@@ -203,11 +200,7 @@ class Flood {
 TEST(Security, TheOwnerPausesAndCancelsOverTheSocketWhileTcpIsFlooded) {
   TempDir root;
   const fs::path witness = root.path() / "laser";
-  Daemon daemon(root.path(),
-                tcpConfig(root.path(), fmt::format("header_timeout: 120\n"
-                                                   "devices: [{{name: laser1, machine: grbl-diode-400, uri: "
-                                                   "\"sim:grbl?speed=5&witness={}\"}}]\n",
-                                                   witness.string())));
+  Daemon daemon(root.path(), tcpConfig(root.path(), "header_timeout: 120\n" + witnessedLaser(5, witness)));
   daemon.start();
   const long long id = cuttingThreeSheets(daemon);
   ASSERT_NE(id, 0);
