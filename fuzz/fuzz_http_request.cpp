@@ -77,22 +77,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   boost::beast::error_code error;
   const size_t used = parser.put(boost::asio::buffer(bytes.data(), bytes.size()), error);
   if (error || !parser.is_header_done()) return 0;
-  const auto& request = parser.get();
-  const auto view = [](boost::beast::string_view text) { return std::string_view(text.data(), text.size()); };
-  const auto field = [&](http::field name) {
-    const auto found = request.find(name);
-    return found == request.end() ? std::string_view() : view(found->value());
-  };
-  RequestHead head;
-  head.method = request.method();
-  head.target = view(request.target());
-  head.host = field(http::field::host);
-  head.origin = field(http::field::origin);
-  head.fetchSite = view(request["Sec-Fetch-Site"]);
-  head.contentType = field(http::field::content_type);
-  head.authorization = field(http::field::authorization);
-  if (const auto length = parser.content_length()) head.contentLength = *length;
-  head.chunked = parser.chunked();
+  const RequestHead head = requestHead(parser);
   try {
     const std::optional<Caller> peer =
         listener.unixSocket ? std::optional<Caller>(Caller{"root", false}) : std::nullopt;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 
 #include "daemon/service/ApiError.h"
 #include "daemon/service/ApiInput.h"
@@ -23,9 +24,46 @@ std::string mediaType(std::string_view contentType) {
   return type;
 }
 
-bool isLoopbackName(const std::string& host) {
-  return host == "localhost" || host.ends_with(".localhost") || host == "::1" ||
-         (host.starts_with("127.") && host.find_first_not_of("0123456789.") == std::string::npos);
+// 127.0.0.1 to 127.255.255.255 written as four decimal numbers (not 127.1, not 0x7f.1).
+bool isLoopbackQuad(std::string_view name) {
+  int parts = 0;
+  while (!name.empty()) {
+    const size_t dot = name.find('.');
+    const std::string_view part = name.substr(0, dot);
+    unsigned value = 256;
+    const auto [end, error] = std::from_chars(part.data(), part.data() + part.size(), value);
+    if (part.empty() || part.size() > 3 || error != std::errc() || end != part.data() + part.size() || value > 255 ||
+        (parts == 0 && value != 127)) {
+      return false;
+    }
+    ++parts;
+    if (dot == std::string_view::npos) break;
+    name.remove_prefix(dot + 1);
+    if (name.empty()) return false;
+  }
+  return parts == 4;
+}
+
+// A Host header of a loopback name (localhost, 127.x.y.z, [::1]) with at most a port of digits after it.
+bool isLoopbackHost(std::string_view host) {
+  std::string_view name = host, port;
+  if (host.starts_with("[")) {
+    const size_t close = host.find(']');
+    if (close == std::string_view::npos) return false;
+    name = host.substr(1, close - 1);
+    port = host.substr(close + 1);
+  } else if (const size_t colon = host.find(':'); colon != std::string_view::npos) {
+    name = host.substr(0, colon);
+    port = host.substr(colon);
+  }
+  if (!port.empty()) {
+    if (port.size() < 2 || port.size() > 6 || port[0] != ':' ||
+        port.substr(1).find_first_not_of("0123456789") != std::string_view::npos) {
+      return false;
+    }
+  }
+  const std::string lower = asciiLower(name);
+  return host.starts_with("[") ? lower == "::1" : (lower == "localhost" || isLoopbackQuad(lower));
 }
 
 // Why a path nothing answers is not there, in a caller's words.
@@ -59,12 +97,37 @@ std::string hostName(std::string_view hostAndPort) {
   return asciiLower(hostAndPort.substr(0, hostAndPort.find(':')));
 }
 
+RequestHead requestHead(const http::request_parser<http::empty_body>& parser) {
+  const auto& request = parser.get();
+  const auto view = [](boost::beast::string_view text) { return std::string_view(text.data(), text.size()); };
+  RequestHead head;
+  head.method = request.method();
+  head.target = view(request.target());
+  head.host = view(request[http::field::host]);
+  head.origin = view(request[http::field::origin]);
+  head.fetchSite = view(request["Sec-Fetch-Site"]);
+  head.contentType = view(request[http::field::content_type]);
+  head.authorization = view(request[http::field::authorization]);
+  head.transferEncoding = view(request[http::field::transfer_encoding]);
+  if (const auto length = parser.content_length()) head.contentLength = *length;
+  head.chunked = parser.chunked();
+  for (const std::string_view once :
+       {"Host", "Authorization", "Origin", "Sec-Fetch-Site", "Content-Type", "Content-Length", "Transfer-Encoding"}) {
+    if (request.count(boost::beast::string_view(once.data(), once.size())) > 1) {
+      head.repeated = once;
+      break;
+    }
+  }
+  return head;
+}
+
 AccessGate::AccessGate(const DaemonConfig& config) : tokens_(config.tokens), uploadLimit_(config.uploadLimit) {
   for (const std::string& origin : config.origins) origins_.push_back(asciiLower(origin));
 }
 
 Admission AccessGate::admit(const RequestHead& head, const Listener& listener, const std::optional<Caller>& peer) {
   Admission admitted;
+  checkFraming(head);
   admitted.target = parseTarget(head.target);
   if (listener.loopback) checkHost(head);
   const std::optional<MatchedRoute> route = matchRoute(admitted.target.parts);
@@ -169,8 +232,8 @@ std::optional<Caller> AccessGate::callerOverTcp(const RequestHead& head, const R
 
 void AccessGate::checkHost(const RequestHead& head) const {
   if (head.host.empty()) throw ApiError(400, "the request has no Host header (HTTP/1.1 needs one)");
+  if (isLoopbackHost(head.host)) return;
   const std::string name = hostName(head.host);
-  if (isLoopbackName(name)) return;
   for (const std::string& origin : origins_) {
     if (hostName(origin) == name) return;
   }
@@ -178,6 +241,23 @@ void AccessGate::checkHost(const RequestHead& head) const {
                                   "(127.0.0.1, localhost, [::1]); a page reached under another name is refused; "
                                   "behind a reverse proxy, list its address in the configuration's origins",
                                   std::string(head.host)));
+}
+
+void AccessGate::checkFraming(const RequestHead& head) {
+  if (!head.repeated.empty()) {
+    throw ApiError(400, fmt::format("the request has more than one {} header", std::string(head.repeated)));
+  }
+  if (head.transferEncoding.empty()) return;
+  // Chunked alone: a coding the daemon does not know (or chunked under
+  // another) would leave where the body ends to a guess.
+  std::string coding = asciiLower(head.transferEncoding);
+  std::erase_if(coding, [](char c) { return c == ' ' || c == '\t'; });
+  if (coding != "chunked") {
+    throw ApiError(501, fmt::format("Transfer-Encoding: {}: the daemon reads chunked bodies and bodies of a "
+                                    "Content-Length only",
+                                    shownText(head.transferEncoding, 60)));
+  }
+  if (head.contentLength) throw ApiError(400, "the request has both a Content-Length and a Transfer-Encoding");
 }
 
 void AccessGate::checkSameOrigin(const RequestHead& head) const {

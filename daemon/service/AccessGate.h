@@ -26,6 +26,8 @@
 //
 // Threads: used on the server's one I/O thread only (its sessions are not locked).
 
+#include <boost/beast/http/empty_body.hpp>
+#include <boost/beast/http/parser.hpp>
 #include <boost/beast/http/verb.hpp>
 #include <chrono>
 #include <optional>
@@ -49,10 +51,16 @@ struct Caller {
 // What the gate reads of a request: its header's fields.
 struct RequestHead {
   boost::beast::http::verb method = boost::beast::http::verb::unknown;
-  std::string_view target, host, origin, fetchSite, contentType, authorization;
+  std::string_view target, host, origin, fetchSite, contentType, authorization, transferEncoding;
   std::optional<uint64_t> contentLength;  // none: no Content-Length
   bool chunked = false;
+  // A field that decides who asks or how the body is read, sent more than
+  // once (which of two a proxy and the daemon would each take is anyone's guess).
+  std::string_view repeated;
 };
+
+// What the gate reads of a parsed header; its views point into `parser`'s.
+RequestHead requestHead(const boost::beast::http::request_parser<boost::beast::http::empty_body>& parser);
 
 struct Listener {
   bool unixSocket = false;  // the daemon's Unix socket
@@ -91,6 +99,7 @@ class AccessGate {
                                       std::string& refusal);
   void checkSameOrigin(const RequestHead& head) const;
   void checkHost(const RequestHead& head) const;
+  static void checkFraming(const RequestHead& head);
 
   std::vector<TokenConfig> tokens_;
   std::vector<std::string> origins_;  // lower case, as a browser sends them

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <iterator>
 #include <optional>
 
 #include "daemon/service/ApiError.h"
@@ -44,13 +45,25 @@ std::optional<std::pair<char32_t, size_t>> codePointAt(std::string_view text, si
   return std::pair<char32_t, size_t>{point, length};
 }
 
-// C0 and C1 controls and DEL; the bidirectional marks, embeddings,
-// overrides and isolates (which make "gpj.obj" read as another name, and a
-// log line say what it does not); zero-width and other invisible format characters.
+// C0 and C1 controls and DEL; the line and paragraph separators; every
+// format character of Unicode 15 (general category Cf: the bidirectional
+// marks, embeddings, overrides and isolates, which make "gpj.obj" read as
+// another name and a log line say what it does not; the zero-width ones;
+// the tag characters, invisible in most fonts); and the fillers shown as nothing.
 bool unshown(char32_t point) {
-  return point < 0x20 || (point >= 0x7f && point <= 0x9f) || point == 0x061c || point == 0x00ad ||
-         (point >= 0x200b && point <= 0x200f) || (point >= 0x202a && point <= 0x202e) ||
-         (point >= 0x2060 && point <= 0x2069) || point == 0xfeff;
+  struct Range {
+    char32_t first, last;
+  };
+  static constexpr Range kUnshown[] = {
+      {0x0000, 0x001f},   {0x007f, 0x009f},   {0x00ad, 0x00ad},   {0x034f, 0x034f},   {0x0600, 0x0605},
+      {0x061c, 0x061c},   {0x06dd, 0x06dd},   {0x070f, 0x070f},   {0x0890, 0x0891},   {0x08e2, 0x08e2},
+      {0x115f, 0x1160},   {0x17b4, 0x17b5},   {0x180e, 0x180e},   {0x200b, 0x200f},   {0x2028, 0x202e},
+      {0x2060, 0x2064},   {0x2066, 0x206f},   {0x3164, 0x3164},   {0xfeff, 0xfeff},   {0xffa0, 0xffa0},
+      {0xfff9, 0xfffb},   {0x110bd, 0x110bd}, {0x110cd, 0x110cd}, {0x13430, 0x1343f}, {0x1bca0, 0x1bca3},
+      {0x1d173, 0x1d17a}, {0xe0000, 0xe007f},
+  };
+  return std::any_of(std::begin(kUnshown), std::end(kUnshown),
+                     [point](const Range& range) { return point >= range.first && point <= range.last; });
 }
 
 // The longest start of `text` of at most `most` bytes that ends between two code points.
@@ -74,7 +87,9 @@ std::string asciiLower(std::string_view text) {
 int64_t wholeNumber(const json& value, const NumberField& field) {
   if (value.is_number_unsigned()) {
     const auto number = value.get<uint64_t>();
-    if (number > static_cast<uint64_t>(field.most)) throw outOfRange(field);
+    if (number > static_cast<uint64_t>(field.most) || static_cast<int64_t>(number) < field.least) {
+      throw outOfRange(field);
+    }
     return static_cast<int64_t>(number);
   }
   if (value.is_number_integer()) {

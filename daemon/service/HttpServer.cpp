@@ -40,10 +40,13 @@ using nlohmann::json;
 namespace {
 
 // A TCP peer address's connections that no request has yet shown a token
-// or session on: a local program that opens many and sends nothing takes
-// no more than these (and all such together no more than half of
-// connection_limit), and never any of the Unix socket's, which has a limit
-// of its own.
+// or session on: a program that opens many and sends nothing has no more
+// than these (and all such together no more than half of connection_limit),
+// and never any of the Unix socket's, which has a limit of its own. Past a
+// limit, a new connection takes the place of the oldest of them that is
+// idle (waiting for a request with nothing unread, or closing after a
+// refusal): every program on loopback shares one address, so a token
+// holder's new connection must never be refused for a stranger's idle ones.
 constexpr size_t kUnknownPerPeer = 16;
 // A connection closed on a refusal is read from (and what it sends thrown
 // away) for this long or this much at most, so that its client reads the
@@ -131,8 +134,23 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
   struct Connection {
     virtual ~Connection() = default;
     virtual void close() = 0;
+    // Whether it is a TCP connection that can give its place to a new one:
+    // idle, and a stranger's (or closing); from `peer` if one is named.
+    [[nodiscard]] virtual bool idle(const asio::ip::address* /*peer*/, bool /*strangersOnly*/) const { return false; }
+    virtual void evict() {}
   };
   std::vector<std::weak_ptr<Connection>> open;
+
+  // Closes the oldest idle connection that `idle(peer, strangersOnly)` picks; whether there was one.
+  bool evictOldest(const asio::ip::address* peer, bool strangersOnly) {
+    for (const auto& weak : open) {
+      if (auto connection = weak.lock(); connection && connection->idle(peer, strangersOnly)) {
+        connection->evict();
+        return true;
+      }
+    }
+    return false;
+  }
 
   // The names of the users who connected lately, on the I/O thread: a
   // lookup reads /etc/passwd through NSS, on every connection. A minute
@@ -187,12 +205,28 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
       counted_ = true;
       ++server.tcpConnections;
       ++server.tcpUnknown;
-      const size_t fromPeer = ++server.unknownByPeer[peer_];
-      if (server.tcpConnections > limit || server.tcpUnknown > std::max<size_t>(1, limit / 2)) {
-        full = fmt::format("the daemon serves {} TCP connections at once; try again shortly", limit);
-      } else if (fromPeer > kUnknownPerPeer) {
-        full = fmt::format("{} has {} connections open without a token or session; try again once they are done",
-                           peer_.to_string(), kUnknownPerPeer);
+      ++server.unknownByPeer[peer_];
+      // Room is made by closing idle strangers' connections, oldest first;
+      // only when every one is at work is the new one refused.
+      while (server.unknownByPeer[peer_] > kUnknownPerPeer) {
+        if (!server.evictOldest(&peer_, true)) {
+          full = fmt::format("{} has {} connections without a token or session at work; try again shortly",
+                             peer_.to_string(), kUnknownPerPeer);
+          break;
+        }
+      }
+      while (full.empty() && server.tcpUnknown > std::max<size_t>(1, limit / 2)) {
+        if (!server.evictOldest(nullptr, true)) {
+          full = fmt::format(
+              "the daemon serves {} TCP connections without a token or session at once; try again "
+              "shortly",
+              std::max<size_t>(1, limit / 2));
+        }
+      }
+      while (full.empty() && server.tcpConnections > limit) {
+        if (!server.evictOldest(nullptr, false)) {
+          full = fmt::format("the daemon serves {} TCP connections at once; try again shortly", limit);
+        }
       }
     } else {
       counted_ = true;
@@ -205,14 +239,23 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     readHeader(true);
   }
 
-  ~Session() override {
-    if (!counted_) return;
+  ~Session() override { uncount(); }
+
+  [[nodiscard]] bool idle(const asio::ip::address* peer, bool strangersOnly) const override {
     if constexpr (kTcp) {
-      --server_->tcpConnections;
-      if (!known_) unknownGone();
+      if (!counted_ || (peer && *peer != peer_) || (strangersOnly && known_)) return false;
+      if (lingering_) return true;
+      // (A request already in the socket's buffer is not idle: it is read next.)
+      beast::error_code error;
+      return waiting_ && !known_ && buffer_.size() == 0 && stream_.socket().available(error) == 0 && !error;
     } else {
-      --server_->unixConnections;
+      return false;
     }
+  }
+
+  void evict() override {
+    uncount();
+    close();
   }
 
   void close() override {
@@ -222,6 +265,18 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   }
 
  private:
+  // Its place given back (once: when it is evicted, or when it ends).
+  void uncount() {
+    if (!counted_) return;
+    counted_ = false;
+    if constexpr (kTcp) {
+      --server_->tcpConnections;
+      if (!known_) unknownGone();
+    } else {
+      --server_->unixConnections;
+    }
+  }
+
   void unknownGone() {
     --server_->tcpUnknown;
     if (auto found = server_->unknownByPeer.find(peer_);
@@ -236,9 +291,12 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     // (The gate judges the body's size, by route; the parser is not to refuse it first.)
     header_->body_limit(std::numeric_limits<std::uint64_t>::max());
     stream_.expires_after(first ? server_->limits.header : server_->limits.idle);
-    http::async_read_header(
-        stream_, buffer_, *header_,
-        [self = this->shared_from_this(), first](beast::error_code error, size_t) { self->onHeader(error, first); });
+    waiting_ = true;
+    http::async_read_header(stream_, buffer_, *header_,
+                            [self = this->shared_from_this(), first](beast::error_code error, size_t) {
+                              self->waiting_ = false;
+                              self->onHeader(error, first);
+                            });
   }
 
   void onHeader(beast::error_code error, bool first) {
@@ -254,20 +312,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     }
     if (error) return fail(400, fmt::format("malformed request: {}", error.message()));
     const auto& request = header_->get();
-    const auto field = [&](http::field name) {
-      const auto value = request[name];
-      return std::string_view(value.data(), value.size());
-    };
-    RequestHead head;
-    head.method = request.method();
-    head.target = std::string_view(request.target().data(), request.target().size());
-    head.host = field(http::field::host);
-    head.origin = field(http::field::origin);
-    head.fetchSite = std::string_view(request["Sec-Fetch-Site"].data(), request["Sec-Fetch-Site"].size());
-    head.contentType = field(http::field::content_type);
-    head.authorization = field(http::field::authorization);
-    if (const auto length = header_->content_length()) head.contentLength = *length;
-    head.chunked = header_->chunked();
+    const RequestHead head = requestHead(*header_);
     keepAlive_ = request.keep_alive();
     method_ = request.method();
     host_ = std::string(head.host);
@@ -280,7 +325,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     if constexpr (kTcp) {
       if (admitted_.caller && !known_) {
         known_ = true;
-        unknownGone();
+        if (counted_) unknownGone();
       }
     }
     switch (admitted_.body) {
@@ -332,8 +377,12 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     } else if (error == beast::error::timeout) {
       server_->log->info("a client did not send its request's body in time; closed");
       fail(408, "the request's body did not come in time");
+    } else if (error.category() == http::make_error_code(http::error::bad_chunk).category() &&
+               error != http::error::partial_message) {
+      // A body that does not keep to its framing (a bad chunk size, say): told, not dropped.
+      fail(400, fmt::format("malformed body: {}", error.message()));
     } else {
-      close();
+      close();  // the caller went away
     }
     return true;
   }
@@ -619,6 +668,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   // still sends (a body never read) is read and thrown away for a moment, so
   // that its client sees the reply rather than a reset, then it is closed.
   void linger() {
+    lingering_ = true;
     beast::error_code ignored;
     stream_.socket().shutdown(Protocol::socket::shutdown_send, ignored);
     stream_.expires_after(kLingerFor);
@@ -710,6 +760,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   asio::ip::address peer_;
   std::optional<Caller> peerCaller_;
   bool counted_ = false, known_ = false, keepAlive_ = true, expectsContinue_ = false;
+  bool waiting_ = false, lingering_ = false;  // for a request's header; after a refusal
   beast::flat_buffer buffer_{64 * 1024};
   std::optional<http::request_parser<http::empty_body>> header_;
   std::optional<http::request_parser<http::string_body>> json_;

@@ -223,6 +223,65 @@ TEST(AccessGate, ARequestAnotherSitesPageCanSendChangesNothing) {
   EXPECT_EQ(startWith("application/json", "https://rotafab.lab.example.evil", "", "rotafab.lab.example"), 403);
 }
 
+// The gate's answer to a request's header as it comes over a loopback TCP
+// listener (-1: Beast itself refused it as malformed).
+int admitBytes(AccessGate& gate, const std::string& bytes) {
+  http::request_parser<http::empty_body> parser;
+  parser.eager(false);
+  boost::beast::error_code error;
+  parser.put(boost::asio::buffer(bytes), error);
+  if (error && error != http::error::need_more) return -1;
+  if (!parser.is_header_done()) return -1;
+  return refusal([&] { gate.admit(requestHead(parser), Listener{false, true}, std::nullopt); });
+}
+
+TEST(AccessGate, AHeaderThatTwoReadersCouldReadTwoWaysIsRefused) {
+  DaemonConfig config;
+  config.tokens.push_back({"alice", hashToken("right-token", "5a17")});
+  AccessGate gate(config);
+  const std::string start = "POST /api/jobs/1/cancel HTTP/1.1\r\n";
+  const std::string host = "Host: 127.0.0.1:8730\r\n";
+  const std::string token = "Authorization: Bearer right-token\r\n";
+  const std::string json = "Content-Type: application/json\r\n";
+  EXPECT_EQ(admitBytes(gate, start + host + token + json + "Content-Length: 2\r\n\r\n"), 0);
+  EXPECT_EQ(admitBytes(gate, start + host + token + json + "Transfer-Encoding: chunked\r\n\r\n"), 0);
+  // The same field twice: which one a proxy and the daemon each take is a guess.
+  EXPECT_EQ(admitBytes(gate, start + host + "Host: evil.example\r\n" + token + "\r\n"), 400);
+  EXPECT_EQ(admitBytes(gate, start + host + token + "Authorization: Bearer wrong\r\n\r\n"), 400);
+  EXPECT_EQ(admitBytes(gate, start + host + token + "Origin: http://127.0.0.1:8730\r\nOrigin: http://evil\r\n\r\n"),
+            400);
+  EXPECT_EQ(admitBytes(gate, start + host + token + json + json + "Content-Length: 2\r\n\r\n"), 400);
+  EXPECT_EQ(
+      admitBytes(gate, start + host + token + "Sec-Fetch-Site: same-origin\r\nSec-Fetch-Site: cross-site\r\n\r\n"),
+      400);
+  // A coding other than chunked alone: not guessed at.
+  for (const std::string coding : {"identity", "xchunked", "chunked, identity", "gzip, chunked", "chunked, chunked"}) {
+    const int status = admitBytes(gate, start + host + token + json + "Transfer-Encoding: " + coding + "\r\n\r\n");
+    EXPECT_TRUE(status == 501 || status == 400 || status == -1) << coding << ": " << status;
+  }
+  RequestHead both;
+  both.method = http::verb::post;
+  both.target = "/api/jobs/1/cancel";
+  both.host = "127.0.0.1";
+  both.authorization = "Bearer right-token";
+  both.contentType = "application/json";
+  both.transferEncoding = "chunked";
+  both.chunked = true;
+  both.contentLength = 2;
+  EXPECT_EQ(refusal([&] { gate.admit(both, Listener{false, true}, std::nullopt); }), 400);
+  // Only this machine's loopback names, with at most a port after them.
+  const std::string get = "GET /api/jobs HTTP/1.1\r\n" + token;
+  for (const std::string name :
+       {"127.0.0.1:8730", "127.0.0.1", "localhost:8730", "LOCALHOST", "[::1]:8730", "127.8.9.10:1"}) {
+    EXPECT_EQ(admitBytes(gate, get + "Host: " + name + "\r\n\r\n"), 0) << name;
+  }
+  for (const std::string name :
+       {"evil.localhost:8730", "127.1:8730", "127.0.0.1:8730junk", "127.0.0.1.evil.example", "0x7f.0.0.1",
+        "127.0.0.256", "[::1]junk", "localhost:", "127.0.0.1:99999999", "[::2]:8730"}) {
+    EXPECT_EQ(admitBytes(gate, get + "Host: " + name + "\r\n\r\n"), 421) << name;
+  }
+}
+
 TEST(AccessGate, ABodyIsJudgedByItsHeaderBeforeAByteOfItIsRead) {
   DaemonConfig config;
   config.uploadLimit = 1000;
@@ -300,6 +359,9 @@ TEST(ApiInput, NumbersAreCheckedAgainstTheirRangeAndNeverWrapped) {
   }
   EXPECT_EQ(refusal([&] { wholeNumber(json(4294967297LL), kFromSheetField); }), 400);
   EXPECT_EQ(refusal([&] { wholeNumber(json(0), kFromSheetField); }), 400);
+  // (JSON text's 0 is read as an unsigned number: checked against the same least.)
+  EXPECT_EQ(refusal([&] { wholeNumber(json::parse("0"), kFromSheetField); }), 400);
+  EXPECT_EQ(refusal([&] { checkedActionArguments("resume", json::parse(R"({"from_sheet": 0})")); }), 400);
   EXPECT_FALSE(wholeNumberIn("4294967297", kSheetField));
   EXPECT_FALSE(wholeNumberIn("9007199254740992", kJobField));
   EXPECT_EQ(wholeNumberIn("9007199254740991", kJobField), kLargestJobId);
@@ -322,6 +384,9 @@ TEST(ApiInput, AFileNameIsCleanedBeforeItNamesAFileAJobOrALogLine) {
   EXPECT_EQ(cleanFileName("\x1b[31mred.obj"), "[31mred.obj");
   EXPECT_EQ(cleanFileName("evil\u202Ejbo.exe"), "eviljbo.exe");  // no right-to-left override
   EXPECT_EQ(cleanFileName("zero\u200Bwidth.obj"), "zerowidth.obj");
+  // Every other invisible character: Mongolian vowel separator, tags, line and paragraph separators.
+  EXPECT_EQ(cleanFileName("a\u180Eb\U000E0041\U000E007Fc\u2028d\u2029e.obj"), "abcde.obj");
+  EXPECT_EQ(cleanFileName("\u2066iso\u2069late\uFFF9.obj"), "isolate.obj");
   EXPECT_EQ(cleanFileName("caf\xc3\xa9.obj"), "caf\xc3\xa9.obj");
   EXPECT_EQ(cleanFileName("bad\xff\xfe.obj"), "bad.obj");
   EXPECT_EQ(cleanFileName(".."), "");

@@ -104,6 +104,17 @@ TEST(Security, EveryRouteInEverySpellingOverTcpAsksForATokenBeforeAnythingElse) 
     }
   }
   EXPECT_GT(asked, 350u);
+  // A body that breaks its own framing is answered, not dropped; a coding
+  // the daemon does not read is refused before the body.
+  for (const auto& [framing, status] :
+       std::vector<std::pair<std::string, int>>{{"Transfer-Encoding: chunked\r\n\r\nzz\r\n{}\r\n0\r\n\r\n", 400},
+                                                {"Transfer-Encoding: identity\r\n\r\n{}", 501}}) {
+    const int fd = connectTcp(port);
+    const RawReply reply = parseReply(rotafab::test::exchange(
+        fd, fmt::format("POST /api/jobs/{}/pause HTTP/1.1\r\nHost: 127.0.0.1\r\n{}{}{}", id, right, json, framing)));
+    ::close(fd);
+    EXPECT_EQ(reply.status, status) << framing << ": " << reply.text;
+  }
   EXPECT_EQ(state(daemon.job(id)), "ready");
 }
 
@@ -210,7 +221,14 @@ TEST(Security, TheOwnerPausesAndCancelsOverTheSocketWhileTcpIsFlooded) {
     ASSERT_TRUE(eventually([&] { return flood.opened() >= 200; }, 10));
     // A slow body from a stranger on top: it holds nothing the owner needs.
     const int slow = connectTcp(port);
-    ::send(slow, "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1000000\r\n\r\nab", 70, MSG_NOSIGNAL);
+    const std::string slowStart = "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1000000\r\n\r\nab";
+    ::send(slow, slowStart.data(), slowStart.size(), MSG_NOSIGNAL);
+    // A token holder on the same address as the flood (every program on
+    // loopback is 127.0.0.1) is served over TCP too: idle strangers give way.
+    for (int i = 0; i < 20; ++i) {
+      const HttpReply listed = overTcp(port, "GET", "/api/jobs", fmt::format("Authorization: Bearer {}\r\n", kToken));
+      ASSERT_EQ(listed.status, 200) << listed.head << listed.body;
+    }
     // The owner, over the Unix socket, is served at once.
     const CommandResult paused = daemon.client(fmt::format("pause {}", id));
     EXPECT_EQ(paused.status, 0) << paused.err;
@@ -316,7 +334,11 @@ TEST(Security, BodiesNobodyAskedForAreNeverReadIntoMemory) {
   EXPECT_EQ(uploaded.status, 400) << uploaded.text.substr(0, 300);
   EXPECT_NE(uploaded.body.value("error", "").find("there is no device nowhere"), std::string::npos) << uploaded.text;
   const size_t peak = peakMemory(daemon.pid());
+#if !defined(__SANITIZE_ADDRESS__)
+  // (Under AddressSanitizer, freed memory is held back in quarantine and
+  // every allocation has red zones: the bound is the program's as built to run.)
   EXPECT_LT(peak, idle + 100 * kMiB) << "idle " << idle / kMiB << " MiB, peak " << peak / kMiB << " MiB";
+#endif
   std::printf("rotafabd's peak resident memory: %zu MiB idle, %zu MiB after 1.3 GiB of refused bodies\n", idle / kMiB,
               peak / kMiB);
   // Nothing of the refused upload stays in the spool.
