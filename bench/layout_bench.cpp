@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "core/Executor.h"
-#include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/ObjWriter.h"
 #include "jobs/MakeJob.h"
 #include "jobs/Manifest.h"
 #include "jobs/Nesting.h"

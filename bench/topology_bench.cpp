@@ -25,12 +25,12 @@
 #include "geometry/CoplanarMerge.h"
 #include "geometry/FaceTracing.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
 #include "geometry/Simplification.h"
 #include "geometry/WeaveStructure.h"
+#include "geometry/io/MeshImport.h"
+#include "geometry/io/ObjWriter.h"
 
 namespace geo = rotafab::geometry;
 

@@ -23,4 +23,19 @@ std::filesystem::path installedHelperFolder();
 // the error of starting it names the program that is missing).
 std::string helperProgram(const std::string& name);
 
+// The value of the environment variable `name`, empty when it is not set.
+std::string environmentValue(const char* name);
+
+// $HOME, else /tmp.
+std::filesystem::path homeFolder();
+
+// The daemon's state folder by default: $XDG_STATE_HOME/rotafab, else
+// ~/.local/state/rotafab (both programs: the daemon keeps its state there,
+// the command line finds the daemon's socket from it).
+std::filesystem::path defaultStateDir();
+
+// The daemon's socket by default: $XDG_RUNTIME_DIR/rotafab/rotafabd.sock,
+// else rotafabd.sock in `stateDir`.
+std::filesystem::path defaultSocket(const std::filesystem::path& stateDir);
+
 }  // namespace rotafab::core

@@ -18,12 +18,12 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "daemon/ExitCode.h"
+#include "core/ExitCode.h"
 #include "daemon/service/DaemonConfig.h"
 #include "daemon/service/HttpServer.h"
 #include "daemon/service/Service.h"
-#include "jobs/AtomicFile.h"
 #include "profiles/Profiles.h"
+#include "toolpath/AtomicFile.h"
 
 namespace {
 
@@ -84,7 +84,7 @@ int serve(const service::DaemonConfig& config) {
   fs::create_directories(config.stateDir, error);
   if (error) {
     fmt::print(stderr, "error: {}: cannot create the state directory: {}\n", config.stateDir.string(), error.message());
-    return cli::kUserError;
+    return core::kUserError;
   }
   keepStatePrivate(config.stateDir);
   int lock = -1;
@@ -92,7 +92,7 @@ int serve(const service::DaemonConfig& config) {
     lock = lockStateDir(config.stateDir);
   } catch (const std::exception& refused) {
     fmt::print(stderr, "error: {}\n", refused.what());
-    return cli::kUserError;
+    return core::kUserError;
   }
   auto log = makeLogger(config.stateDir);
   boost::asio::io_context io(1);
@@ -104,7 +104,7 @@ int serve(const service::DaemonConfig& config) {
   } catch (const std::exception& failed) {
     log->error("{}", failed.what());
     ::close(lock);
-    return cli::kUserError;
+    return core::kUserError;
   }
   service::HttpLimits limits;
   limits.header = std::chrono::milliseconds(static_cast<long>(config.headerTimeout * 1000));
@@ -116,7 +116,7 @@ int serve(const service::DaemonConfig& config) {
     log->error("{}", failed.what());
     queue.shutdown("it could not listen", [] {});
     ::close(lock);
-    return cli::kUserError;
+    return core::kUserError;
   }
   nlohmann::json where{{"pid", ::getpid()}, {"listen", server.addresses()}};
   try {
@@ -147,7 +147,7 @@ int serve(const service::DaemonConfig& config) {
   std::error_code ignored;
   fs::remove(config.stateDir / "rotafabd.json", ignored);
   ::close(lock);
-  return cli::kSuccess;
+  return core::kSuccess;
 }
 
 }  // namespace
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& error) {
     if (error.get_exit_code() == 0) return app.exit(error);
     fmt::print(stderr, "error: {}\nRun `rotafabd --help` for usage.\n", error.what());
-    return rotafab::cli::kUsageError;
+    return rotafab::core::kUsageError;
   }
   if (!token.empty()) {
     std::random_device random;
@@ -188,9 +188,9 @@ int main(int argc, char** argv) {
     return serve(config);
   } catch (const rotafab::service::ConfigError& error) {
     fmt::print(stderr, "error: {}\n", error.what());
-    return rotafab::cli::kUserError;
+    return rotafab::core::kUserError;
   } catch (const std::exception& error) {
     fmt::print(stderr, "error: {}\n", error.what());
-    return rotafab::cli::kUserError;
+    return rotafab::core::kUserError;
   }
 }

@@ -1,7 +1,7 @@
 #pragma once
 // The device abstraction: one interface for every cutter, whatever
 // its wire protocol, as libsigrok has one for every logic analyser. A device
-// knows toolpaths (jobs/Toolpath.h), never meshes. Every call that waits on
+// knows toolpaths (toolpath/Toolpath.h), never meshes. Every call that waits on
 // the device has a timeout; a timeout, a disconnect, an error or alarm the
 // controller reports, or a cancel ends in a DeviceFault, and the driver has
 // turned the laser off (as far as the controller still answers) before it
@@ -14,7 +14,7 @@
 #include <string>
 
 #include "core/Cancellation.h"
-#include "jobs/Toolpath.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::devices {
 

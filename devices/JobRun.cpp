@@ -1,6 +1,6 @@
 #include "devices/JobRun.h"
 
-#include "jobs/AtomicFile.h"
+#include "toolpath/AtomicFile.h"
 
 namespace rotafab::devices {
 

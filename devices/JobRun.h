@@ -17,9 +17,9 @@
 #include "core/Cancellation.h"
 #include "devices/Device.h"
 #include "devices/DriverEntry.h"
-#include "jobs/SheetDrawing.h"
-#include "jobs/Toolpath.h"
 #include "profiles/Profiles.h"
+#include "toolpath/SheetDrawing.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::devices {
 

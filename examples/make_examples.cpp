@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/ObjWriter.h"
 
 namespace geo = rotafab::geometry;
 

@@ -56,9 +56,6 @@ void readBody(const Admission& admitted, std::string_view body, size_t piece) {
     const nlohmann::json value = nlohmann::json::parse(body, nullptr, false);
     if (value.is_discarded()) return;
     if (admitted.route.route == Route::JobAction) (void)checkedActionArguments(admitted.route.name, value);
-    if (admitted.route.route == Route::Jobs && value.is_object() && value.contains("options")) {
-      (void)optionWords(value["options"]);
-    }
   }
 }
 

@@ -11,7 +11,7 @@
 #include "geometry/DualMesh.h"
 #include "geometry/FaceTracing.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
+#include "geometry/io/MeshImport.h"
 
 namespace geo = rotafab::geometry;
 

@@ -10,7 +10,7 @@
 #include <unordered_map>
 
 #include "geometry/EdgeUses.h"
-#include "geometry/MeshImport.h"
+#include "geometry/io/MeshImport.h"
 
 namespace rotafab::geometry {
 namespace {

@@ -22,7 +22,7 @@
 #include <ostream>
 #include <string>
 
-#include "jobs/SheetDrawing.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs {
 

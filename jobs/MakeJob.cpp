@@ -17,13 +17,13 @@
 #include "geometry/FastenerHoles.h"
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/MeshRepair.h"
 #include "geometry/Simplification.h"
 #include "geometry/WeaveStructure.h"
-#include "jobs/AtomicFile.h"
+#include "geometry/io/MeshImport.h"
 #include "jobs/OutputFolder.h"
-#include "jobs/Toolpath.h"
+#include "toolpath/AtomicFile.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::jobs {
 namespace {

@@ -15,8 +15,8 @@
 #include "core/UserError.h"
 #include "geometry/WeaveStructure.h"
 #include "jobs/JobCost.h"
-#include "jobs/JsonErrors.h"
 #include "jobs/SvgWriter.h"
+#include "toolpath/JsonErrors.h"
 
 namespace rotafab::jobs {
 

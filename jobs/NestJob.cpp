@@ -5,8 +5,8 @@
 #include <chrono>
 
 #include "core/UserError.h"
-#include "jobs/AtomicFile.h"
 #include "jobs/LayoutSvg.h"
+#include "toolpath/AtomicFile.h"
 
 namespace rotafab::jobs {
 

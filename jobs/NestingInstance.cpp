@@ -7,7 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 
-#include "jobs/JsonErrors.h"
+#include "toolpath/JsonErrors.h"
 
 namespace rotafab::jobs {
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "jobs/Nesting.h"
-#include "jobs/SheetDrawing.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs {
 

@@ -12,11 +12,11 @@
 #include <stdexcept>
 
 #include "core/Polygon2.h"
-#include "jobs/AtomicFile.h"
 #include "jobs/DxfWriter.h"
-#include "jobs/EpsWriter.h"
 #include "jobs/RowLayout.h"
 #include "jobs/SvgWriter.h"
+#include "toolpath/AtomicFile.h"
+#include "toolpath/EpsWriter.h"
 
 namespace rotafab::jobs {
 

@@ -12,8 +12,8 @@
 #include "core/WorkContext.h"
 #include "jobs/Nesting.h"
 #include "jobs/Part.h"
-#include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs {
 

@@ -26,7 +26,7 @@
 #include <string>
 #include <string_view>
 
-#include "jobs/SheetDrawing.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs {
 

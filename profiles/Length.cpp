@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include "core/UserError.h"
+
 namespace rotafab::profiles {
 
 std::optional<double> parseLength(std::string_view text) {
@@ -28,6 +30,15 @@ std::optional<double> parseLength(std::string_view text) {
     return std::nullopt;
   }
   return value * inchesPerUnit;
+}
+
+double lengthOption(const std::string& text, std::string_view flag, bool positive) {
+  const auto value = parseLength(text);
+  if (!value || *value < 0 || (positive && !(*value > 0))) {
+    throw core::UserError(fmt::format("{} {}: expected a {}length such as 0.125in, 3.2mm or 0.32cm", flag, text,
+                                      positive ? "positive " : ""));
+  }
+  return *value;
 }
 
 namespace {

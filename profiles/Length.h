@@ -14,6 +14,11 @@ namespace rotafab::profiles {
 // one of the units.
 std::optional<double> parseLength(std::string_view text);
 
+// A length option's value in inches (`flag`, "--kerf", names it in the
+// message); zero allowed unless `positive`. Throws core::UserError: "--kerf
+// 2furlongs: expected a length such as 0.125in, 3.2mm or 0.32cm".
+double lengthOption(const std::string& text, std::string_view flag, bool positive = false);
+
 // The unit a length is written in: "in", "mm" or "cm" ("in" for a bare number).
 std::string_view writtenUnit(std::string_view text);
 

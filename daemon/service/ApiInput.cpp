@@ -203,36 +203,4 @@ json checkedActionArguments(std::string_view action, const json& body) {
   return checked;
 }
 
-std::vector<std::string> optionWords(const json& options) {
-  std::vector<std::string> words;
-  if (options.is_null()) return words;
-  constexpr size_t kMostWords = 200;
-  if (options.is_array()) {
-    if (options.size() > kMostWords) throw ApiError(400, fmt::format("options: more than {} words", kMostWords));
-    for (const json& word : options) {
-      if (!word.is_string()) {
-        throw ApiError(400, "options: expected a list of words such as [\"--structure\", \"band\"]");
-      }
-      words.push_back(checkedText(word, "options", 1000));
-    }
-    return words;
-  }
-  if (!options.is_object()) throw ApiError(400, "options: expected a list of words or an object of options");
-  if (options.size() > kMostWords) throw ApiError(400, fmt::format("options: more than {} options", kMostWords));
-  for (const auto& [key, value] : options.items()) {
-    const std::string name = checkedText(json(key), "options", 100);
-    const std::string flag = name.starts_with("--") ? name : "--" + name;
-    if (value.is_boolean()) {
-      if (value.get<bool>()) words.push_back(flag);
-    } else if (value.is_string()) {
-      words.push_back(flag), words.push_back(checkedText(value, "options." + name, 1000));
-    } else if (value.is_number()) {
-      words.push_back(flag), words.push_back(value.dump());
-    } else {
-      throw ApiError(400, fmt::format("options.{}: expected text, a number or true", name));
-    }
-  }
-  return words;
-}
-
 }  // namespace rotafab::service

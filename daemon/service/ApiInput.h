@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -61,9 +62,5 @@ std::string withoutDaemonPaths(std::string message, const std::vector<std::strin
 // An action's arguments, checked and with only the fields it takes
 // (resume: from_sheet; move: before or priority; the others: none).
 nlohmann::json checkedActionArguments(std::string_view action, const nlohmann::json& body);
-
-// The `make` options of a submission: a JSON array of command-line words,
-// or an object of option names and values ({"structure": "band", "score-folds": true}).
-std::vector<std::string> optionWords(const nlohmann::json& options);
 
 }  // namespace rotafab::service

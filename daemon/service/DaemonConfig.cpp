@@ -14,15 +14,9 @@ namespace rotafab::service {
 namespace fs = std::filesystem;
 namespace {
 
-std::string environment(const char* name) {
-  const char* value = std::getenv(name);
-  return value ? value : "";
-}
+using core::environmentValue;
 
-fs::path home() {
-  const std::string dir = environment("HOME");
-  return dir.empty() ? fs::path("/tmp") : fs::path(dir);
-}
+fs::path home() { return core::homeFolder(); }
 
 // `~/` and `$XDG_RUNTIME_DIR`, `$XDG_STATE_HOME`, `$HOME` at the start of a path.
 fs::path expanded(const std::string& text) {
@@ -30,7 +24,7 @@ fs::path expanded(const std::string& text) {
   if (text.starts_with("$")) {
     const size_t slash = text.find('/');
     const std::string name = text.substr(1, slash == std::string::npos ? std::string::npos : slash - 1);
-    const std::string value = environment(name.c_str());
+    const std::string value = environmentValue(name.c_str());
     if (!value.empty()) return fs::path(value) / (slash == std::string::npos ? "" : text.substr(slash + 1));
   }
   return text;
@@ -66,16 +60,6 @@ bool validListen(const std::string& address) {
 }
 
 }  // namespace
-
-fs::path defaultStateDir() {
-  const std::string state = environment("XDG_STATE_HOME");
-  return (state.empty() ? home() / ".local/state" : fs::path(state)) / "rotafab";
-}
-
-fs::path defaultSocket(const fs::path& stateDir) {
-  const std::string runtime = environment("XDG_RUNTIME_DIR");
-  return runtime.empty() ? stateDir / "rotafabd.sock" : fs::path(runtime) / "rotafab/rotafabd.sock";
-}
 
 // The Unix socket for `rotafab`, and loopback TCP for a browser (the workshop page).
 static std::vector<std::string> defaultListen(const fs::path& stateDir) {

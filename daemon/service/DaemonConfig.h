@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "core/ProgramFolders.h"
+
 namespace rotafab::service {
 
 // The workshop page's port on loopback by default (SPEC, "Daemon").
@@ -64,10 +66,8 @@ struct DaemonConfig {
   double planTimeout = 3600;  // seconds a plan may take before its job fails
 };
 
-// $XDG_STATE_HOME/rotafab, else ~/.local/state/rotafab.
-std::filesystem::path defaultStateDir();
-// $XDG_RUNTIME_DIR/rotafab/rotafabd.sock, else rotafabd.sock in `stateDir`.
-std::filesystem::path defaultSocket(const std::filesystem::path& stateDir);
+using core::defaultSocket;  // (core/ProgramFolders.h: the command line finds the socket too)
+using core::defaultStateDir;
 
 // The defaults: what the daemon runs with when no file is given.
 DaemonConfig defaultConfig();

@@ -589,7 +589,7 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
                      "mesh or a `make` output folder on the daemon's machine");
     }
     submission.path = checkedText(body["path"], "path", 4096);
-    submission.options = optionWords(body.value("options", json()));
+    submission.options = makeOptionsOf(body.value("options", json()));
     if (body.contains("device")) submission.device = checkedText(body["device"], "device", 64);
     if (body.contains("priority")) {
       submission.priority = static_cast<int>(wholeNumber(body["priority"], kPriorityField));

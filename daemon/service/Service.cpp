@@ -4,7 +4,6 @@
 #include <spdlog/sinks/base_sink.h>
 #include <spdlog/spdlog.h>
 
-#include <CLI/CLI.hpp>
 #include <atomic>
 #include <boost/asio/post.hpp>
 #include <boost/asio/steady_timer.hpp>
@@ -20,7 +19,6 @@
 #include "core/Executor.h"
 #include "core/UserError.h"
 #include "core/WorkContext.h"
-#include "daemon/MakeOptions.h"
 #include "daemon/service/ApiInput.h"
 #include "daemon/service/DiskReserve.h"
 #include "daemon/service/UploadForm.h"
@@ -28,10 +26,10 @@
 #include "devices/DriverEntry.h"
 #include "devices/JobRun.h"
 #include "geometry/PolygonMesh.h"
-#include "jobs/JobSheets.h"
-#include "jobs/ManifestFile.h"
-#include "jobs/Toolpath.h"
 #include "profiles/Profiles.h"
+#include "toolpath/JobSheets.h"
+#include "toolpath/ManifestFile.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::service {
 namespace asio = boost::asio;
@@ -73,36 +71,11 @@ std::string isoTime(double unixSeconds) {
   return text;
 }
 
-// The `make` options a job may carry: those of `rotafab make` but the
-// output folder and the summary's form, which are the daemon's to choose.
-void checkSubmittedOptions(const CLI::App& make) {
-  for (const char* own : {"--out", "--json"}) {
-    if (make.count(own) > 0) {
-      throw ApiError(400, fmt::format("{} is not a submission's option: the daemon keeps the job's files and "
-                                      "`rotafab status --json` gives its summary",
-                                      own));
-    }
-  }
-}
-
-// Parses the words as `rotafab make MESH WORDS...` would.
-cli::MakeOptions parseMakeOptions(const std::string& mesh, const std::vector<std::string>& words, bool& machineGiven,
-                                  bool& materialGiven) {
-  cli::MakeOptions options;
-  CLI::App make{"make"};
-  cli::addMakeOptions(make, options);
-  std::vector<std::string> arguments(words.rbegin(), words.rend());
-  arguments.push_back(mesh);
-  try {
-    make.parse(arguments);
-    cli::checkStructureOptions(make, options);
-  } catch (const CLI::ParseError& error) {
-    throw ApiError(400, fmt::format("make options: {}", error.what()));
-  }
-  checkSubmittedOptions(make);
-  machineGiven = make.count("--machine") > 0;
-  materialGiven = make.count("--material") > 0;
-  return options;
+// A job's `make` options as the store keeps them (an object of options; a
+// list of words in stores written before), read by make's table.
+std::optional<jobs::MakeOptions> storedOptions(const std::string& stored) {
+  if (stored.empty()) return std::nullopt;
+  return makeOptionsOf(json::parse(stored, nullptr, false));
 }
 
 // A message about a file in the spool, in the words of the file the
@@ -423,7 +396,13 @@ struct Service::Impl {
              {"strokes", job.strokes},
              {"message", job.message}};
     out["host"] = job.host.empty() ? json(nullptr) : json(job.host);
-    out["options"] = json::parse(job.options.empty() ? "[]" : job.options, nullptr, false);
+    // (As the words of `rotafab make`, as the API has always shown them.)
+    try {
+      const auto options = storedOptions(job.options);
+      out["options"] = options ? json(jobs::optionWords(*options)) : json::array();
+    } catch (const ApiError&) {
+      out["options"] = json::parse(job.options, nullptr, false);
+    }
     if (!job.summary.empty()) out["summary"] = json::parse(job.summary, nullptr, false);
     if (const auto p = planning.find(job.id); p != planning.end() && !p->second.progress.is_null()) {
       out["progress"] = p->second.progress;
@@ -971,12 +950,13 @@ struct Service::Impl {
       why = "the daemon has no devices";
       return std::nullopt;
     }
-    const json words = json::parse(options.empty() ? "[]" : options, nullptr, false);
     std::string machine;
-    if (words.is_array()) {
-      for (size_t i = 0; i + 1 < words.size(); ++i) {
-        if (words[i] == "--machine") machine = words[i + 1].get<std::string>();
+    try {
+      if (const auto given = storedOptions(options); given && given->given.contains("machine")) {
+        machine = given->machine;
       }
+    } catch (const ApiError&) {
+      // (Its plan says what is wrong with them.)
     }
     for (const Target& target : all) {
       if (machine.empty() || target.machine.name == machine) return target;
@@ -1077,17 +1057,19 @@ struct Service::Impl {
         summary = planOfFolder(folder, machine);
         sheets = summary["sheets"].get<int>();
       } else {
-        const json words = json::parse(job.options.empty() ? "[]" : job.options);
-        bool machineGiven = false, materialGiven = false;
-        cli::MakeOptions options = parseMakeOptions((folder / job.source).string(),
-                                                    words.get<std::vector<std::string>>(), machineGiven, materialGiven);
+        std::optional<jobs::MakeOptions> stored = storedOptions(job.options);
+        if (!stored) throw ApiError(400, "make options: --structure is required");
+        jobs::MakeOptions& options = *stored;
+        options.mesh = (folder / job.source).string();
+        const bool machineGiven = options.given.contains("machine");
+        const bool materialGiven = options.given.contains("material");
         if (machineGiven && options.machine != machine.name) {
           throw ApiError(400,
                          fmt::format("--machine {}: device {} is a {}", options.machine, job.device, machine.name));
         }
         options.machine = machine.name;
         if (!materialGiven) options.material = material.name;
-        jobs::MakeRequest request = cli::requestOf(options, catalogue);
+        jobs::MakeRequest request = jobs::requestOf(options, catalogue);
         // The daemon cuts from the SVG: it is written whatever --formats says.
         request.formats = request.formats.value_or(jobs::defaultFormats(machine));
         request.formats->svg = true;
@@ -1807,7 +1789,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
     job.owner = submission.owner;
     job.device = submission.device;
     job.priority = submission.priority;
-    job.options = json(submission.options).dump();
+    if (submission.options) job.options = jobs::optionsJson(*submission.options).dump();
     std::optional<Spool::Entry> entry;
     Reply refused;
     refused.status = 0;
@@ -1825,8 +1807,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
         submission.upload.reset();
         job.kind = JobKind::Mesh;
         job.source = submission.fileName;
-        bool machine = false, material = false;
-        parseMakeOptions(job.source, submission.options, machine, material);
+        if (!submission.options) throw ApiError(400, "make options: --structure is required");
       } else {
         entry.emplace(impl.spool->begin());
         const fs::path path = submission.path;
@@ -1836,7 +1817,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
                          fmt::format("path \"{}\": expected an absolute path on the daemon's machine", path.string()));
         }
         if (fs::is_directory(path, error)) {
-          if (!submission.options.empty()) {
+          if (submission.options) {
             throw ApiError(400, fmt::format("{}: a planned folder is cut as it was made; make options are for a mesh",
                                             path.string()));
           }
@@ -1861,8 +1842,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
           if (job.source.empty() || job.source.starts_with("planned")) {
             throw ApiError(400, fmt::format("{}: not a mesh file's name", shownText(path.string(), 1000)));
           }
-          bool machine = false, material = false;
-          parseMakeOptions(job.source, submission.options, machine, material);
+          if (!submission.options) throw ApiError(400, "make options: --structure is required");
           // Copied a piece at a time: a mesh of any size is never whole in the daemon's memory.
           try {
             entry->copyFile(job.source, path);

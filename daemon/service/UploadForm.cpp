@@ -86,7 +86,7 @@ Submission UploadForm::finish(const std::string& owner) {
   if (options_) {
     const json options = json::parse(*options_, nullptr, false);
     if (options.is_discarded()) throw ApiError(400, "options: not valid JSON");
-    submission.options = optionWords(options);
+    submission.options = makeOptionsOf(options);
   }
   if (device_) submission.device = checkedText(json(*device_), "device", 64);
   if (priority_) submission.priority = static_cast<int>(wholeNumber(json(*priority_), kPriorityField));

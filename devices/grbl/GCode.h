@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/Toolpath.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::devices::grbl {
 

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "jobs/Toolpath.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::devices::m2nano {
 

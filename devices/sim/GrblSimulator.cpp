@@ -16,7 +16,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "jobs/MotionPlan.h"
+#include "toolpath/MotionPlan.h"
 
 namespace rotafab::devices::sim {
 namespace {

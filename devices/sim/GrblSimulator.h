@@ -6,7 +6,7 @@
 // that loses what overflows it, a 15-block planner (a line leaves the
 // buffer, and is acknowledged, only when the planner has room), motion as
 // GRBL's planner makes it (accelerations, corners at the junction
-// deviation's speed, look-ahead over the blocks planned; jobs/MotionPlan.h),
+// deviation's speed, look-ahead over the blocks planned; toolpath/MotionPlan.h),
 // sped up by `timeScale`; a spindle change (M3, M4, M5, or an S alone in
 // laser mode) acknowledged only once the motion before it has ended;
 // realtime `?`, `!`, `~` and 0x18; status reports with the WCO, Ov, A and

@@ -9,8 +9,8 @@
 #include <fstream>
 #include <sstream>
 
-#include "jobs/AtomicFile.h"
-#include "jobs/EpsWriter.h"
+#include "toolpath/AtomicFile.h"
+#include "toolpath/EpsWriter.h"
 
 extern char** environ;
 

@@ -15,7 +15,7 @@
 #include <sstream>
 
 #include "cli/CliSupport.h"
-#include "geometry/ObjWriter.h"
+#include "geometry/io/ObjWriter.h"
 #include "support/CrumpledMesh.h"
 #include "support/TestSupport.h"
 

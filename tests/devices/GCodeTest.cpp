@@ -9,9 +9,9 @@
 #include <cmath>
 #include <regex>
 
-#include "jobs/Toolpath.h"
 #include "profiles/Profiles.h"
 #include "support/TestSheets.h"
+#include "toolpath/Toolpath.h"
 
 namespace rotafab::devices::grbl {
 namespace {

@@ -19,7 +19,7 @@
 #include <termios.h>
 #include <unistd.h>
 
-#include "jobs/SheetDrawing.h"
+#include "toolpath/SheetDrawing.h"
 
 #include "devices/grbl/GCode.h"
 #include "devices/grbl/GrblDriver.h"

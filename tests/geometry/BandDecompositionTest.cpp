@@ -16,9 +16,9 @@
 #include "geometry/Curvature.h"
 #include "geometry/DevelopableBands.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/PanelUnfolding.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/MeshSupport.h"
 #include "support/TestSupport.h"
 

@@ -14,7 +14,7 @@
 #include <set>
 
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
+#include "geometry/io/MeshImport.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::geometry {

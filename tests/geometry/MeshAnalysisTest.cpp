@@ -7,8 +7,8 @@
 
 #include <numbers>
 
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/MeshSupport.h"
 #include "support/TestSupport.h"
 

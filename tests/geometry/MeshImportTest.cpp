@@ -1,7 +1,7 @@
 // Import: every supported path reads what the file holds, and every bad input
 // is refused with one line that names the file and what is wrong.
 
-#include "geometry/MeshImport.h"
+#include "geometry/io/MeshImport.h"
 
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -15,8 +15,8 @@
 
 #include <cstring>
 
-#include "geometry/ObjWriter.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/ObjWriter.h"
 #include "support/MeshSupport.h"
 #include "support/TestSupport.h"
 

@@ -9,8 +9,8 @@
 
 #include "geometry/BandStructure.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/MeshSupport.h"
 #include "support/TestContext.h"
 #include "support/TestSupport.h"

@@ -1,7 +1,7 @@
-// The mesh reader's reply (geometry/MeshWire.h): a mesh comes back as it
+// The mesh reader's reply (geometry/io/MeshWire.h): a mesh comes back as it
 // went, and bytes that are no mesh are refused before anything uses them.
 
-#include "geometry/MeshWire.h"
+#include "geometry/io/MeshWire.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "geometry/ObjWriter.h"
+#include "geometry/io/ObjWriter.h"
 #include "support/MeshSupport.h"
 #include "support/TestSupport.h"
 

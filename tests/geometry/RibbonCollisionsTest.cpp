@@ -12,8 +12,8 @@
 #include <cmath>
 
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/MeshSupport.h"
 #include "support/TestContext.h"
 

@@ -15,7 +15,7 @@
 #include <set>
 
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
+#include "geometry/io/MeshImport.h"
 #include "support/Hausdorff.h"
 #include "support/MeshSupport.h"
 #include "support/TestContext.h"

@@ -12,8 +12,8 @@
 #include <stdexcept>
 
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 
 namespace rotafab::geometry {
 namespace {

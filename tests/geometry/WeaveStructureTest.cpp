@@ -15,8 +15,8 @@
 #include "core/Polygon2.h"
 #include "geometry/FastenerHoles.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/MeshSupport.h"
 #include "support/TestContext.h"
 

@@ -14,8 +14,8 @@
 #include "geometry/EdgeUses.h"
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 #include "support/TestSupport.h"
 
 namespace rotafab::geometry {

@@ -11,8 +11,8 @@
 
 #include "core/Polygon2.h"
 #include "geometry/MeshAnalysis.h"
-#include "geometry/MeshImport.h"
 #include "geometry/Primitives.h"
+#include "geometry/io/MeshImport.h"
 
 namespace rotafab::geometry {
 namespace {

@@ -2,7 +2,7 @@
 // atomically is either complete or absent (or still the old one), and the
 // temporary file never outlives the call.
 
-#include "jobs/AtomicFile.h"
+#include "toolpath/AtomicFile.h"
 
 #include <grp.h>
 #include <gtest/gtest.h>

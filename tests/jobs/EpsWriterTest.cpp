@@ -3,7 +3,7 @@
 // and whose strokes carry each operation's exact profile colour where that
 // operation's paths are (the driver picks the operation by colour).
 
-#include "jobs/EpsWriter.h"
+#include "toolpath/EpsWriter.h"
 
 #include <gtest/gtest.h>
 

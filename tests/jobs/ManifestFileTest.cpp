@@ -4,18 +4,18 @@
 // manifest that is not as `make` writes it is left to readManifest, which
 // says what is wrong.
 
-#include "jobs/ManifestFile.h"
+#include "toolpath/ManifestFile.h"
 
 #include <gtest/gtest.h>
 
 #include <fstream>
 
 #include "core/UserError.h"
-#include "jobs/JobSheets.h"
 #include "jobs/MakeJob.h"
 #include "support/TestContext.h"
 #include "support/TestSupport.h"
 #include "support/WorkshopRequest.h"
+#include "toolpath/JobSheets.h"
 
 namespace rotafab::jobs {
 namespace {

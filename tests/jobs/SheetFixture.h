@@ -19,8 +19,8 @@
 #include <vector>
 
 #include "geometry/HersheyFont.h"
-#include "jobs/SheetDrawing.h"
 #include "support/TestSupport.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs::sheet_tests {
 

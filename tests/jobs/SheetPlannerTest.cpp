@@ -11,9 +11,9 @@
 #include <sstream>
 
 #include "core/Polygon2.h"
-#include "jobs/SheetReader.h"
 #include "support/TestContext.h"
 #include "support/TestSupport.h"
+#include "toolpath/SheetReader.h"
 
 namespace rotafab::jobs {
 namespace {

@@ -7,8 +7,8 @@
 
 #include "SheetFixture.h"
 #include "jobs/DxfWriter.h"
-#include "jobs/EpsWriter.h"
 #include "jobs/SvgWriter.h"
+#include "toolpath/EpsWriter.h"
 
 namespace rotafab::jobs::sheet_tests {
 namespace {

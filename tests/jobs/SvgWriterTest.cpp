@@ -5,7 +5,7 @@
 
 #include "jobs/SvgWriter.h"
 
-#include "jobs/SheetReader.h"
+#include "toolpath/SheetReader.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Toolpaths: the order of operations, passes and travel, and the SVG sheet
 // they are planned from, read back.
 
-#include "jobs/Toolpath.h"
+#include "toolpath/Toolpath.h"
 
 #include <gtest/gtest.h>
 
@@ -10,11 +10,11 @@
 #include <fstream>
 #include <regex>
 
-#include "support/TestSupport.h"
-#include "jobs/SheetReader.h"
 #include "jobs/SvgWriter.h"
 #include "profiles/Profiles.h"
 #include "support/TestSheets.h"
+#include "support/TestSupport.h"
+#include "toolpath/SheetReader.h"
 
 namespace rotafab::jobs {
 namespace {

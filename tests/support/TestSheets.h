@@ -4,8 +4,8 @@
 
 #include <string>
 
-#include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::test {
 

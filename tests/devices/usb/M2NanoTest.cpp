@@ -16,8 +16,8 @@
 #include "devices/m2nano/Lhymicro.h"
 #include "devices/m2nano/M2NanoDriver.h"
 #include "devices/sim/M2NanoSimulator.h"
-#include "jobs/SheetDrawing.h"
 #include "profiles/Profiles.h"
+#include "toolpath/SheetDrawing.h"
 
 namespace rotafab::devices {
 namespace {

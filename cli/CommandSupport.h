@@ -1,0 +1,58 @@
+#pragma once
+// What the command-line verbs share: the one-line user error, length options and error reporting.
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include <stdexcept>
+#include <string>
+
+#include "cli/ExitStatus.h"
+#include "core/UserError.h"
+#include "jobs/MakeOptions.h"
+#include "jobs/Nesting.h"
+#include "jobs/OutputFolder.h"
+#include "profiles/Length.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::cli {
+
+// Bad input or a bad option value: printed as one line, exit status 1.
+using core::UserError;
+
+using jobs::flagOf;  // a build parameter by the flag that sets it, for messages: "--fastener"
+using profiles::lengthOption;
+
+// --order strict|window|free (CLI11 has checked the word).
+inline jobs::OrderMode orderOption(const std::string& order) { return jobs::orderModeOf(order); }
+
+// Runs a command's body and reports the errors every command reports alike,
+// as one line on stderr with exit status 1: a UserError or an invalid profile
+// as it is, anything else after `subject` (the file the command works on).
+// The body catches its own first (a device fault, an invalid mesh).
+template <typename Body>
+int reportingErrors(const std::string& subject, Body&& body) {
+  try {
+    return body();
+  } catch (const UserError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+  } catch (const profiles::ProfileError& error) {
+    fmt::print(stderr, "error: {}\n", error.what());
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "error: {}: {}\n", subject, error.what());
+  }
+  return kUserError;
+}
+
+// An --out folder option's check (a usage error, before any work): not a
+// file, nor inside one, and writable.
+inline CLI::Validator outputFolderCheck() {
+  return CLI::Validator(
+      [](std::string& folder) {
+        const std::string why = jobs::whyNotAnOutputFolder(folder);
+        return why.empty() ? std::string() : fmt::format("{}: {}", folder, why);
+      },
+      "FOLDER");
+}
+
+}  // namespace rotafab::cli

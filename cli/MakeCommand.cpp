@@ -1,0 +1,121 @@
+#include "cli/MakeCommand.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "cli/CommandContext.h"
+#include "cli/CommandSupport.h"
+#include "cli/MakeOptionsCli.h"
+#include "cli/ProgressLines.h"
+#include "jobs/MakeJob.h"
+#include "profiles/Profiles.h"
+
+namespace rotafab::cli {
+namespace {
+
+// "stands: ..." or "tips over: ... hang it from ...", with the mass when the material gives it.
+std::string stabilityLine(const geometry::Stability& stability) {
+  const std::string mass = stability.massKg ? fmt::format("; mass {:.3g} kg", *stability.massKg) : "";
+  if (stability.stands) {
+    return fmt::format("stands: its centre of mass is {:.2f} in inside its footprint{}", stability.margin, mass);
+  }
+  const geometry::Point3 &p = stability.hangPoints.at(0), &q = stability.hangPoints.at(1);
+  const std::string hang =
+      p == q ? geometry::formatPoint(p) : fmt::format("{} and {}", geometry::formatPoint(p), geometry::formatPoint(q));
+  if (!(stability.margin < -geometry::kBalanceInches)) {
+    return fmt::format("balances on the edge of its footprint, and a touch tips it{}; hang it from {}", mass, hang);
+  }
+  return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {}",
+                     -stability.margin, mass, hang);
+}
+
+void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const CommandContext& command) {
+  const auto& s = job.seconds;
+  if (options.json) {
+    // SPEC's summary, and the notes and warnings printed on the way (also
+    // on standard error), for a script that reads only the object.
+    nlohmann::ordered_json summary = jobs::summaryJson(job);
+    summary["notes"] = command.notes();
+    summary["warnings"] = command.warnings();
+    std::cout << summary.dump() << '\n';
+    return;
+  }
+  const size_t sheets = job.sheets.sheets.size();
+  const size_t panels = job.structure.panels.size();
+  const int fasteners = job.structure.fasteners;
+  fmt::print("{}: {} panel{} on {} sheet{} ({:.1f}% of the usable bed area), {} fastener{}; written to {}/\n",
+             options.mesh, panels, panels == 1 ? "" : "s", sheets, sheets == 1 ? "" : "s", 100 * job.sheets.utilization,
+             fasteners, fasteners == 1 ? "" : "s", job.folder.string());
+  if (const auto& simplified = job.mesh.simplified) {
+    if (simplified->simplified()) {
+      fmt::print("  panels asked: {}; the mesh simplified from {} faces to {}\n", simplified->asked,
+                 simplified->facesBefore, simplified->facesAfter);
+    } else {
+      fmt::print("  panels asked: {}; the mesh has {} faces, not simplified\n", simplified->asked,
+                 simplified->facesAfter);
+    }
+  }
+  fmt::print("  built, {:.1f} x {:.1f} x {:.1f} in; {}\n", job.size.x(), job.size.y(), job.size.z(),
+             stabilityLine(job.stability));
+  fmt::print("  it takes {}\n", jobs::costLine(job.cost));
+  fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, estimate {:.2f} s, writing {:.2f} s\n", s.import,
+             s.geometry, s.nesting, s.estimate, s.writing);
+  fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", job.folder.string(), job.folder.string());
+}
+
+int runMake(const MakeOptions& options) {
+  return reportingErrors(options.mesh, [&]() -> int {
+    const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+    const jobs::MakeRequest request = requestOf(options, catalogue);
+    const std::filesystem::path folder =
+        options.out.empty() ? jobs::defaultOutputFolder(request) : std::filesystem::path(options.out);
+    ProgressLineOptions lines;
+    lines.prefix = "make: ";
+    lines.nestingPrefix = "nesting: ";
+    const auto& bed = request.machine.bed;
+    const double k = profiles::unitsPerInch(bed.unit);
+    lines.bed = fmt::format("{:.4g} x {:.4g} {}", bed.width * k, bed.height * k, bed.unit);
+    lines.rows = request.rows;
+    lines.folder = folder.string();
+    CommandContext command{ProgressLines(lines)};
+    try {
+      printSummary(options, jobs::makeJob(request, folder, command.context()), command);
+      return kSuccess;
+    } catch (const core::Cancelled&) {
+      fmt::print(stderr, "make: stopped; nothing was written\n");
+      return command.interruptedStatus();
+    } catch (const geometry::InvalidMeshError& error) {
+      fmt::print(stderr, "error: {}\n", error.what());
+      return kUserError;
+    } catch (const std::bad_alloc&) {
+      fmt::print(stderr, "error: {}: the structure does not fit in memory\n", options.mesh);
+      return kUserError;
+    }
+  });
+}
+
+}  // namespace
+
+void addMakeCommand(CLI::App& app, int& status) {
+  auto options = std::make_shared<MakeOptions>();
+  CLI::App* make = app.add_subcommand("make", "Turn a mesh into numbered, drilled panels on laser sheets");
+  addMakeOptions(*make, *options);
+  make->footer(
+      "Writes into the output folder: sheet-001.eps/.svg/.dxf, ... (one set per sheet, for the cutter) and\n"
+      "sheet-001.preview.svg (for people), manifest.json (SPEC), manifest.txt (what it takes, and the assembly\n"
+      "steps), structure.obj (the panels in 3D, a group per panel). Lengths take in, mm or cm.\n"
+      "Default scale: the mean edge becomes 2 in. Ctrl-C stops at once and writes nothing.\n\n"
+      "Examples:\n"
+      "  rotafab make examples/bunny.obj --structure band\n"
+      "  rotafab make examples/torus.obj --structure band --size 30in --fastener 3mm --out torus/");
+  make->callback([options, make, &status] {
+    checkStructureOptions(*make, *options);
+    status = runMake(*options);
+  });
+}
+
+}  // namespace rotafab::cli

@@ -1,0 +1,189 @@
+#include "cli/RunCommand.h"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <memory>
+
+#include "cli/CommandContext.h"
+#include "cli/CommandSupport.h"
+#include "cli/RunProgress.h"
+#include "devices/JobRun.h"
+#include "toolpath/JobSheets.h"
+
+namespace rotafab::cli {
+namespace {
+
+struct RunOptions {
+  std::string target, device, out, machine, material = "posterboard";
+  std::optional<int> sheet;
+  bool frame = false, dryRun = false;
+};
+
+// The machine profile: the one named, or the first the URI's driver drives.
+profiles::MachineProfile machineFor(const RunOptions& options, const profiles::ProfileCatalogue& catalogue,
+                                    std::string_view driver) {
+  if (options.machine.empty()) {
+    if (auto machine = profiles::firstMachineFor(catalogue, driver)) return *machine;
+    throw UserError(fmt::format("no machine profile for the {} driver; give --machine", driver));
+  }
+  profiles::MachineProfile machine = profiles::findMachine(catalogue, options.machine);
+  if (machine.driver != driver) {
+    throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver", machine.name,
+                                machine.driver, options.device, driver));
+  }
+  return machine;
+}
+
+int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command) {
+  const auto& toolpaths = job.toolpaths();
+  if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
+    throw UserError(
+        fmt::format("{}: {} sheets, and no terminal to ask before each one that the next is loaded: "
+                    "run them one at a time with --sheet N",
+                    options.target, toolpaths.size()));
+  }
+  const auto started = std::chrono::steady_clock::now();
+  devices::RunSummary done;
+  try {
+    done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation()), command.cancellation());
+  } catch (const devices::DeviceFault& fault) {
+    // Where the job stopped, so that the operator knows what is cut and can
+    // go on from that sheet; and what is true of the laser.
+    const std::string where =
+        fault.sheet == 0    ? std::string("before the first sheet")
+        : fault.nothingSent ? fmt::format("at sheet {} of {}, before any of it was sent", fault.sheet, fault.sheets)
+                            : fmt::format("at sheet {} of {}, after stroke {} of {}", fault.sheet, fault.sheets,
+                                          fault.strokesDone, fault.strokes);
+    const std::string laser = fault.nothingSent && fault.sheet > 1
+                                  ? std::string("the sheets before it ended with the laser off")
+                                  : devices::laserStateAfter(fault);
+    if (fault.kind == devices::FaultKind::Cancelled) {
+      // The operator's choice, not an error.
+      fmt::print(stderr, "run: stopped {}; {}{}\n", where, laser,
+                 fault.sheet > 0
+                     ? fmt::format("; to go on, load sheet {} and run it with --sheet {}", fault.sheet, fault.sheet)
+                     : "");
+      // (no signal: the operator did not say the next sheet was loaded)
+      return command.signal() != 0 ? command.interruptedStatus() : kUserError;
+    }
+    fmt::print(stderr, "error: {} ({}; stopped {}; {})\n", fault.what(), devices::faultName(fault.kind), where, laser);
+    return kDeviceFault;
+  }
+  // The spool only writes the sheets (and hands them to the print queue): a print driver cuts them later.
+  const bool spool = options.device.starts_with("spool:");
+  const char* what = !spool                                                 ? "cut on"
+                     : options.device.find("printer=") != std::string::npos ? "sent to the printer by"
+                                                                            : "written as EPS by";
+  fmt::print("{}: {} sheet{} {} {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target, done.sheets,
+             done.sheets == 1 ? "" : "s", what, options.device, done.strokes, done.burnt,
+             minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
+             minutes(done.estimated));
+  return kSuccess;
+}
+
+int runRun(const RunOptions& options) {
+  return reportingErrors(options.target, [&]() -> int {
+    // Ctrl-C and SIGTERM cancel the job from here on (before any device, a simulator's thread, starts).
+    CommandContext command({}, 0, CommandContext::SecondSignal::Waits);
+    try {
+      devices::JobRunSetup setup;
+      try {
+        setup.device = devices::parseDeviceUri(options.device);
+      } catch (const std::invalid_argument& error) {
+        throw UserError(fmt::format("--device {}", error.what()));
+      }
+      if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
+      const std::vector<jobs::JobSheet> sheets = jobs::readJobSheets(options.target, options.sheet);
+      const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
+      setup.machine = machineFor(options, catalogue, setup.device.driver->name());
+      setup.material = profiles::findMaterial(catalogue, options.material);
+      jobs::checkSheetsFitBed(sheets, setup.machine);
+      for (const jobs::JobSheet& sheet : sheets) setup.sheets.push_back(sheet.drawing);
+      setup.dryRun = options.dryRun;
+      setup.cancellation = &command.cancellation();
+      setup.connected = [&](const std::string& identity) {
+        fmt::print(stderr, "run: {}: {}\n", options.device, identity);
+      };
+      const auto& driver = *setup.device.driver;
+      if (options.dryRun && !driver.connectsForDryRun(*setup.device.address)) {
+        if (const std::string note = driver.dryRunNote(*setup.device.address); !note.empty()) {
+          fmt::print(stderr, "run: {}\n", note);
+        }
+      }
+      std::unique_ptr<devices::JobRun> job;
+      try {
+        job = std::make_unique<devices::JobRun>(std::move(setup));
+      } catch (const std::invalid_argument& error) {
+        throw UserError(error.what());
+      }
+      if (!options.dryRun) return cut(options, *job, command);
+      if (job->toolpaths().size() > 1) {
+        // One file of several sheets would be cut back to back, onto one sheet.
+        throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
+                                    job->toolpaths().size()));
+      }
+      if (command.cancellation().cancelled()) {
+        fmt::print(stderr, "run: stopped; nothing was written\n");
+        return command.interruptedStatus();
+      }
+      fmt::print("{}: {}\n", options.out, job->writeDryRun(options.out));
+      return kSuccess;
+    } catch (const devices::DeviceFault& fault) {
+      if (fault.kind == devices::FaultKind::Cancelled && command.signal() != 0) {
+        fmt::print(stderr, "run: stopped before the first sheet; {}\n", devices::laserStateAfter(fault));
+        return command.interruptedStatus();
+      }
+      fmt::print(stderr, "error: {} ({}; {})\n", fault.what(), devices::faultName(fault.kind),
+                 devices::laserStateAfter(fault));
+      return kDeviceFault;
+    }
+  });
+}
+
+}  // namespace
+
+void addRunCommand(CLI::App& app, int& status) {
+  auto options = std::make_shared<RunOptions>();
+  CLI::App* run = app.add_subcommand("run", "Drive a cutter directly: cut the sheets of a `make` output");
+  run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
+  run->add_option("--device", options->device,
+                  "Device URI: grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
+                  "sim:grbl?speed=50 moves 50 times faster), m2nano://usb/1a86:5512 (a K40's M2 Nano board), "
+                  "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)")
+      ->required();
+  run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
+  run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
+  run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
+  run->add_option("--out", options->out,
+                  "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool)");
+  run->add_option("--machine", options->machine, "Machine profile (default: the first whose driver the URI names)");
+  run->add_option("--material", options->material, "Material profile: power and speed overrides")
+      ->capture_default_str();
+  run->footer(
+      "Cuts etch, then score, then inner cuts, then outer cuts, each with the machine profile's power, speed and\n"
+      "passes. Ctrl-C stops the job and leaves the laser off (GRBL: feed hold, reset, M5; M2 Nano: \"I\", which\n"
+      "drops the board's queue, then a home). Exit status 3 on a device fault.\n\n"
+      "Examples:\n"
+      "  rotafab make examples/cube.obj --structure band --machine grbl-diode-400 --out cube/\n"
+      "  rotafab run cube/ --device sim:grbl\n"
+      "  rotafab run cube/ --sheet 1 --device grbl:///dev/ttyUSB0 --frame\n"
+      "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode\n"
+      "  rotafab make examples/cube.obj --structure band --machine k40-m2nano --out k40/\n"
+      "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512\n"
+      "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512 --dry-run --out sheet1.egv");
+  run->callback([options, &status] {
+    // A safety check before anything opens a device: `--out` without
+    // `--dry-run` would otherwise cut for real and write nothing.
+    if (!options->out.empty() && !options->dryRun) {
+      throw CLI::ValidationError("--out",
+                                 "needs --dry-run: without it, run cuts on the device and writes no file; "
+                                 "add --dry-run to write the bytes to " +
+                                     options->out + " instead");
+    }
+    status = runRun(*options);
+  });
+}
+
+}  // namespace rotafab::cli

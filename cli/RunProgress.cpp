@@ -1,0 +1,69 @@
+#include "cli/RunProgress.h"
+
+#include <fmt/format.h>
+#include <poll.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+namespace rotafab::cli {
+
+void ProgressBar::operator()(const devices::Progress& p) {
+  const int percent = static_cast<int>(100 * p.bytesAcknowledged / std::max<size_t>(p.bytesTotal, 1));
+  const auto now = std::chrono::steady_clock::now();
+  if (terminal_ ? now - lastShown_ < std::chrono::milliseconds(200) && percent != 100
+                : percent / 10 == lastPercent_ / 10) {
+    return;
+  }
+  lastShown_ = now, lastPercent_ = percent;
+  const int filled = percent / 5;
+  fmt::print(stderr, "{}run: sheet {} [{}{}] {:3}%  stroke {} of {}, {} left{}", terminal_ ? "\r" : "", p.sheet,
+             std::string(filled, '#'), std::string(20 - filled, '.'), percent, p.stroke, p.strokes,
+             minutes(p.secondsLeft), terminal_ ? "" : "\n");
+}
+
+void ProgressBar::end() const {
+  if (terminal_) fmt::print(stderr, "\n");
+}
+
+bool waitForEnter(const core::Cancellation& cancel) {
+  for (;;) {
+    if (cancel.cancelled()) return false;
+    pollfd input{STDIN_FILENO, POLLIN, 0};
+    if (::poll(&input, 1, 200) > 0) {
+      char byte = 0;
+      while (::read(STDIN_FILENO, &byte, 1) == 1) {
+        if (byte == '\n') return true;
+      }
+      return false;
+    }
+  }
+}
+
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel) {
+  const bool terminal = ::isatty(STDERR_FILENO) != 0;
+  auto bar = std::make_shared<ProgressBar>(terminal);
+  devices::RunEvents events;
+  events.beforeSheet = [&cancel](const jobs::Toolpath& next) {
+    fmt::print(stderr, "run: load sheet {} and press Enter (Ctrl-C stops)\n", next.sheet);
+    return waitForEnter(cancel);  // Ctrl-C or the end of input: stop, do not cut blind
+  };
+  events.sheetStarted = [bar, sheets, terminal](size_t s, const jobs::Toolpath& toolpath, double seconds) {
+    // A simulator faster than real: its time, and the machine's it stands for.
+    const std::string machineTime = std::abs(seconds - toolpath.seconds) > 0.5
+                                        ? fmt::format(" ({} on the machine simulated)", minutes(toolpath.seconds))
+                                        : "";
+    fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}{}\n", toolpath.sheet, s + 1,
+               sheets, toolpath.strokes.size(), toolpath.burnLength, minutes(seconds), machineTime);
+    *bar = ProgressBar(terminal);
+  };
+  events.framing = [] { fmt::print(stderr, "run: framing (laser off)\n"); };
+  events.progress = [bar](const devices::Progress& p) { (*bar)(p); };
+  events.sheetFinished = [bar] { bar->end(); };
+  events.stopped = [bar] { bar->end(); };
+  return events;
+}
+
+}  // namespace rotafab::cli

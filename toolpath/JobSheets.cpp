@@ -1,0 +1,116 @@
+#include "toolpath/JobSheets.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "core/UserError.h"
+#include "toolpath/JsonErrors.h"
+#include "toolpath/ManifestFile.h"
+#include "toolpath/SheetReader.h"
+
+namespace rotafab::jobs {
+namespace {
+
+using SheetFiles = std::vector<std::pair<int, std::filesystem::path>>;  // (number, SVG file)
+
+void requireSvgSheets(const std::filesystem::path& manifestFile, const SheetFiles& sheets) {
+  if (sheets.empty()) {
+    throw core::UserError(
+        fmt::format("{}: lists no SVG sheet, which a cut is run from; make it again with svg in "
+                    "--formats (the default)",
+                    manifestFile.string()));
+  }
+}
+
+// The SVG sheets an output folder's manifest lists.
+SheetFiles listedSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
+  const auto manifestFile = folder / "manifest.json";
+  SheetFiles sheets;
+  try {
+    for (const auto& sheet : manifest.at("sheets")) {
+      const int64_t number = sheet.at("index");
+      if (number < 1 || number > INT32_MAX) {
+        throw core::UserError(
+            fmt::format("{}: sheets: index {} is not a sheet's number (1, 2, ...)", manifestFile.string(), number));
+      }
+      const int index = static_cast<int>(number);
+      for (const auto& file : sheet.at("files")) {
+        const std::string name = file;
+        if (name.ends_with(".svg")) sheets.emplace_back(index, folder / name);
+      }
+    }
+  } catch (const nlohmann::json::exception& error) {
+    throw core::UserError(fmt::format("{}: sheets: {}", manifestFile.string(), jsonErrorText(error)));
+  }
+  requireSvgSheets(manifestFile, sheets);
+  return sheets;
+}
+
+// The sheets to read: an output folder's, or one sheet's SVG.
+SheetFiles sheetFiles(const std::filesystem::path& target, std::optional<int> only) {
+  SheetFiles sheets;
+  if (std::filesystem::is_directory(target)) {
+    sheets = listedSheets(target, readManifest(target));
+  } else {
+    if (target.extension() != ".svg") {
+      throw core::UserError(
+          fmt::format("{}: give the sheet's .svg (or the output folder of `rotafab make`)", target.string()));
+    }
+    sheets.emplace_back(1, target);
+  }
+  if (only) {
+    const auto it = std::find_if(sheets.begin(), sheets.end(), [&](const auto& s) { return s.first == *only; });
+    if (it == sheets.end()) {
+      throw core::UserError(fmt::format("--sheet {}: {} has sheets 1 to {}", *only, target.string(), sheets.size()));
+    }
+    sheets = {*it};
+  }
+  return sheets;
+}
+
+std::vector<JobSheet> readSheets(const SheetFiles& files) {
+  std::vector<JobSheet> sheets;
+  for (const auto& [index, file] : files) {
+    try {
+      sheets.push_back({index, file, readSheetSvg(file)});
+    } catch (const std::invalid_argument& error) {
+      throw core::UserError(error.what());
+    }
+  }
+  return sheets;
+}
+
+}  // namespace
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& target, std::optional<int> only) {
+  return readSheets(sheetFiles(target, only));
+}
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const nlohmann::ordered_json& manifest) {
+  return readSheets(listedSheets(folder, manifest));
+}
+
+std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
+                                    const std::vector<std::pair<int, std::string>>& svgSheets) {
+  SheetFiles sheets;
+  for (const auto& [index, name] : svgSheets) sheets.emplace_back(index, folder / name);
+  requireSvgSheets(folder / "manifest.json", sheets);
+  return readSheets(sheets);
+}
+
+void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {
+  for (const JobSheet& sheet : sheets) {
+    if (sheet.drawing.width > machine.bed.width + 1e-6 || sheet.drawing.height > machine.bed.height + 1e-6) {
+      throw core::UserError(
+          fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
+                      "make it for this machine (`rotafab make ... --machine {}`)",
+                      sheet.file.string(), sheet.drawing.width, sheet.drawing.height, machine.name, machine.bed.width,
+                      machine.bed.height, machine.name));
+    }
+  }
+}
+
+}  // namespace rotafab::jobs
