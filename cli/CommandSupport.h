@@ -20,11 +20,9 @@ namespace rotafab::cli {
 // Bad input or a bad option value: printed as one line, exit status 1.
 using core::UserError;
 
-using jobs::flagOf;  // a build parameter by the flag that sets it, for messages: "--fastener"
+using jobs::flagOf;       // a build parameter by the flag that sets it, for messages: "--fastener"
+using jobs::orderModeOf;  // --order strict|window|free (CLI11 has checked the word)
 using profiles::lengthOption;
-
-// --order strict|window|free (CLI11 has checked the word).
-inline jobs::OrderMode orderOption(const std::string& order) { return jobs::orderModeOf(order); }
 
 // Runs a command's body and reports the errors every command reports alike,
 // as one line on stderr with exit status 1: a UserError or an invalid profile

@@ -71,7 +71,7 @@ int runNest(const NestOptions& options) {
     request.search.seed = options.seed;
     request.search.evaluations = options.evaluations;
     request.search.threads = options.threads;
-    request.search.order = orderOption(options.order);
+    request.search.order = orderModeOf(options.order);
     request.search.window = options.window;
     ProgressLineOptions lines;
     lines.prefix = "nest: ";

@@ -71,6 +71,9 @@ std::string isoTime(double unixSeconds) {
   return text;
 }
 
+// A mesh submitted without options: as `rotafab make` says it.
+constexpr const char* kNoStructure = "make options: --structure is required";
+
 // A job's `make` options as the store keeps them (an object of options; a
 // list of words in stores written before), read by make's table.
 std::optional<jobs::MakeOptions> storedOptions(const std::string& stored) {
@@ -1058,7 +1061,7 @@ struct Service::Impl {
         sheets = summary["sheets"].get<int>();
       } else {
         std::optional<jobs::MakeOptions> stored = storedOptions(job.options);
-        if (!stored) throw ApiError(400, "make options: --structure is required");
+        if (!stored) throw ApiError(400, kNoStructure);
         jobs::MakeOptions& options = *stored;
         options.mesh = (folder / job.source).string();
         const bool machineGiven = options.given.contains("machine");
@@ -1807,7 +1810,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
         submission.upload.reset();
         job.kind = JobKind::Mesh;
         job.source = submission.fileName;
-        if (!submission.options) throw ApiError(400, "make options: --structure is required");
+        if (!submission.options) throw ApiError(400, kNoStructure);
       } else {
         entry.emplace(impl.spool->begin());
         const fs::path path = submission.path;
@@ -1842,7 +1845,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
           if (job.source.empty() || job.source.starts_with("planned")) {
             throw ApiError(400, fmt::format("{}: not a mesh file's name", shownText(path.string(), 1000)));
           }
-          if (!submission.options) throw ApiError(400, "make options: --structure is required");
+          if (!submission.options) throw ApiError(400, kNoStructure);
           // Copied a piece at a time: a mesh of any size is never whole in the daemon's memory.
           try {
             entry->copyFile(job.source, path);
