@@ -16,18 +16,17 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <chrono>
-#include <deque>
 #include <filesystem>
 #include <map>
 #include <optional>
-#include <regex>
 #include <set>
 #include <unordered_map>
 #include <utility>
 
-#include "core/ProgramFolders.h"
 #include "daemon/service/AccessGate.h"
 #include "daemon/service/ApiInput.h"
+#include "daemon/service/EventStream.h"
+#include "daemon/service/HttpRoutes.h"
 #include "daemon/service/UploadForm.h"
 
 namespace rotafab::service {
@@ -55,36 +54,6 @@ constexpr auto kLingerFor = std::chrono::seconds(2);
 constexpr size_t kLingerBytes = 1 << 20;
 // An upload is read this much at a time, and written before the next piece is read.
 constexpr size_t kUploadPiece = 64 * 1024;
-
-// The page's files (HTML, CSS, JavaScript): PREFIX/share/rotafab/web once
-// installed; the source tree's daemon/web for a program run from its build tree.
-fs::path pageFolder() {
-  const fs::path installed = core::installedDataFolder() / "web";
-  std::error_code error;
-  if (fs::is_directory(installed, error)) return installed;
-#if defined(ROTAFAB_WEB_DIR) && defined(ROTAFAB_BUILD_DIR)
-  if (fs::equivalent(core::programFolder(), ROTAFAB_BUILD_DIR, error)) return ROTAFAB_WEB_DIR;
-#endif
-  return "/usr/share/rotafab/web";
-}
-
-// Debian's libjs-three, which the page's 3D view loads: only the files it uses.
-constexpr std::string_view kThreeFolder = "/usr/share/javascript/three";
-const std::set<std::string>& threeFiles() {
-  static const std::set<std::string> files{"build/three.min.js", "examples/js/controls/OrbitControls.js"};
-  return files;
-}
-
-std::string contentTypeOf(const fs::path& file) {
-  const std::string extension = file.extension().string();
-  if (extension == ".html") return "text/html; charset=utf-8";
-  if (extension == ".js") return "text/javascript; charset=utf-8";
-  if (extension == ".css") return "text/css; charset=utf-8";
-  if (extension == ".svg") return "image/svg+xml";
-  if (extension == ".png") return "image/png";
-  if (extension == ".json") return "application/json";
-  return "text/plain; charset=utf-8";
-}
 
 std::optional<std::string> accountName(uid_t uid) {
   struct passwd entry {};
@@ -456,145 +425,18 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
     }
   }
 
-  JobId jobNumber() const {
-    const auto id = wholeNumberIn(admitted_.route.job, kJobField);
-    if (!id) throw ApiError(404, fmt::format("no such job: {}", shownText(admitted_.route.job, 40)));
-    return *id;
-  }
-
-  void route(json body) {
-    Service& service = server_->service;
-    const MatchedRoute& route = admitted_.route;
-    const bool get = method_ == http::verb::get;
-    switch (route.route) {
-      case Route::PageIndex:
-      case Route::PageFile:
-      case Route::PageLibrary:
-      case Route::Favicon:
-        return page();
-      case Route::Login:
-        return login();
-      case Route::About:
-        return respond({200, {{"name", "rotafabd"}, {"version", "0.1.0"}, {"host", service.config().host}}});
-      case Route::Sessions:
-        return loginLink();
-      case Route::Devices:
-        return service.devices(replier());
-      case Route::Events:
-        return;  // (started from the header)
-      case Route::Jobs:
-        if (get) return service.list(replier());
-        return service.submit(jsonSubmission(body), replier());
-      case Route::Job:
-        return service.status(jobNumber(), replier());
-      case Route::JobManifest:
-        return service.manifest(jobNumber(), replier());
-      case Route::JobFile:
-        return service.file(jobNumber(), route.name, replier());
-      case Route::JobSheet: {
-        const JobId id = jobNumber();
-        const auto sheet = wholeNumberIn(route.name, kSheetField);
-        if (!sheet) throw ApiError(404, fmt::format("no sheet {}", shownText(route.name, 40)));
-        return service.sheet(id, static_cast<int>(*sheet), replier());
-      }
-      case Route::JobAction: {
-        const JobId id = jobNumber();
-        return service.act(id, route.name, checkedActionArguments(route.name, body), admitted_.caller->name, replier());
-      }
-    }
-  }
-
-  // The workshop page's files and Debian's three.js, the same for everyone.
-  void page() {
-    const MatchedRoute& route = admitted_.route;
-    const auto notFound = [&] {
-      return ApiError(404, fmt::format("no such page: {} (the page is at /, the API under /api; see docs/API.md)",
-                                       admitted_.target.path()));
-    };
-    Reply file;
-    if (route.route == Route::Favicon) {
-      Reply none{204, nullptr};  // no icon: asked for by every browser of its own accord
-      none.contentType = "image/x-icon";
-      return respond(std::move(none));
-    }
-    if (route.route == Route::PageIndex) {
-      file.file = server_->pages / "index.html";
-    } else if (route.route == Route::PageFile) {
-      static const std::regex kPageFile(R"([A-Za-z0-9_-]+\.(html|js|css|svg|png))");
-      if (!std::regex_match(route.name, kPageFile)) throw notFound();
-      file.file = server_->pages / route.name;
-    } else {
-      if (!threeFiles().contains(route.name)) throw notFound();
-      file.file = fs::path(kThreeFolder) / route.name;
-    }
-    std::error_code error;
-    if (!fs::is_regular_file(file.file, error)) {
-      throw ApiError(404, fmt::format("{} is not installed (the page's files; see the README)", file.file.string()));
-    }
-    respond(std::move(file));
-  }
-
-  // A login link's landing: the secret goes to the page in the fragment,
-  // which the browser never sends to a server; the page keeps it and clears the address.
-  void login() {
-    const auto secret = server_->gate.openSession(queryValue(admitted_.target.query, "code"));
-    Reply landing{303, nullptr};
-    landing.text = "to the workshop page\n";
-    landing.contentType = "text/plain; charset=utf-8";
-    landing.headers = {{"Location", secret ? "/#session=" + *secret : "/#signin=used"}};
-    respond(std::move(landing));
-  }
-
-  // A one-time link that opens a browser's session for who asks (over the
-  // Unix socket: this machine's user; over TCP: the token's holder).
-  void loginLink() {
-    std::string base;
-    if constexpr (kTcp) {
-      if (admitted_.caller->bySession) throw ApiError(403, "a login link is asked for with a token or on this machine");
-      base = "http://" + host_;
-    } else {
-      const auto page = server_->loopbackPage();
-      if (!page) {
-        throw ApiError(409,
-                       "the daemon has no TCP listener on this machine for a browser: add tcp://127.0.0.1:8730 to "
-                       "listen in its configuration");
-      }
-      base = *page;
-    }
-    const std::string code = server_->gate.newLoginCode(admitted_.caller->name);
-    respond({201,
-             {{"url", base + "/login?code=" + code},
-              {"page", base + "/"},
-              {"user", admitted_.caller->name},
-              {"expires_in", std::chrono::seconds(AccessGate::kLoginLinkLasts).count()}}});
-  }
-
-  // {"path": ...} of a mesh or a `make` output folder on the daemon's machine.
-  Submission jsonSubmission(const json& body) const {
-    Submission submission;
-    submission.owner = admitted_.caller->name;
-    for (const auto& [key, value] : body.items()) {
-      if (key != "path" && key != "options" && key != "device" && key != "priority") {
-        throw ApiError(400, fmt::format("unknown field \"{}\" (path, options, device, priority)", shownText(key, 40)));
-      }
-    }
-    if (kTcp && body.contains("path")) {
-      throw ApiError(403,
-                     "a path on the daemon's machine can be submitted over its Unix socket only; over TCP, upload "
-                     "the mesh (a multipart form with file=@MESH)");
-    }
-    if (!body.contains("path") || !body["path"].is_string()) {
-      throw ApiError(400,
-                     "a submission is a multipart upload of the mesh (file=@MESH), or {\"path\": \"/abs/path\"} of a "
-                     "mesh or a `make` output folder on the daemon's machine");
-    }
-    submission.path = checkedText(body["path"], "path", 4096);
-    submission.options = makeOptionsOf(body.value("options", json()));
-    if (body.contains("device")) submission.device = checkedText(body["device"], "device", 64);
-    if (body.contains("priority")) {
-      submission.priority = static_cast<int>(wholeNumber(body["priority"], kPriorityField));
-    }
-    return submission;
+  void route(const json& body) {
+    const RouteCall call{server_->service,
+                         server_->gate,
+                         admitted_,
+                         method_ == http::verb::get,
+                         kTcp,
+                         host_,
+                         server_->loopbackPage(),
+                         server_->pages,
+                         [this](Reply reply) { respond(std::move(reply)); },
+                         replier()};
+    answerRoute(call, body);
   }
 
   // ---- replies ----
@@ -686,72 +528,19 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   // ---- the event stream (server-sent events) ----
 
   void startEvents() {
+    std::optional<int64_t> onlyJob;
     const std::string job = queryValue(admitted_.target.query, "job");
     if (!job.empty()) {
       const auto id = wholeNumberIn(job, kJobField);
       if (!id) return fail(400, fmt::format("job={}: expected a job number", shownText(job, 40)));
-      onlyJob_ = *id;
+      onlyJob = *id;
     }
     header_.reset();
     stream_.expires_never();
-    queue_.push_back(
-        "HTTP/1.1 200 OK\r\nServer: rotafabd\r\nContent-Type: text/event-stream\r\nCache-Control: no-cache\r\n"
-        "Connection: close\r\n\r\n: rotafabd events\n\n");
-    writeNext();
-    auto weak = std::weak_ptr<Session>(this->shared_from_this());
-    const auto executor = stream_.get_executor();
-    subscription_ = server_->service.subscribe([weak, executor, onlyJob = onlyJob_](const ServiceEvent& event) {
-      if (onlyJob && event.type != "device" &&
-          event.data.value("job", event.data.value("id", int64_t{0})) != *onlyJob) {
-        return;
-      }
-      std::string text = fmt::format("event: {}\ndata: {}\n\n", event.type,
-                                     event.data.dump(-1, ' ', false, json::error_handler_t::replace));
-      asio::post(executor, [weak, text = std::move(text)]() mutable {
-        if (auto self = weak.lock()) self->sendEvent(std::move(text));
-      });
-    });
-    subscribed_ = true;
-    heartbeat();
-    // A client that goes away is seen as its end of the stream.
-    stream_.socket().async_wait(Protocol::socket::wait_read,
-                                [self = this->shared_from_this()](beast::error_code) { self->endEvents(); });
-  }
-
-  void heartbeat() {
-    timer_ = std::make_unique<asio::steady_timer>(stream_.get_executor(), std::chrono::seconds(15));
-    timer_->async_wait([weak = std::weak_ptr<Session>(this->shared_from_this())](beast::error_code error) {
-      auto self = weak.lock();
-      if (error || !self || self->ended_) return;
-      self->sendEvent(": keep-alive\n\n");
-      self->heartbeat();
-    });
-  }
-
-  void sendEvent(std::string text) {
-    if (ended_) return;
-    // A client that does not read falls behind: it is dropped, not waited for.
-    if (queue_.size() > 1000) return endEvents();
-    queue_.push_back(std::move(text));
-    if (queue_.size() == 1) writeNext();
-  }
-
-  void writeNext() {
-    if (queue_.empty() || ended_) return;
-    asio::async_write(stream_.socket(), asio::buffer(queue_.front()),
-                      [self = this->shared_from_this()](beast::error_code error, size_t) {
-                        if (error) return self->endEvents();
-                        self->queue_.pop_front();
-                        self->writeNext();
-                      });
-  }
-
-  void endEvents() {
-    if (ended_) return;
-    ended_ = true;
-    if (subscribed_) server_->service.unsubscribe(subscription_);
-    if (timer_) timer_->cancel();
-    close();
+    auto self = this->shared_from_this();
+    std::make_shared<EventStream<typename Protocol::socket>>(stream_.socket(), server_->service, onlyJob, self,
+                                                             [session = self.get()] { session->close(); })
+        ->start();
   }
 
   Stream stream_;
@@ -772,12 +561,6 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
   std::vector<char> piece_;
   std::array<char, 4096> drain_{};
   size_t drained_ = 0;
-  // The event stream's.
-  std::optional<int64_t> onlyJob_;
-  std::deque<std::string> queue_;
-  size_t subscription_ = 0;
-  bool subscribed_ = false, ended_ = false;
-  std::unique_ptr<asio::steady_timer> timer_;
 };
 
 template <typename Acceptor, typename Protocol>
