@@ -42,16 +42,6 @@ nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified
 // "footprint" (its corners on the ground)}; inches.
 nlohmann::ordered_json stabilityJson(const geometry::Stability& stability);
 
-// The panels as parts for the planner: outline, fastener holes (circles),
-// labels to etch, folds to score. The parts' order runs over the panels in
-// assembly order, each panel's pieces (geometry::PanelPiece) right after it
-// as parts of their own.
-std::vector<Part> structureParts(const geometry::Structure& structure);
-
-// For each of structureParts()'s parts, in its order: its panel (index) and
-// its piece (index, -1 for the panel itself).
-std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure);
-
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
 // the panels already placed that it joins and the edge numbers to fasten
 // with the fasteners of each; totals at the end. Throws

@@ -10,28 +10,28 @@
 namespace rotafab::jobs {
 namespace {
 
-constexpr double kScale = 1e5;  // 1/100000 in
+constexpr double kClipperUnits = 1e5;  // 1/100000 in
 
 }  // namespace
 
 Polygon2 offsetPolygon(const Polygon2& polygon, double distance) {
   ClipperLib::Path path;
   for (const Point2& p : polygon) {
-    path.push_back({static_cast<ClipperLib::cInt>(std::llround(p.x() * kScale)),
-                    static_cast<ClipperLib::cInt>(std::llround(p.y() * kScale))});
+    path.push_back({static_cast<ClipperLib::cInt>(std::llround(p.x() * kClipperUnits)),
+                    static_cast<ClipperLib::cInt>(std::llround(p.y() * kClipperUnits))});
   }
   if (ClipperLib::Area(path) < 0) std::reverse(path.begin(), path.end());
   // Round joins traced to within 1/10000 in.
-  ClipperLib::ClipperOffset offset(2.0, 1e-4 * kScale);
+  ClipperLib::ClipperOffset offset(2.0, 1e-4 * kClipperUnits);
   offset.AddPath(path, ClipperLib::jtRound, ClipperLib::etClosedPolygon);
   ClipperLib::Paths out;
-  offset.Execute(out, distance * kScale);
+  offset.Execute(out, distance * kClipperUnits);
   if (out.empty()) throw std::invalid_argument(fmt::format("an offset of {} in leaves nothing", distance));
   const auto& largest = *std::max_element(out.begin(), out.end(), [](const auto& a, const auto& b) {
     return std::abs(ClipperLib::Area(a)) < std::abs(ClipperLib::Area(b));
   });
   Polygon2 result;
-  for (const auto& p : largest) result.emplace_back(p.X / kScale, p.Y / kScale);
+  for (const auto& p : largest) result.emplace_back(p.X / kClipperUnits, p.Y / kClipperUnits);
   if (polygonArea(result) < 0) std::reverse(result.begin(), result.end());
   return result;
 }

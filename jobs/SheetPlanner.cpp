@@ -200,4 +200,46 @@ std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const S
   return files;
 }
 
+std::vector<Part> structureParts(const geometry::Structure& structure) {
+  std::vector<Part> parts;
+  const auto add = [&](const std::string& name, int order, const Polygon2& outline,
+                       const std::vector<geometry::PanelHole>& holes, const std::vector<geometry::PanelLabel>& labels,
+                       const std::vector<Polyline2>& scores) {
+    Part part;
+    part.name = name;
+    part.order = order;
+    part.outline = outline;
+    for (const geometry::PanelHole& hole : holes) part.circles.push_back({hole.xy, hole.diameter / 2});
+    for (const geometry::PanelLabel& label : labels) {
+      part.etch.insert(part.etch.end(), label.strokes.begin(), label.strokes.end());
+    }
+    part.score = scores;
+    parts.push_back(std::move(part));
+  };
+  // One running order: a panel, then its pieces, then the next panel (so
+  // that pieces do not push later panels out of the planner's window).
+  for (const auto& [i, k] : partOwners(structure)) {
+    const geometry::Panel& panel = structure.panels[i];
+    if (k < 0) {
+      add(fmt::format("panel {}", panel.id), static_cast<int>(parts.size()), panel.outline, panel.holes, panel.labels,
+          panel.scores);
+    } else {
+      const geometry::PanelPiece& piece = panel.pieces[k];
+      add("piece " + piece.name, static_cast<int>(parts.size()), piece.outline, piece.holes, piece.labels, {});
+    }
+  }
+  return parts;
+}
+
+std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure) {
+  std::vector<std::pair<int, int>> owners;
+  for (size_t i = 0; i < structure.panels.size(); ++i) {
+    owners.emplace_back(static_cast<int>(i), -1);
+    for (size_t k = 0; k < structure.panels[i].pieces.size(); ++k) {
+      owners.emplace_back(static_cast<int>(i), static_cast<int>(k));
+    }
+  }
+  return owners;
+}
+
 }  // namespace rotafab::jobs

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/WorkContext.h"
+#include "geometry/Structure.h"
 #include "jobs/Nesting.h"
 #include "jobs/Part.h"
 #include "profiles/Profiles.h"
@@ -91,5 +92,15 @@ std::string previewFile(int sheet);
 std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const SheetFormats& formats,
                                                   const std::filesystem::path& folder,
                                                   const core::WorkContext& context);
+
+// The panels as parts for the planner: outline, fastener holes (circles),
+// labels to etch, folds to score. The parts' order runs over the panels in
+// assembly order, each panel's pieces (geometry::PanelPiece) right after it
+// as parts of their own.
+std::vector<Part> structureParts(const geometry::Structure& structure);
+
+// For each of structureParts()'s parts, in its order: its panel (index) and
+// its piece (index, -1 for the panel itself).
+std::vector<std::pair<int, int>> partOwners(const geometry::Structure& structure);
 
 }  // namespace rotafab::jobs
