@@ -105,17 +105,27 @@ struct HttpServer::Impl : std::enable_shared_from_this<HttpServer::Impl> {
     virtual void close() = 0;
     // Whether it is a TCP connection that can give its place to a new one:
     // idle, and a stranger's (or closing); from `peer` if one is named.
-    [[nodiscard]] virtual bool idle(const asio::ip::address* /*peer*/, bool /*strangersOnly*/) const { return false; }
+    // `midHeader`: a stranger's that has sent part of a request's header counts too.
+    [[nodiscard]] virtual bool idle(const asio::ip::address* /*peer*/, bool /*strangersOnly*/,
+                                    bool /*midHeader*/) const {
+      return false;
+    }
     virtual void evict() {}
   };
   std::vector<std::weak_ptr<Connection>> open;
 
-  // Closes the oldest idle connection that `idle(peer, strangersOnly)` picks; whether there was one.
+  // Closes the oldest idle connection that `idle(peer, strangersOnly)`
+  // picks; failing that, the oldest stranger's that is still sending its
+  // request's header (a header sent a byte at a time must not hold a place
+  // a token holder's request needs: a real client sends its header at once,
+  // so the newest connection, the one that asks for room, is its); whether there was one.
   bool evictOldest(const asio::ip::address* peer, bool strangersOnly) {
-    for (const auto& weak : open) {
-      if (auto connection = weak.lock(); connection && connection->idle(peer, strangersOnly)) {
-        connection->evict();
-        return true;
+    for (const bool midHeader : {false, true}) {
+      for (const auto& weak : open) {
+        if (auto connection = weak.lock(); connection && connection->idle(peer, strangersOnly, midHeader)) {
+          connection->evict();
+          return true;
+        }
       }
     }
     return false;
@@ -210,10 +220,11 @@ class Session : public HttpServer::Impl::Connection, public std::enable_shared_f
 
   ~Session() override { uncount(); }
 
-  [[nodiscard]] bool idle(const asio::ip::address* peer, bool strangersOnly) const override {
+  [[nodiscard]] bool idle(const asio::ip::address* peer, bool strangersOnly, bool midHeader) const override {
     if constexpr (kTcp) {
       if (!counted_ || (peer && *peer != peer_) || (strangersOnly && known_)) return false;
       if (lingering_) return true;
+      if (midHeader) return waiting_ && !known_;
       // (A request already in the socket's buffer is not idle: it is read next.)
       beast::error_code error;
       return waiting_ && !known_ && buffer_.size() == 0 && stream_.socket().available(error) == 0 && !error;

@@ -164,12 +164,13 @@ TEST(Security, AnotherSitesPageCannotStartACutNorReadTheQueue) {
   daemon.client(fmt::format("cancel {}", id));
 }
 
-// Holds `count` idle TCP connections to `port` open, opening another
-// whenever the daemon closes one, until stopped; how many the daemon refused.
+// Holds `count` idle TCP connections to `port` open (each having sent
+// `opening`, such as part of a request's header), opening another whenever
+// the daemon closes one, until stopped.
 class Flood {
  public:
-  Flood(int port, size_t count) {
-    thread_ = std::thread([this, port, count] {
+  Flood(int port, size_t count, std::string opening = "") {
+    thread_ = std::thread([this, port, count, opening] {
       std::vector<int> open;
       while (!stop_) {
         while (open.size() < count && !stop_) {
@@ -177,6 +178,7 @@ class Flood {
           if (fd < 0) break;
           timeval quick{0, 1000};
           ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &quick, sizeof quick);
+          if (!opening.empty()) ::send(fd, opening.data(), opening.size(), MSG_NOSIGNAL);
           open.push_back(fd);
           ++opened_;
         }
@@ -219,12 +221,16 @@ TEST(Security, TheOwnerPausesAndCancelsOverTheSocketWhileTcpIsFlooded) {
   {
     Flood flood(port, 200);
     ASSERT_TRUE(eventually([&] { return flood.opened() >= 200; }, 10));
+    // And strangers who send a request's header a piece at a time, never finishing it.
+    Flood slowHeaders(port, 40, "GET /api/jobs HTTP/1.1\r\nHost: 127.0.0.1\r\n");
+    ASSERT_TRUE(eventually([&] { return slowHeaders.opened() >= 40; }, 10));
     // A slow body from a stranger on top: it holds nothing the owner needs.
     const int slow = connectTcp(port);
     const std::string slowStart = "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1000000\r\n\r\nab";
     ::send(slow, slowStart.data(), slowStart.size(), MSG_NOSIGNAL);
     // A token holder on the same address as the flood (every program on
-    // loopback is 127.0.0.1) is served over TCP too: idle strangers give way.
+    // loopback is 127.0.0.1) is served over TCP too: idle strangers give
+    // way, and those still sending their header.
     for (int i = 0; i < 20; ++i) {
       const HttpReply listed = overTcp(port, "GET", "/api/jobs", fmt::format("Authorization: Bearer {}\r\n", kToken));
       ASSERT_EQ(listed.status, 200) << listed.head << listed.body;
