@@ -131,31 +131,52 @@ double polygonArea3(const std::vector<Point3>& polygon) {
 
 namespace {
 
-Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
-  const ParameterNames& names = options.names;
-  if (!(options.fastener > 0)) {
-    throw ParameterError(Parameter::Fastener, names(Parameter::Fastener) + ": the hole diameter must be positive");
-  }
-  const RotationSystem rs = RotationSystem::fromMesh(mesh);
+// One build's shared state (V.1-V.3): the band decomposition of the mesh,
+// its developable bands, each face's panel unfolded, and the flood fill's
+// order; the edges numbered once the overlaps are mended.
+struct BandBuild {
+  BandBuild(const PolygonMesh& mesh, const BandOptions& options) : mesh(mesh), options(options) {}
+
+  const PolygonMesh& mesh;
+  const BandOptions& options;
+  RotationSystem rs;
+  BandDecomposition decomposition;
+  std::vector<EdgeBand> bands;
+  std::vector<FlatPanel> flat;
+  FloodFillOrder order;
+  std::vector<int> edgeNumber;  // per edge, in the order the flood fill meets them; 0 for a boundary edge
+
   // Faces as a user finds them in the file; a face capping a hole (--holes fill) has no number there.
-  const auto faceName = [&](int f) {
+  [[nodiscard]] std::string faceName(int f) const {
     return mesh.sourceFaceIndex(f) >= 0 ? fmt::format("face {}", mesh.sourceFaceIndex(f))
                                         : std::string("the face filling a hole");
-  };
+  }
+  // Edges as a user finds them in the file: by their two vertices.
+  [[nodiscard]] std::string edgeName(int e) const {
+    return fmt::format("the edge between vertices {} and {}", mesh.sourceVertexIndex(rs.origin(2 * e)),
+                       mesh.sourceVertexIndex(rs.target(2 * e)));
+  }
+};
+
+// The band decomposition (III, V.1), its bands made developable (V.2) and
+// each face's panel unfolded (V.3); the flood fill's order from the face
+// asked for, or the lowest (V.5).
+void unfoldPanels(BandBuild& b, const core::WorkContext& context) {
+  const PolygonMesh& mesh = b.mesh;
+  const BandOptions& options = b.options;
+  b.rs = RotationSystem::fromMesh(mesh);
   context.report({"geometry", "band decomposition", 0, static_cast<size_t>(mesh.faceCount())});
-  const BandDecomposition decomposition = bandDecomposition(mesh, rs, options.tension);
+  b.decomposition = bandDecomposition(mesh, b.rs, options.tension);
   context.check();
-  const std::vector<EdgeBand> bands = developableBands(rs, decomposition, options.samples);
-  std::vector<FlatPanel> flat;
+  b.bands = developableBands(b.rs, b.decomposition, options.samples);
   for (int f = 0; f < mesh.faceCount(); ++f) {
     context.check();
     try {
-      flat.push_back(unfoldPanel(rs, decomposition, bands, f));
+      b.flat.push_back(unfoldPanel(b.rs, b.decomposition, b.bands, f));
     } catch (const std::invalid_argument& error) {
-      throw std::invalid_argument(fmt::format("{}: {}", faceName(f), error.what()));
+      throw std::invalid_argument(fmt::format("{}: {}", b.faceName(f), error.what()));
     }
   }
-
   int start = -1;
   if (options.start) {
     for (int f = 0; f < mesh.faceCount() && start < 0; ++f) {
@@ -164,179 +185,197 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
     if (start < 0) {
       throw ParameterError(Parameter::Start,
                            fmt::format("{} {}: the mesh has no such face (faces are numbered from 0 as in the file)",
-                                       names(Parameter::Start), *options.start));
+                                       options.names(Parameter::Start), *options.start));
     }
   } else {
     start = lowestFace(mesh, options.up);
   }
-  const FloodFillOrder order = floodFill(mesh, rs, start, options.up);
+  b.order = floodFill(mesh, b.rs, start, options.up);
+}
 
-  // Edges as a user finds them in the file: by their two vertices.
-  const auto edgeName = [&](int e) {
-    return fmt::format("the edge between vertices {} and {}", mesh.sourceVertexIndex(rs.origin(2 * e)),
-                       mesh.sourceVertexIndex(rs.target(2 * e)));
-  };
-  // A panel that would overlap itself (V.4) is split: one band at a time,
-  // the later of two that overlap, is cut off with a tab (or, where no tab
-  // has room, across its middle), until none do.
-  // A piece crossing itself cannot be mended so.
-  int split = 0, halved = 0, gluedTabs = 0;
+// A panel that would overlap itself (V.4) is split: one band at a time,
+// the later of two that overlap, is cut off with a tab (or, where no tab
+// has room, across its middle), until none do. A piece crossing itself
+// cannot be mended so; the last remedy is the face itself in two
+// (FacesToSplit, after this pass), where it has corners enough.
+class OverlapMending {
+ public:
+  explicit OverlapMending(BandBuild& b) : b_(b) {}
+
+  void mendFace(int f);
+
+  int split = 0, halved = 0, gluedTabs = 0;  // bands cut off with a tab, cut across, tabs glued
   FacesToSplit toSplit;
-  for (int f = 0; f < mesh.faceCount(); ++f) {
-    context.check();
-    for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
-      const auto [i, j] = overlaps.front();
-      const auto where = [&] { return fmt::format("panel {} ({})", order.panelOfFace[f] + 1, faceName(f)); };
-      // The last remedy, the face itself in two (after this pass), where it has corners enough.
-      const auto splitLater = [&](const std::string& why) {
-        if (mesh.faces[f].size() < 4) return false;
-        if (toSplit.faces.empty()) toSplit.firstError = why;
-        toSplit.faces.push_back(f);
-        return true;
-      };
-      if (j < 0) {
-        const std::string what =
-            fmt::format("{}: its vertex band crosses itself when laid flat (the face is far from planar)", where());
-        if (splitLater(what)) break;
-        throw std::invalid_argument(what + "; split the face in the mesh");
+
+ private:
+  bool cutOff(int f, int index, bool glued, std::string& why, double& mostRoom);
+  bool cutAcross(int f, int index);
+
+  BandBuild& b_;
+};
+
+void OverlapMending::mendFace(int f) {
+  std::vector<FlatPanel>& flat = b_.flat;
+  const BandOptions& options = b_.options;
+  for (auto overlaps = overlappingPieces(flat[f]); !overlaps.empty(); overlaps = overlappingPieces(flat[f])) {
+    const auto [i, j] = overlaps.front();
+    const auto where = [&] { return fmt::format("panel {} ({})", b_.order.panelOfFace[f] + 1, b_.faceName(f)); };
+    // The last remedy, the face itself in two (after this pass), where it has corners enough.
+    const auto splitLater = [&](const std::string& why) {
+      if (b_.mesh.faces[f].size() < 4) return false;
+      if (toSplit.faces.empty()) toSplit.firstError = why;
+      toSplit.faces.push_back(f);
+      return true;
+    };
+    if (j < 0) {
+      const std::string what =
+          fmt::format("{}: its vertex band crosses itself when laid flat (the face is far from planar)", where());
+      if (splitLater(what)) break;
+      throw std::invalid_argument(what + "; split the face in the mesh");
+    }
+    if (i == j) {
+      throw std::invalid_argument(fmt::format("{}: the band of {} overlaps itself when laid flat", where(),
+                                              b_.edgeName(flat[f].bands[j].edge)));
+    }
+    std::string why;
+    double mostRoom = 0;  // of the tabs tried, the best share of the clearance needed
+    if (!cutOff(f, j, false, why, mostRoom) && (i < 0 || !cutOff(f, i, false, why, mostRoom))) {
+      const std::string what =
+          fmt::format("{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}", where(),
+                      b_.edgeName(flat[f].bands[j].edge), why.empty() ? "it is cut across already" : why);
+      // The tab's room grows with the mesh, but only until the tab is as
+      // deep as it may be, and other tabs may be in the way: an estimate.
+      if (mostRoom > 0 && !options.glueBandsWithoutRoom) {
+        NoRoomForHoleError error(what, 1, 1.02 / mostRoom, options.fastener, options.names);
+        error.estimate = true;
+        throw error;
       }
-      if (i == j) {
-        throw std::invalid_argument(
-            fmt::format("{}: the band of {} overlaps itself when laid flat", where(), edgeName(flat[f].bands[j].edge)));
+      // A tab glued where it has no room for its hole and bands may be glued.
+      if (options.glueBandsWithoutRoom &&
+          (cutOff(f, j, true, why, mostRoom) || (i >= 0 && cutOff(f, i, true, why, mostRoom)))) {
+        ++split;
+        continue;
       }
-      // The later band of the two, or else the earlier one: the first whose
-      // tab has room for its hole, at least kLeastClearance diameters from
-      // the piece's and the panel's outlines and clear of the panel's other
-      // tabs' holes; at the point of most clearance.
-      std::string why;
-      double mostRoom = 0;  // of the tabs tried, the best share of the clearance needed
-      // `glued`: a tab with no room for its hole is glued (BandOptions::glueBandsWithoutRoom).
-      const auto cutOff = [&](int index, bool glued = false) {
-        if (flat[f].bands[index].halved) return false;
-        FlatPanel trial = flat[f];
-        try {
-          detachBand(trial, index, 2 * kClearance * options.fastener);
-        } catch (const std::invalid_argument& error) {
-          why = error.what();
-          return false;
-        }
-        FlatBand& cut = trial.bands[index];
-        // Tabs of one panel may lie on each other, but none over another's hole.
-        for (const FlatBand& other : trial.bands) {
-          if (&other != &cut && other.detached && !other.tabGlued && insidePolygon(cut.tabOutline, other.tab)) {
-            why = "its tab would cover the hole of another band's tab";
-            return false;
-          }
-        }
-        const auto room = [&](const Point2& p) {
-          if (!insidePolygon(cut.tabOutline, p) || !insidePolygon(trial.outline, p)) return -1.0;
-          double least = std::min(distanceToOutline(cut.pieceOutline, p), distanceToOutline(trial.outline, p));
-          for (const FlatBand& other : trial.bands) {
-            if (&other == &cut || !other.detached || other.tabGlued) continue;
-            least = std::min(least, (other.tab - p).norm() - options.fastener);
-            if (insidePolygon(other.tabOutline, p)) return -1.0;  // under another tab
-          }
-          return least / options.fastener;  // diameters
-        };
-        const auto [hole, clearance] = mostRoomIn(cut.tabOutline, room);
-        mostRoom = std::max(mostRoom, clearance / kLeastClearance);
-        if (clearance < kLeastClearance && glued) {
-          cut.tabGlued = true;
-          ++gluedTabs;
-          flat[f] = std::move(trial);
-          return true;
-        }
-        if (clearance < kLeastClearance) {
-          why = fmt::format("its tab has no room for a {:.3f} in fastener hole {:g} diameter{} from every outline",
-                            options.fastener, kLeastClearance, kLeastClearance == 1 ? "" : "s");
-          return false;
-        }
-        cut.tab = hole;
-        flat[f] = std::move(trial);
-        return true;
-      };
-      // Where no tab has room: the band cut across its middle, so that the
-      // other copy, whole, holds both halves (its holes are checked with
-      // the others', below). Not both copies of a band: the halves would
-      // then hold only each other's panel.
-      const auto cutAcross = [&](int index) {
-        const FlatBand& copy = flat[f].bands[index];
-        const EdgeBand& band = bands[copy.edge];
-        const FlatBand* other = bandCopy(flat[copy.fromA ? band.faceB : band.faceA], copy.edge);
-        if (copy.halved || (other && other->halved)) return false;
-        FlatPanel trial = flat[f];
-        try {
-          halveBand(trial, index);
-        } catch (const std::invalid_argument&) {
-          return false;
-        }
-        flat[f] = std::move(trial);
-        ++halved;
-        return true;
-      };
-      if (!cutOff(j) && (i < 0 || !cutOff(i))) {
-        const std::string what =
-            fmt::format("{} would overlap itself when unfolded, and the band of {} cannot be cut off: {}", where(),
-                        edgeName(flat[f].bands[j].edge), why.empty() ? "it is cut across already" : why);
-        // The tab's room grows with the mesh, but only until the tab is as
-        // deep as it may be, and other tabs may be in the way: an estimate.
-        if (mostRoom > 0 && !options.glueBandsWithoutRoom) {
-          NoRoomForHoleError error(what, 1, 1.02 / mostRoom, options.fastener, names);
-          error.estimate = true;
-          throw error;
-        }
-        // A tab glued where it has no room for its hole and bands may be glued.
-        if (options.glueBandsWithoutRoom && (cutOff(j, true) || (i >= 0 && cutOff(i, true)))) {
-          ++split;
-          continue;
-        }
-        // No tab at any size: the band across its middle; else the face itself in two.
-        if (cutAcross(j) || (i >= 0 && cutAcross(i))) continue;
-        if (splitLater(what + "; nor can it be cut across its middle")) break;
-        throw std::invalid_argument(fmt::format(
-            "{}; nor can it be cut across its middle; split that face in the mesh, or simplify the mesh ({} N)", what,
-            names(Parameter::Panels)));
-      }
-      ++split;
+      // No tab at any size: the band across its middle; else the face itself in two.
+      if (cutAcross(f, j) || (i >= 0 && cutAcross(f, i))) continue;
+      if (splitLater(what + "; nor can it be cut across its middle")) break;
+      throw std::invalid_argument(fmt::format(
+          "{}; nor can it be cut across its middle; split that face in the mesh, or simplify the mesh ({} N)", what,
+          options.names(Parameter::Panels)));
+    }
+    ++split;
+  }
+}
+
+// Band `index` of face f's panel cut off with a tab: the later band of the
+// two, or else the earlier one, the first whose tab has room for its hole,
+// at least kLeastClearance diameters from the piece's and the panel's
+// outlines and clear of the panel's other tabs' holes; at the point of most
+// clearance. `glued`: a tab with no room for its hole is glued
+// (BandOptions::glueBandsWithoutRoom). Says `why` not, and the best share
+// of the clearance a tab tried had (`mostRoom`).
+bool OverlapMending::cutOff(int f, int index, bool glued, std::string& why, double& mostRoom) {
+  const double fastener = b_.options.fastener;
+  if (b_.flat[f].bands[index].halved) return false;
+  FlatPanel trial = b_.flat[f];
+  try {
+    detachBand(trial, index, 2 * kClearance * fastener);
+  } catch (const std::invalid_argument& error) {
+    why = error.what();
+    return false;
+  }
+  FlatBand& cut = trial.bands[index];
+  // Tabs of one panel may lie on each other, but none over another's hole.
+  for (const FlatBand& other : trial.bands) {
+    if (&other != &cut && other.detached && !other.tabGlued && insidePolygon(cut.tabOutline, other.tab)) {
+      why = "its tab would cover the hole of another band's tab";
+      return false;
     }
   }
-  if (!toSplit.faces.empty()) throw toSplit;
-  // (done: the bands cut off with a tab; total: those and the bands cut across)
-  if (split + halved > 0) {
-    context.report({"geometry", "panels split", static_cast<size_t>(split), static_cast<size_t>(split + halved)});
+  const auto room = [&](const Point2& p) {
+    if (!insidePolygon(cut.tabOutline, p) || !insidePolygon(trial.outline, p)) return -1.0;
+    double least = std::min(distanceToOutline(cut.pieceOutline, p), distanceToOutline(trial.outline, p));
+    for (const FlatBand& other : trial.bands) {
+      if (&other == &cut || !other.detached || other.tabGlued) continue;
+      least = std::min(least, (other.tab - p).norm() - fastener);
+      if (insidePolygon(other.tabOutline, p)) return -1.0;  // under another tab
+    }
+    return least / fastener;  // diameters
+  };
+  const auto [hole, clearance] = mostRoomIn(cut.tabOutline, room);
+  mostRoom = std::max(mostRoom, clearance / kLeastClearance);
+  if (clearance < kLeastClearance && glued) {
+    cut.tabGlued = true;
+    ++gluedTabs;
+    b_.flat[f] = std::move(trial);
+    return true;
   }
+  if (clearance < kLeastClearance) {
+    why = fmt::format("its tab has no room for a {:.3f} in fastener hole {:g} diameter{} from every outline", fastener,
+                      kLeastClearance, kLeastClearance == 1 ? "" : "s");
+    return false;
+  }
+  cut.tab = hole;
+  b_.flat[f] = std::move(trial);
+  return true;
+}
 
-  // Edge numbers in the order the flood fill meets the edges, so that the
-  // numbers a builder looks for next are close to the ones in hand.
-  Structure result;
-  result.kind = StructureKind::Band;
-  std::vector<int> edgeNumber(rs.edgeCount(), 0);
-  for (int face : order.faceOfPanel) {
-    Dart d = rs.faceDart(face);
-    for (size_t side = 0; side < mesh.faces[face].size(); ++side, d = rs.faceNext(d)) {
+// Where no tab has room: the band cut across its middle, so that the
+// other copy, whole, holds both halves (its holes are checked with the
+// others'). Not both copies of a band: the halves would then hold only
+// each other's panel.
+bool OverlapMending::cutAcross(int f, int index) {
+  const FlatBand& copy = b_.flat[f].bands[index];
+  const EdgeBand& band = b_.bands[copy.edge];
+  const FlatBand* other = bandCopy(b_.flat[copy.fromA ? band.faceB : band.faceA], copy.edge);
+  if (copy.halved || (other && other->halved)) return false;
+  FlatPanel trial = b_.flat[f];
+  try {
+    halveBand(trial, index);
+  } catch (const std::invalid_argument&) {
+    return false;
+  }
+  b_.flat[f] = std::move(trial);
+  ++halved;
+  return true;
+}
+
+// Edge numbers in the order the flood fill meets the edges, so that the
+// numbers a builder looks for next are close to the ones in hand; how many.
+int numberEdges(BandBuild& b) {
+  int edges = 0;
+  b.edgeNumber.assign(b.rs.edgeCount(), 0);
+  for (int face : b.order.faceOfPanel) {
+    Dart d = b.rs.faceDart(face);
+    for (size_t side = 0; side < b.mesh.faces[face].size(); ++side, d = b.rs.faceNext(d)) {
       const int e = RotationSystem::edgeOf(d);
-      if (!rs.isBoundaryEdge(e) && edgeNumber[e] == 0) edgeNumber[e] = ++result.edges;
+      if (!b.rs.isBoundaryEdge(e) && b.edgeNumber[e] == 0) b.edgeNumber[e] = ++edges;
     }
   }
+  return edges;
+}
 
-  context.report({"geometry", "fastener holes", 0, static_cast<size_t>(result.edges)});
-  const std::vector<BandHoles> holes =
-      placeFastenerHoles(bands, flat, options.fastener, context, edgeName, names, options.glueBandsWithoutRoom);
+// The fasteners, the bands glued and what the holes leave to say: tabs
+// glued, bands glued, bands with one narrow hole.
+void countFasteners(const BandBuild& b, const std::vector<BandHoles>& holes, const OverlapMending& mended,
+                    Structure& result) {
+  const double fastener = b.options.fastener;
+  const ParameterNames& names = b.options.names;
   int narrow = 0, narrowest = -1;
-  result.fasteners = split - gluedTabs;  // the tabs'
+  result.fasteners = mended.split - mended.gluedTabs;  // the tabs'
   for (const BandHoles& h : holes) {
     result.fasteners += static_cast<int>(h.holes.size());
-    if (h.glued) result.glued.push_back(edgeNumber[h.edge]);
+    if (h.glued) result.glued.push_back(b.edgeNumber[h.edge]);
     if (h.edge < 0 || h.glued || h.clearance >= kClearance) continue;
     ++narrow;
     if (narrowest < 0 || h.clearance < holes[narrowest].clearance) narrowest = h.edge;
   }
-  if (gluedTabs > 0) {
+  if (const int gluedTabs = mended.gluedTabs; gluedTabs > 0) {
     result.warnings.push_back(fmt::format(
         "{} band{} cut off {} panel{} that would overlap {}: no room for {} tab's {:.3f} in fastener hole, so {} "
         "tab{} {} glued",
         gluedTabs, gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "a" : "the", gluedTabs == 1 ? "" : "s",
-        gluedTabs == 1 ? "itself" : "themselves", gluedTabs == 1 ? "its" : "their", options.fastener,
+        gluedTabs == 1 ? "itself" : "themselves", gluedTabs == 1 ? "its" : "their", fastener,
         gluedTabs == 1 ? "its" : "their", gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "is" : "are"));
   }
   if (!result.glued.empty()) {
@@ -349,185 +388,256 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
     result.warnings.push_back(fmt::format(
         "{} band{} no room for a {:.3f} in fastener hole {:g} diameter from every outline, so no hole: glue {} "
         "(edge{} {}{})",
-        n, n == 1 ? " has" : "s have", options.fastener, kLeastClearance, n == 1 ? "it" : "them", n == 1 ? "" : "s",
-        some, n > 5 ? ", ..." : ""));
+        n, n == 1 ? " has" : "s have", fastener, kLeastClearance, n == 1 ? "it" : "them", n == 1 ? "" : "s", some,
+        n > 5 ? ", ..." : ""));
   }
   if (narrow > 0) {
     result.warnings.push_back(fmt::format(
         "{} band{} too narrow for a {:.3f} in hole {} diameters from its outlines: one hole each, down to {:.2f} "
         "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
-        narrow, narrow == 1 ? " is" : "s are", options.fastener, kClearance, holes[narrowest].clearance,
-        edgeNumber[narrowest], names(Parameter::Size), names(Parameter::Fastener)));
+        narrow, narrow == 1 ? " is" : "s are", fastener, kClearance, holes[narrowest].clearance,
+        b.edgeNumber[narrowest], names(Parameter::Size), names(Parameter::Fastener)));
   }
+}
+
+// A panel's holes drawn as circles, for the labels to keep clear of: the
+// panel's own, and each piece's.
+struct PanelCircles {
+  std::vector<Circle> panel;
+  std::vector<std::vector<Circle>> pieces;
+};
+
+// Panel `number` (from 0) of the flood fill's order: its outline, surface,
+// area, holes (a detached band's go on its piece; its tab's fastener on
+// both), its pieces and its joins (V.5).
+Panel panelWithBands(const BandBuild& b, const std::vector<BandHoles>& holes, int number, PanelCircles& circles) {
+  const double fastener = b.options.fastener;
+  const int f = b.order.faceOfPanel[number];
+  const FlatPanel& fp = b.flat[f];
+  Panel panel;
+  panel.id = number + 1;
+  panel.source.face = b.mesh.sourceFaceIndex(f);
+  panel.source.cap = panel.source.face < 0;
+  panel.outline = fp.outline;
+  const VertexBand& vb = b.decomposition.vertexBands[f];
+  panel.area = polygonArea3(vb.corners);
+  panel.surface.push_back(vb.corners);
+  for (const FlatBand& copy : fp.bands) {
+    const EdgeBand& band = b.bands[copy.edge];
+    const int edge = b.edgeNumber[copy.edge];
+    PanelPiece* piece = nullptr;
+    if (copy.detached || copy.halved) {
+      panel.pieces.push_back({fmt::format("{}{}", panel.id, static_cast<char>('a' + panel.pieces.size() % 26)),
+                              edge,
+                              copy.pieceOutline,
+                              {},
+                              {},
+                              0.0,
+                              copy.halved     ? PieceFastening::Band
+                              : copy.tabGlued ? PieceFastening::Glue
+                                              : PieceFastening::Tab});
+      piece = &panel.pieces.back();
+      circles.pieces.emplace_back();
+    }
+    for (const BandPoint& hole : holes[copy.edge].holes) {
+      const Point2 at = hole.onPanel(copy);
+      const bool onPiece = copy.onPiece(at);
+      (onPiece ? piece->holes : panel.holes).push_back({edge, at, fastener});
+      (onPiece ? circles.pieces.back() : circles.panel).push_back({at, fastener / 2});
+    }
+    if (copy.detached && !copy.tabGlued) {
+      piece->holes.push_back({0, copy.tab, fastener});
+      circles.pieces.back().push_back({copy.tab, fastener / 2});
+      panel.holes.push_back({0, copy.tab, fastener});
+      circles.panel.push_back({copy.tab, fastener / 2});
+    }
+    double bandArea = 0;
+    for (const auto& t : band.triangles()) {
+      panel.surface.push_back({band.point(t[0]), band.point(t[1]), band.point(t[2])});
+      bandArea += polygonArea3(panel.surface.back());
+    }
+    // Laid flat without stretching: the far half's area is its outline's.
+    const double pieceArea = copy.halved ? signedArea(copy.pieceOutline) : copy.detached ? bandArea : 0.0;
+    if (piece) piece->area += pieceArea;
+    panel.area += bandArea - pieceArea;
+    panel.joins.push_back({b.order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1, edge});
+  }
+  return panel;
+}
+
+// A detached band's piece named on its tab, along the side it is fastened to.
+void namePieceOnItsTab(const FlatBand& copy, PanelPiece& piece, const HersheyFont& font,
+                       const std::vector<Circle>& circles, const std::vector<TextBox>& taken,
+                       std::vector<std::string>& unfitted) {
+  std::vector<Point2> onTab;
+  const auto& t = copy.tabOutline;
+  Point2 middle = Point2::Zero();
+  for (const Point2& p : t) middle += p;
+  middle /= static_cast<double>(t.size());
+  for (double u = 0.2; u <= 0.801; u += 0.15) {
+    for (double v = 0.2; v <= 0.801; v += 0.3) onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * middle);
+  }
+  const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
+  if (const auto box = fitText(font, piece.name, std::atan2(side.y(), side.x()), copy.tabOutline, copy.pieceOutline,
+                               circles, taken, onTab)) {
+    piece.labels.push_back(
+        {piece.name, 0, LabelRole::Piece, *box, font.strokes(piece.name, box->origin, box->height, box->angle)});
+  } else {
+    unfitted.push_back(fmt::format("piece {}", piece.name));
+  }
+}
+
+// A band cut across: the far half's name on it, reading out along the
+// band (`near` to `far`), nearest its middle.
+void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half, const HersheyFont& font,
+                 const std::vector<Circle>& circles, std::vector<std::string>& unfitted) {
+  const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
+  std::vector<Point2> onHalf;
+  for (double u = 0.65; u <= 0.951; u += 0.05) {
+    for (double t = 0.3; t <= 0.701; t += 0.1) onHalf.push_back(copy.at(near + (far - near) * u, t));
+  }
+  const Point2 middle = copy.at(near + (far - near) * 0.75, 0.5);
+  std::stable_sort(onHalf.begin(), onHalf.end(), [&](const Point2& a, const Point2& b) {
+    return (a - middle).squaredNorm() < (b - middle).squaredNorm();
+  });
+  std::vector<TextBox> halfTaken;
+  if (const auto box = fitText(font, half.name, std::atan2(out.y(), out.x()), copy.pieceOutline, copy.pieceOutline,
+                               circles, halfTaken, onHalf)) {
+    half.labels.push_back(
+        {half.name, 0, LabelRole::Piece, *box, font.strokes(half.name, box->origin, box->height, box->angle)});
+  } else {
+    unfitted.push_back(fmt::format("piece {}", half.name));
+  }
+}
+
+// Each band's edge number near its holes, reading out from the vertex band
+// (on a piece: and the piece's name on its tab; on a band cut across, the
+// far half's name on it). Returns the boxes taken on the panel.
+std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>& holes, const FlatPanel& fp,
+                                const HersheyFont& font, const PanelCircles& circles, Panel& panel,
+                                std::vector<std::string>& unfitted) {
+  std::vector<TextBox> taken;
+  size_t pieceIndex = 0;
+  for (const FlatBand& copy : fp.bands) {
+    // The edge number goes where the band's near end is: on the piece of
+    // a band cut off, on the panel of a band cut across.
+    PanelPiece* cut = copy.detached || copy.halved ? &panel.pieces[pieceIndex] : nullptr;
+    const std::vector<Circle>* cutCircles = cut ? &circles.pieces[pieceIndex] : nullptr;
+    if (cut) ++pieceIndex;
+    PanelPiece* piece = copy.detached ? cut : nullptr;
+    const std::vector<Circle>& circlesHere = piece ? *cutCircles : circles.panel;
+    std::vector<TextBox> pieceTaken;
+    std::vector<TextBox>& takenHere = piece ? pieceTaken : taken;
+    auto& labelsHere = piece ? piece->labels : panel.labels;
+    const auto& outlineHere = piece ? copy.pieceOutline : fp.outline;
+    const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
+    const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
+    Point2 holesAt = Point2::Zero();
+    for (const BandPoint& hole : holes[copy.edge].holes) holesAt += hole.onPanel(copy);
+    holesAt /= std::max<double>(1, static_cast<double>(holes[copy.edge].holes.size()));
+    std::vector<Point2> candidates;
+    for (double s = 0.1; s <= 0.901; s += 0.1) {
+      for (double t = 0.2; t <= 0.801; t += 0.1) candidates.push_back(copy.at(s, t));
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
+      return (a - holesAt).squaredNorm() < (b - holesAt).squaredNorm();
+    });
+    const int edge = b.edgeNumber[copy.edge];
+    const std::string label = std::to_string(edge);
+    if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, outlineHere,
+                                 circlesHere, takenHere, candidates)) {
+      takenHere.push_back(*box);
+      labelsHere.push_back({labelText(label), edge, LabelRole::Edge, *box,
+                            labelStrokes(font, label, box->origin, box->height, box->angle)});
+    } else {
+      unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
+    }
+    if (piece) {
+      namePieceOnItsTab(copy, *piece, font, circlesHere, takenHere, unfitted);
+    } else if (cut) {
+      nameFarHalf(copy, near, far, *cut, font, *cutCircles, unfitted);
+    }
+  }
+  return taken;
+}
+
+// The panel number on the vertex band, as near its centre as it fits.
+void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::vector<Circle>& circles,
+                      const std::vector<TextBox>& taken, Panel& panel, std::vector<std::string>& unfitted) {
+  Point2 centre = Point2::Zero();
+  for (const Point2& p : fp.vertexBand) centre += p;
+  centre /= static_cast<double>(fp.vertexBand.size());
+  double reach = 0;
+  for (const Point2& p : fp.vertexBand) reach = std::max(reach, (p - centre).norm());
+  std::vector<Point2> candidates;
+  for (int i = -5; i <= 5; ++i) {
+    for (int j = -5; j <= 5; ++j) candidates.push_back(centre + Point2(i, j) * (reach / 5));
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
+    return (a - centre).squaredNorm() < (b - centre).squaredNorm();
+  });
+  const std::string label = std::to_string(panel.id);
+  if (const auto box = fitText(font, labelText(label), 0.0, fp.vertexBand, fp.outline, circles, taken, candidates)) {
+    panel.labels.push_back(
+        {labelText(label), 0, LabelRole::Panel, *box, labelStrokes(font, label, box->origin, box->height, box->angle)});
+  } else {
+    unfitted.push_back(fmt::format("panel number {}", panel.id));
+  }
+}
+
+// Panel `number` (from 0) whole: its bands, labels and folds to score.
+Panel bandPanel(const BandBuild& b, const std::vector<BandHoles>& holes, const HersheyFont& font, int number,
+                std::vector<std::string>& unfitted) {
+  const FlatPanel& fp = b.flat[b.order.faceOfPanel[number]];
+  PanelCircles circles;
+  Panel panel = panelWithBands(b, holes, number, circles);
+  const std::vector<TextBox> taken = labelBands(b, holes, fp, font, circles, panel, unfitted);
+  labelPanelNumber(fp, font, circles.panel, taken, panel, unfitted);
+  if (b.options.scoreFolds) {
+    for (size_t side = 0; side < fp.bandOfSide.size(); ++side) {
+      if (fp.bandOfSide[side] < 0) continue;
+      panel.scores.push_back({fp.vertexBand[side], fp.vertexBand[(side + 1) % fp.vertexBand.size()]});
+    }
+  }
+  return panel;
+}
+
+Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
+  if (!(options.fastener > 0)) {
+    throw ParameterError(Parameter::Fastener,
+                         options.names(Parameter::Fastener) + ": the hole diameter must be positive");
+  }
+  BandBuild b(mesh, options);
+  unfoldPanels(b, context);
+  OverlapMending mended(b);
+  for (int f = 0; f < mesh.faceCount(); ++f) {
+    context.check();
+    mended.mendFace(f);
+  }
+  if (!mended.toSplit.faces.empty()) throw mended.toSplit;
+  // (done: the bands cut off with a tab; total: those and the bands cut across)
+  if (mended.split + mended.halved > 0) {
+    context.report({"geometry", "panels split", static_cast<size_t>(mended.split),
+                    static_cast<size_t>(mended.split + mended.halved)});
+  }
+  Structure result;
+  result.kind = StructureKind::Band;
+  result.edges = numberEdges(b);
+
+  context.report({"geometry", "fastener holes", 0, static_cast<size_t>(result.edges)});
+  const std::vector<BandHoles> holes = placeFastenerHoles(
+      b.bands, b.flat, options.fastener, context, [&](int e) { return b.edgeName(e); }, options.names,
+      options.glueBandsWithoutRoom);
+  countFasteners(b, holes, mended, result);
 
   context.report({"geometry", "labels", 0, static_cast<size_t>(mesh.faceCount())});
   const HersheyFont& font = HersheyFont::simplex();
   // Each panel on its own, so the panels are shared out among the cores.
   result.panels.resize(mesh.faceCount());
   std::vector<std::vector<std::string>> unfittedOf(mesh.faceCount());  // labels too large even at the smallest height
-  const auto makePanel = [&](int number) {
-    std::vector<std::string>& unfitted = unfittedOf[number];
-    const int f = order.faceOfPanel[number];
-    const FlatPanel& fp = flat[f];
-    Panel panel;
-    panel.id = number + 1;
-    panel.source.face = mesh.sourceFaceIndex(f);
-    panel.source.cap = panel.source.face < 0;
-    panel.outline = fp.outline;
-    const VertexBand& vb = decomposition.vertexBands[f];
-    panel.area = polygonArea3(vb.corners);
-    panel.surface.push_back(vb.corners);
-    // The panel's holes (a detached band's go on its piece; its tab's
-    // fastener on both), and the pieces themselves.
-    std::vector<Circle> circles;
-    std::vector<std::vector<Circle>> pieceCircles;
-    for (const FlatBand& copy : fp.bands) {
-      const EdgeBand& band = bands[copy.edge];
-      PanelPiece* piece = nullptr;
-      if (copy.detached || copy.halved) {
-        panel.pieces.push_back({fmt::format("{}{}", panel.id, static_cast<char>('a' + panel.pieces.size() % 26)),
-                                edgeNumber[copy.edge],
-                                copy.pieceOutline,
-                                {},
-                                {},
-                                0.0,
-                                copy.halved     ? PieceFastening::Band
-                                : copy.tabGlued ? PieceFastening::Glue
-                                                : PieceFastening::Tab});
-        piece = &panel.pieces.back();
-        pieceCircles.emplace_back();
-      }
-      for (const BandPoint& hole : holes[copy.edge].holes) {
-        const Point2 at = hole.onPanel(copy);
-        const bool onPiece = copy.onPiece(at);
-        (onPiece ? piece->holes : panel.holes).push_back({edgeNumber[copy.edge], at, options.fastener});
-        (onPiece ? pieceCircles.back() : circles).push_back({at, options.fastener / 2});
-      }
-      if (copy.detached && !copy.tabGlued) {
-        piece->holes.push_back({0, copy.tab, options.fastener});
-        pieceCircles.back().push_back({copy.tab, options.fastener / 2});
-        panel.holes.push_back({0, copy.tab, options.fastener});
-        circles.push_back({copy.tab, options.fastener / 2});
-      }
-      double bandArea = 0;
-      for (const auto& t : band.triangles()) {
-        panel.surface.push_back({band.point(t[0]), band.point(t[1]), band.point(t[2])});
-        bandArea += polygonArea3(panel.surface.back());
-      }
-      // Laid flat without stretching: the far half's area is its outline's.
-      const double pieceArea = copy.halved ? signedArea(copy.pieceOutline) : copy.detached ? bandArea : 0.0;
-      if (piece) piece->area += pieceArea;
-      panel.area += bandArea - pieceArea;
-      panel.joins.push_back({order.panelOfFace[copy.fromA ? band.faceB : band.faceA] + 1, edgeNumber[copy.edge]});
-    }
-    // Labels: each band's edge number near its holes, reading out from the
-    // vertex band (on a piece: and the piece's name on its tab); then the
-    // panel number on the vertex band.
-    std::vector<TextBox> taken;
-    size_t pieceIndex = 0;
-    for (const FlatBand& copy : fp.bands) {
-      // The edge number goes where the band's near end is: on the piece of
-      // a band cut off, on the panel of a band cut across.
-      PanelPiece* cut = copy.detached || copy.halved ? &panel.pieces[pieceIndex] : nullptr;
-      const std::vector<Circle>* cutCircles = cut ? &pieceCircles[pieceIndex] : nullptr;
-      if (cut) ++pieceIndex;
-      PanelPiece* piece = copy.detached ? cut : nullptr;
-      const std::vector<Circle>& circlesHere = piece ? *cutCircles : circles;
-      std::vector<TextBox> pieceTaken;
-      std::vector<TextBox>& takenHere = piece ? pieceTaken : taken;
-      auto& labelsHere = piece ? piece->labels : panel.labels;
-      const auto& outlineHere = piece ? copy.pieceOutline : fp.outline;
-      const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
-      const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
-      Point2 holesAt = Point2::Zero();
-      for (const BandPoint& hole : holes[copy.edge].holes) holesAt += hole.onPanel(copy);
-      holesAt /= std::max<double>(1, static_cast<double>(holes[copy.edge].holes.size()));
-      std::vector<Point2> candidates;
-      for (double s = 0.1; s <= 0.901; s += 0.1) {
-        for (double t = 0.2; t <= 0.801; t += 0.1) candidates.push_back(copy.at(s, t));
-      }
-      std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
-        return (a - holesAt).squaredNorm() < (b - holesAt).squaredNorm();
-      });
-      const std::string label = std::to_string(edgeNumber[copy.edge]);
-      if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, outlineHere,
-                                   circlesHere, takenHere, candidates)) {
-        takenHere.push_back(*box);
-        labelsHere.push_back({labelText(label), edgeNumber[copy.edge], LabelRole::Edge, *box,
-                              labelStrokes(font, label, box->origin, box->height, box->angle)});
-      } else {
-        unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
-      }
-      if (piece) {
-        // The piece's name on its tab, along the side it is fastened to.
-        std::vector<Point2> onTab;
-        const auto& t = copy.tabOutline;
-        Point2 middle = Point2::Zero();
-        for (const Point2& p : t) middle += p;
-        middle /= static_cast<double>(t.size());
-        for (double u = 0.2; u <= 0.801; u += 0.15) {
-          for (double v = 0.2; v <= 0.801; v += 0.3)
-            onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * middle);
-        }
-        const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
-        if (const auto box = fitText(font, piece->name, std::atan2(side.y(), side.x()), copy.tabOutline,
-                                     copy.pieceOutline, circlesHere, takenHere, onTab)) {
-          piece->labels.push_back({piece->name, 0, LabelRole::Piece, *box,
-                                   font.strokes(piece->name, box->origin, box->height, box->angle)});
-        } else {
-          unfitted.push_back(fmt::format("piece {}", piece->name));
-        }
-      } else if (cut) {
-        // The far half's name on it, reading out along the band, nearest its middle.
-        std::vector<Point2> onHalf;
-        for (double u = 0.65; u <= 0.951; u += 0.05) {
-          for (double t = 0.3; t <= 0.701; t += 0.1) onHalf.push_back(copy.at(near + (far - near) * u, t));
-        }
-        const Point2 middle = copy.at(near + (far - near) * 0.75, 0.5);
-        std::stable_sort(onHalf.begin(), onHalf.end(), [&](const Point2& a, const Point2& b) {
-          return (a - middle).squaredNorm() < (b - middle).squaredNorm();
-        });
-        std::vector<TextBox> halfTaken;
-        if (const auto box = fitText(font, cut->name, std::atan2(out.y(), out.x()), copy.pieceOutline,
-                                     copy.pieceOutline, *cutCircles, halfTaken, onHalf)) {
-          cut->labels.push_back(
-              {cut->name, 0, LabelRole::Piece, *box, font.strokes(cut->name, box->origin, box->height, box->angle)});
-        } else {
-          unfitted.push_back(fmt::format("piece {}", cut->name));
-        }
-      }
-    }
-    {
-      Point2 centre = Point2::Zero();
-      for (const Point2& p : fp.vertexBand) centre += p;
-      centre /= static_cast<double>(fp.vertexBand.size());
-      double reach = 0;
-      for (const Point2& p : fp.vertexBand) reach = std::max(reach, (p - centre).norm());
-      std::vector<Point2> candidates;
-      for (int i = -5; i <= 5; ++i) {
-        for (int j = -5; j <= 5; ++j) candidates.push_back(centre + Point2(i, j) * (reach / 5));
-      }
-      std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
-        return (a - centre).squaredNorm() < (b - centre).squaredNorm();
-      });
-      const std::string label = std::to_string(panel.id);
-      if (const auto box =
-              fitText(font, labelText(label), 0.0, fp.vertexBand, fp.outline, circles, taken, candidates)) {
-        panel.labels.push_back({labelText(label), 0, LabelRole::Panel, *box,
-                                labelStrokes(font, label, box->origin, box->height, box->angle)});
-      } else {
-        unfitted.push_back(fmt::format("panel number {}", panel.id));
-      }
-    }
-    if (options.scoreFolds) {
-      for (size_t side = 0; side < fp.bandOfSide.size(); ++side) {
-        if (fp.bandOfSide[side] < 0) continue;
-        panel.scores.push_back({fp.vertexBand[side], fp.vertexBand[(side + 1) % fp.vertexBand.size()]});
-      }
-    }
-    result.panels[number] = std::move(panel);
-  };
-  context.parallelFor(mesh.faceCount(), [&](size_t number) { makePanel(static_cast<int>(number)); });
+  context.parallelFor(mesh.faceCount(), [&](size_t number) {
+    result.panels[number] = bandPanel(b, holes, font, static_cast<int>(number), unfittedOf[number]);
+  });
   std::vector<std::string> unfitted;
   for (auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
   if (!unfitted.empty()) {
