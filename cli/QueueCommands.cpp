@@ -357,245 +357,260 @@ int runDaemonManifest(long long job, const std::string& format, const std::strin
   });
 }
 
-void addQueueCommands(CLI::App& app, int& status) {
-  // submit
-  {
-    auto client = std::make_shared<ClientOptions>();
-    auto make = std::make_shared<MakeOptions>();
-    auto device = std::make_shared<std::string>();
-    auto priority = std::make_shared<int>(0);
-    auto follows = std::make_shared<bool>(false);
-    CLI::App* submit = app.add_subcommand(
-        "submit", "Queue a mesh (planned with `make` options) or a `make` output folder on the daemon");
-    addMakeOptions(*submit, *make);
-    submit->get_option("MESH")->description(
-        "A mesh file (uploaded), or a `make` output folder on the daemon's machine");
-    submit->get_option("--structure")->required(false);
-    submit->get_option("--out")->description("(not for submit: the daemon keeps the job's files)");
-    submit->get_option("--json")->description("Print the job as the daemon's JSON");
-    submit->add_option("--device", *device, "The device to cut on (default: any device whose machine profile fits)");
-    submit->add_option("--priority", *priority, "Higher is cut first (default 0)");
-    submit->add_flag("--follow", *follows, "Then follow the job until it is planned (or fails)");
-    addClientOptions(*submit, *client, false);
-    submit->footer(
-        "The job is planned once, against its device's machine profile; it is cut only after `rotafab start JOB`\n"
-        "(unless the device has auto_start), with a stop before each sheet after the first (`rotafab next JOB`).\n\n"
-        "Examples:\n"
-        "  rotafab submit examples/bunny.obj --structure band --follow\n"
-        "  rotafab submit examples/cube.obj --structure band --device laser1 --priority 5\n"
-        "  rotafab submit $PWD/cube-band/          # a folder `rotafab make` wrote, cut as it is");
-    submit->callback([submit, client, make, device, priority, follows, &status] {
-      std::error_code isFolder;
-      if (make->structure.empty() && !fs::is_directory(make->mesh, isFolder)) {
-        throw CLI::ValidationError("--structure is required to plan a mesh (band or weave)");
+namespace {
+
+// The body of `submit`: a planned folder goes by its path, a mesh is uploaded with its `make` options.
+int submitJob(const ClientOptions& client, const MakeOptions& make, const std::string& device, int priority,
+              bool follows) {
+  if (!make.out.empty())
+    throw UserError("--out: the daemon keeps a submitted job's files; `rotafab make` writes a folder");
+  const DaemonClient daemon = clientOf(client);
+  // (--json is submit's own here: how the job is printed.)
+  MakeOptions sent = make;
+  sent.given.erase("json");
+  const std::vector<std::string> words = jobs::optionWords(sent);
+  std::error_code error;
+  json job;
+  if (fs::is_directory(make.mesh, error)) {
+    if (!words.empty()) {
+      throw UserError(fmt::format("{}: a planned folder is cut as `make` made it; {} is an option for a mesh",
+                                  make.mesh, words.front()));
+    }
+    json body{{"path", fs::absolute(make.mesh).lexically_normal().string()}, {"priority", priority}};
+    if (!device.empty()) body["device"] = device;
+    job = daemon.post("/api/jobs", body);
+  } else {
+    std::ifstream in(make.mesh, std::ios::binary);
+    if (!in) throw UserError(fmt::format("{}: cannot read the file", make.mesh));
+    std::ostringstream bytes;
+    bytes << in.rdbuf();
+    std::vector<std::pair<std::string, std::string>> fields{{"options", jobs::optionsJson(sent).dump()},
+                                                            {"priority", std::to_string(priority)}};
+    if (!device.empty()) fields.emplace_back("device", device);
+    job = daemon.upload("/api/jobs", fs::path(make.mesh).filename().string(), bytes.str(), fields);
+  }
+  if (make.json) {
+    std::cout << job.dump() << '\n';
+  } else {
+    fmt::print("job {}: {} {}{}\n", job.value("id", 0), job.value("source", ""),
+               job.value("state", "") == "queued" ? "queued" : "submitted",
+               job["device"].is_string() ? " for " + job["device"].get<std::string>() : "");
+  }
+  // A planned folder is checked as it is submitted: its job is ready at once.
+  if (settled(job)) {
+    if (!make.json)
+      fmt::print("job {}: {}: {}\n", job.value("id", 0), job.value("state", ""), job.value("message", ""));
+    return kSuccess;
+  }
+  if (follows) return follow(daemon, job.value("id", 0LL));
+  if (!make.json) fmt::print("follow it with `rotafab status {} --follow`\n", job.value("id", 0));
+  return kSuccess;
+}
+
+void addSubmitCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto make = std::make_shared<MakeOptions>();
+  auto device = std::make_shared<std::string>();
+  auto priority = std::make_shared<int>(0);
+  auto follows = std::make_shared<bool>(false);
+  CLI::App* submit = app.add_subcommand(
+      "submit", "Queue a mesh (planned with `make` options) or a `make` output folder on the daemon");
+  addMakeOptions(*submit, *make);
+  submit->get_option("MESH")->description("A mesh file (uploaded), or a `make` output folder on the daemon's machine");
+  submit->get_option("--structure")->required(false);
+  submit->get_option("--out")->description("(not for submit: the daemon keeps the job's files)");
+  submit->get_option("--json")->description("Print the job as the daemon's JSON");
+  submit->add_option("--device", *device, "The device to cut on (default: any device whose machine profile fits)");
+  submit->add_option("--priority", *priority, "Higher is cut first (default 0)");
+  submit->add_flag("--follow", *follows, "Then follow the job until it is planned (or fails)");
+  addClientOptions(*submit, *client, false);
+  submit->footer(
+      "The job is planned once, against its device's machine profile; it is cut only after `rotafab start JOB`\n"
+      "(unless the device has auto_start), with a stop before each sheet after the first (`rotafab next JOB`).\n\n"
+      "Examples:\n"
+      "  rotafab submit examples/bunny.obj --structure band --follow\n"
+      "  rotafab submit examples/cube.obj --structure band --device laser1 --priority 5\n"
+      "  rotafab submit $PWD/cube-band/          # a folder `rotafab make` wrote, cut as it is");
+  submit->callback([submit, client, make, device, priority, follows, &status] {
+    std::error_code isFolder;
+    if (make->structure.empty() && !fs::is_directory(make->mesh, isFolder)) {
+      throw CLI::ValidationError("--structure is required to plan a mesh (band or weave)");
+    }
+    checkStructureOptions(*submit, *make);
+    status = talking([&]() -> int { return submitJob(*client, *make, *device, *priority, *follows); });
+  });
+}
+
+void addJobsCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  CLI::App* jobs = app.add_subcommand("jobs", "List the daemon's jobs in queue order");
+  addClientOptions(*jobs, *client);
+  jobs->callback([client, &status] {
+    status = talking([&]() -> int {
+      const json answer = clientOf(*client).get("/api/jobs");
+      if (client->json) {
+        std::cout << answer.dump(1) << '\n';
+      } else {
+        printJobs(answer["jobs"]);
       }
-      checkStructureOptions(*submit, *make);
-      status = talking([&]() -> int {
-        if (!make->out.empty())
-          throw UserError("--out: the daemon keeps a submitted job's files; `rotafab make` writes a folder");
-        const DaemonClient daemon = clientOf(*client);
-        // (--json is submit's own here: how the job is printed.)
-        MakeOptions sent = *make;
-        sent.given.erase("json");
-        const std::vector<std::string> words = jobs::optionWords(sent);
-        std::error_code error;
-        json job;
-        if (fs::is_directory(make->mesh, error)) {
-          if (!words.empty()) {
-            throw UserError(fmt::format("{}: a planned folder is cut as `make` made it; {} is an option for a mesh",
-                                        make->mesh, words.front()));
-          }
-          json body{{"path", fs::absolute(make->mesh).lexically_normal().string()}, {"priority", *priority}};
-          if (!device->empty()) body["device"] = *device;
-          job = daemon.post("/api/jobs", body);
-        } else {
-          std::ifstream in(make->mesh, std::ios::binary);
-          if (!in) throw UserError(fmt::format("{}: cannot read the file", make->mesh));
-          std::ostringstream bytes;
-          bytes << in.rdbuf();
-          std::vector<std::pair<std::string, std::string>> fields{{"options", jobs::optionsJson(sent).dump()},
-                                                                  {"priority", std::to_string(*priority)}};
-          if (!device->empty()) fields.emplace_back("device", *device);
-          job = daemon.upload("/api/jobs", fs::path(make->mesh).filename().string(), bytes.str(), fields);
-        }
-        if (make->json) {
-          std::cout << job.dump() << '\n';
-        } else {
-          fmt::print("job {}: {} {}{}\n", job.value("id", 0), job.value("source", ""),
-                     job.value("state", "") == "queued" ? "queued" : "submitted",
-                     job["device"].is_string() ? " for " + job["device"].get<std::string>() : "");
-        }
-        // A planned folder is checked as it is submitted: its job is ready at once.
-        if (settled(job)) {
-          if (!make->json)
-            fmt::print("job {}: {}: {}\n", job.value("id", 0), job.value("state", ""), job.value("message", ""));
-          return kSuccess;
-        }
-        if (*follows) return follow(daemon, job.value("id", 0LL));
-        if (!make->json) fmt::print("follow it with `rotafab status {} --follow`\n", job.value("id", 0));
-        return kSuccess;
-      });
+      return kSuccess;
     });
-  }
-  // jobs
-  {
-    auto client = std::make_shared<ClientOptions>();
-    CLI::App* jobs = app.add_subcommand("jobs", "List the daemon's jobs in queue order");
-    addClientOptions(*jobs, *client);
-    jobs->callback([client, &status] {
-      status = talking([&]() -> int {
-        const json answer = clientOf(*client).get("/api/jobs");
-        if (client->json) {
-          std::cout << answer.dump(1) << '\n';
-        } else {
-          printJobs(answer["jobs"]);
-        }
-        return kSuccess;
-      });
+  });
+}
+
+void addStatusCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto job = std::make_shared<std::string>();
+  auto follows = std::make_shared<bool>(false);
+  CLI::App* statusVerb = app.add_subcommand("status", "A job's state, progress and history");
+  statusVerb->add_option("JOB", *job, "The job's number")->required();
+  statusVerb->add_flag("--follow", *follows,
+                       "Show live progress until the job is done, fails, is cancelled or interrupted, or is planned");
+  addClientOptions(*statusVerb, *client);
+  statusVerb->callback([client, job, follows, &status] {
+    status = talking([&]() -> int {
+      const long long id = jobNumber(*job);
+      const DaemonClient daemon = clientOf(*client);
+      if (*follows) return follow(daemon, id);
+      const json answer = daemon.get(fmt::format("/api/jobs/{}", id));
+      if (client->json) {
+        std::cout << answer.dump(1) << '\n';
+      } else {
+        printStatus(answer);
+      }
+      return kSuccess;
     });
-  }
-  // status
-  {
-    auto client = std::make_shared<ClientOptions>();
-    auto job = std::make_shared<std::string>();
-    auto follows = std::make_shared<bool>(false);
-    CLI::App* statusVerb = app.add_subcommand("status", "A job's state, progress and history");
-    statusVerb->add_option("JOB", *job, "The job's number")->required();
-    statusVerb->add_flag("--follow", *follows,
-                         "Show live progress until the job is done, fails, is cancelled or interrupted, or is planned");
-    addClientOptions(*statusVerb, *client);
-    statusVerb->callback([client, job, follows, &status] {
-      status = talking([&]() -> int {
-        const long long id = jobNumber(*job);
-        const DaemonClient daemon = clientOf(*client);
-        if (*follows) return follow(daemon, id);
-        const json answer = daemon.get(fmt::format("/api/jobs/{}", id));
-        if (client->json) {
-          std::cout << answer.dump(1) << '\n';
-        } else {
-          printStatus(answer);
-        }
-        return kSuccess;
-      });
+  });
+}
+
+// cancel, pause, start, next: a job number and nothing else.
+void addJobActionCommand(CLI::App& app, int& status, const char* verb, const char* help) {
+  auto client = std::make_shared<ClientOptions>();
+  auto job = std::make_shared<std::string>();
+  CLI::App* command = app.add_subcommand(verb, help);
+  command->add_option("JOB", *job, "The job's number")->required();
+  addClientOptions(*command, *client);
+  const std::string name = verb;
+  command->callback([client, job, name, &status] {
+    status = talking([&]() -> int {
+      const json answer = clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/{}", jobNumber(*job), name),
+                                                          json::object(), kDeviceCheckPatience, saysWaiting);
+      printAnswer(answer, name, client->json);
+      return kSuccess;
     });
-  }
-  // cancel, pause, start, next: a job number and nothing else
-  const auto addSimple = [&app, &status](const char* verb, const char* help) {
-    auto client = std::make_shared<ClientOptions>();
-    auto job = std::make_shared<std::string>();
-    CLI::App* command = app.add_subcommand(verb, help);
-    command->add_option("JOB", *job, "The job's number")->required();
-    addClientOptions(*command, *client);
-    const std::string name = verb;
-    command->callback([client, job, name, &status] {
-      status = talking([&]() -> int {
-        const json answer = clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/{}", jobNumber(*job), name),
-                                                            json::object(), kDeviceCheckPatience, saysWaiting);
-        printAnswer(answer, name, client->json);
-        return kSuccess;
-      });
+  });
+}
+
+void addResumeCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto job = std::make_shared<std::string>();
+  auto fromSheet = std::make_shared<std::optional<int>>();
+  CLI::App* resume =
+      app.add_subcommand("resume", "Go on with a paused job, or an interrupted or failed one from a sheet");
+  resume->add_option("JOB", *job, "The job's number")->required();
+  resume
+      ->add_option("--from-sheet", *fromSheet,
+                   "For an interrupted or failed job: the sheet to cut again from (loaded, fresh)")
+      ->check(CLI::PositiveNumber);
+  addClientOptions(*resume, *client);
+  resume->footer(
+      "A job the daemon was cutting when it stopped comes back interrupted and never restarts by itself:\n"
+      "check the machine, load the sheet, then resume it from that sheet.\n\n"
+      "Examples:\n"
+      "  rotafab resume 7\n"
+      "  rotafab resume 7 --from-sheet 3");
+  resume->callback([client, job, fromSheet, &status] {
+    status = talking([&]() -> int {
+      json body = json::object();
+      if (*fromSheet) body["from_sheet"] = **fromSheet;
+      printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
+                                                  kDeviceCheckPatience, saysWaiting),
+                  "resume", client->json);
+      return kSuccess;
     });
-  };
-  addSimple("cancel", "Cancel a job; a cut stops with the laser off");
-  addSimple("pause", "Hold a running cut (feed hold); `rotafab resume JOB` goes on");
-  // resume
-  {
-    auto client = std::make_shared<ClientOptions>();
-    auto job = std::make_shared<std::string>();
-    auto fromSheet = std::make_shared<std::optional<int>>();
-    CLI::App* resume =
-        app.add_subcommand("resume", "Go on with a paused job, or an interrupted or failed one from a sheet");
-    resume->add_option("JOB", *job, "The job's number")->required();
-    resume
-        ->add_option("--from-sheet", *fromSheet,
-                     "For an interrupted or failed job: the sheet to cut again from (loaded, fresh)")
-        ->check(CLI::PositiveNumber);
-    addClientOptions(*resume, *client);
-    resume->footer(
-        "A job the daemon was cutting when it stopped comes back interrupted and never restarts by itself:\n"
-        "check the machine, load the sheet, then resume it from that sheet.\n\n"
-        "Examples:\n"
-        "  rotafab resume 7\n"
-        "  rotafab resume 7 --from-sheet 3");
-    resume->callback([client, job, fromSheet, &status] {
-      status = talking([&]() -> int {
-        json body = json::object();
-        if (*fromSheet) body["from_sheet"] = **fromSheet;
-        printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
-                                                    kDeviceCheckPatience, saysWaiting),
-                    "resume", client->json);
-        return kSuccess;
-      });
+  });
+}
+
+void addMoveCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto job = std::make_shared<std::string>();
+  auto before = std::make_shared<std::string>();
+  auto priority = std::make_shared<std::optional<int>>();
+  CLI::App* move = app.add_subcommand("move", "Reorder the queue: a job before another, or a new priority");
+  move->add_option("JOB", *job, "The job's number")->required();
+  auto* beforeOption = move->add_option("--before", *before, "Put it just before this job (and at its priority)");
+  move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
+  addClientOptions(*move, *client);
+  move->callback([client, job, before, priority, &status] {
+    status = talking([&]() -> int {
+      json body = json::object();
+      if (!before->empty()) body["before"] = jobNumber(*before);
+      if (*priority) body["priority"] = **priority;
+      if (body.empty()) throw UserError("move: give --before OTHER or --priority P");
+      const DaemonClient daemon = clientOf(*client);
+      daemon.post(fmt::format("/api/jobs/{}/move", jobNumber(*job)), body);
+      const json answer = daemon.get("/api/jobs");
+      if (client->json) {
+        std::cout << answer.dump(1) << '\n';
+      } else {
+        printJobs(answer["jobs"]);
+      }
+      return kSuccess;
     });
-  }
-  addSimple("start", "Cut a planned job on its device, from its first sheet (load it first)");
-  addSimple("next", "Say the next sheet is loaded: the job cuts it");
-  // move
-  {
-    auto client = std::make_shared<ClientOptions>();
-    auto job = std::make_shared<std::string>();
-    auto before = std::make_shared<std::string>();
-    auto priority = std::make_shared<std::optional<int>>();
-    CLI::App* move = app.add_subcommand("move", "Reorder the queue: a job before another, or a new priority");
-    move->add_option("JOB", *job, "The job's number")->required();
-    auto* beforeOption = move->add_option("--before", *before, "Put it just before this job (and at its priority)");
-    move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
-    addClientOptions(*move, *client);
-    move->callback([client, job, before, priority, &status] {
-      status = talking([&]() -> int {
-        json body = json::object();
-        if (!before->empty()) body["before"] = jobNumber(*before);
-        if (*priority) body["priority"] = **priority;
-        if (body.empty()) throw UserError("move: give --before OTHER or --priority P");
-        const DaemonClient daemon = clientOf(*client);
-        daemon.post(fmt::format("/api/jobs/{}/move", jobNumber(*job)), body);
-        const json answer = daemon.get("/api/jobs");
-        if (client->json) {
-          std::cout << answer.dump(1) << '\n';
-        } else {
-          printJobs(answer["jobs"]);
-        }
+  });
+}
+
+void addDashboardCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto urlOnly = std::make_shared<bool>(false);
+  CLI::App* dashboard =
+      app.add_subcommand("dashboard", "Open the workshop page (queue, machines, previews, assembly guide) signed in");
+  dashboard->add_flag("--url", *urlOnly, "Only print the one-time login link, for a browser you open yourself");
+  addClientOptions(*dashboard, *client);
+  dashboard->footer(
+      "The daemon serves the page on loopback TCP (http://127.0.0.1:8730 unless that port was taken: rotafabd.json\n"
+      "in its state directory says where). A browser gets in only with a session, which a one-time link\n"
+      "opens: this command asks the daemon for one over its Unix socket, as this machine's user, and opens\n"
+      "it in the browser. The link works once, within five minutes; the session lasts a week unused.\n\n"
+      "Examples:\n"
+      "  rotafab dashboard\n"
+      "  rotafab dashboard --url          # print the link only (another browser, a tablet over SSH tunnel)");
+  dashboard->callback([client, urlOnly, &status] {
+    status = talking([&]() -> int {
+      const json link = clientOf(*client).post("/api/sessions", json::object());
+      const std::string url = link.value("url", "");
+      if (client->json) {
+        std::cout << link.dump(1) << '\n';
         return kSuccess;
-      });
-    });
-  }
-  // dashboard
-  {
-    auto client = std::make_shared<ClientOptions>();
-    auto urlOnly = std::make_shared<bool>(false);
-    CLI::App* dashboard =
-        app.add_subcommand("dashboard", "Open the workshop page (queue, machines, previews, assembly guide) signed in");
-    dashboard->add_flag("--url", *urlOnly, "Only print the one-time login link, for a browser you open yourself");
-    addClientOptions(*dashboard, *client);
-    dashboard->footer(
-        "The daemon serves the page on loopback TCP (http://127.0.0.1:8730 unless that port was taken: rotafabd.json\n"
-        "in its state directory says where). A browser gets in only with a session, which a one-time link\n"
-        "opens: this command asks the daemon for one over its Unix socket, as this machine's user, and opens\n"
-        "it in the browser. The link works once, within five minutes; the session lasts a week unused.\n\n"
-        "Examples:\n"
-        "  rotafab dashboard\n"
-        "  rotafab dashboard --url          # print the link only (another browser, a tablet over SSH tunnel)");
-    dashboard->callback([client, urlOnly, &status] {
-      status = talking([&]() -> int {
-        const json link = clientOf(*client).post("/api/sessions", json::object());
-        const std::string url = link.value("url", "");
-        if (client->json) {
-          std::cout << link.dump(1) << '\n';
-          return kSuccess;
-        }
-        if (*urlOnly) {
-          fmt::print("{}\n", url);
-          return kSuccess;
-        }
-        if (openInBrowser(url)) {
-          fmt::print("opened the workshop page in your browser; the link works once, within five minutes:\n{}\n", url);
-        } else {
-          fmt::print("open this link in a browser on this machine (it works once, within five minutes):\n{}\n", url);
-        }
+      }
+      if (*urlOnly) {
+        fmt::print("{}\n", url);
         return kSuccess;
-      });
+      }
+      if (openInBrowser(url)) {
+        fmt::print("opened the workshop page in your browser; the link works once, within five minutes:\n{}\n", url);
+      } else {
+        fmt::print("open this link in a browser on this machine (it works once, within five minutes):\n{}\n", url);
+      }
+      return kSuccess;
     });
-  }
+  });
+}
+
+}  // namespace
+
+// The verbs are added in the order `rotafab --help` lists them.
+void addQueueCommands(CLI::App& app, int& status) {
+  addSubmitCommand(app, status);
+  addJobsCommand(app, status);
+  addStatusCommand(app, status);
+  addJobActionCommand(app, status, "cancel", "Cancel a job; a cut stops with the laser off");
+  addJobActionCommand(app, status, "pause", "Hold a running cut (feed hold); `rotafab resume JOB` goes on");
+  addResumeCommand(app, status);
+  addJobActionCommand(app, status, "start", "Cut a planned job on its device, from its first sheet (load it first)");
+  addJobActionCommand(app, status, "next", "Say the next sheet is loaded: the job cuts it");
+  addMoveCommand(app, status);
+  addDashboardCommand(app, status);
 }
 
 }  // namespace rotafab::cli

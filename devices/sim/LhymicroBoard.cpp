@@ -255,6 +255,18 @@ void LhymicroBoard::interpret(uint8_t byte) {
     return;
   }
   if (mode_ == BoardMode::Finished) return;  // until the next 'I'
+  breakOffLeaving(c);
+  if (c >= '0' && c <= '9') {
+    readDigit(c);
+    return;
+  }
+  if (endDigits(c)) return;  // a speed code's low-speed suffix 'C', read with it
+  if (readDistanceLetter(c)) return;
+  flushDistance();
+  runCommand(c);
+}
+
+void LhymicroBoard::breakOffLeaving(char c) {
   // "FNSE" / "@NSE" must come unbroken: padding 'F' followed by anything else was only padding.
   if (leavingStep_ > 0 && c != "NSE"[leavingStep_ - 1]) {
     // Padding inside compact mode is a hazard: a real board may read its 'F'
@@ -265,42 +277,44 @@ void LhymicroBoard::interpret(uint8_t byte) {
     }
     leaving_ = 0, leavingStep_ = 0;
   }
+}
 
-  if (c >= '0' && c <= '9') {
-    switch (digits_) {
-      case Digits::SMode:
-        if (sMode_ == -1) {
-          sMode_ = c - '0';
-        } else {
-          violation(fmt::format("a second digit '{}' after S", c));
-        }
-        return;
-      case Digits::Speed:
-        digitText_ += c;
-        return;
-      case Digits::Raster:
-        digitText_ += c;
-        if (digitText_.size() == 3) {
-          if (rasterGroups_ == 1) rasterStep_ = std::stol(digitText_);
-          digitText_.clear();
-          digits_ = Digits::Distance;
-        }
-        return;
-      case Digits::Distance:
-        digitText_ += c;
-        if (digitText_.size() == 3) {
-          addDistance(std::stol(digitText_));
-          digitText_.clear();
-        }
-        return;
-    }
+void LhymicroBoard::readDigit(char c) {
+  switch (digits_) {
+    case Digits::SMode:
+      if (sMode_ == -1) {
+        sMode_ = c - '0';
+      } else {
+        violation(fmt::format("a second digit '{}' after S", c));
+      }
+      return;
+    case Digits::Speed:
+      digitText_ += c;
+      return;
+    case Digits::Raster:
+      digitText_ += c;
+      if (digitText_.size() == 3) {
+        if (rasterGroups_ == 1) rasterStep_ = std::stol(digitText_);
+        digitText_.clear();
+        digits_ = Digits::Distance;
+      }
+      return;
+    case Digits::Distance:
+      digitText_ += c;
+      if (digitText_.size() == 3) {
+        addDistance(std::stol(digitText_));
+        digitText_.clear();
+      }
+      return;
   }
+}
 
+bool LhymicroBoard::endDigits(char c) {
   // A non-digit ends the digits before it.
   switch (digits_) {
     case Digits::Speed:
       finishSpeedCode(c == 'C');
-      if (c == 'C') return;  // the low-speed suffix
+      if (c == 'C') return true;  // the low-speed suffix
       break;
     case Digits::Raster:
       violation(fmt::format("a raster step of {} digits", digitText_.size()));
@@ -317,25 +331,30 @@ void LhymicroBoard::interpret(uint8_t byte) {
     sMode_ = -2;
   }
   if (sMode_ == -2) digits_ = Digits::Distance;
+  return false;
+}
 
+bool LhymicroBoard::readDistanceLetter(char c) {
   // Distances add up until the next command letter.
   if (c == '|') {
     addDistance(25);
     smallJump_ = true;
-    return;
+    return true;
   }
   if (c == 'z') {
     addDistance(smallJump_ ? 26 : 255);
     smallJump_ = false;
-    return;
+    return true;
   }
   if (c >= 'a' && c <= 'y') {
     addDistance(c - 'a' + 1);
     smallJump_ = false;
-    return;
+    return true;
   }
+  return false;
+}
 
-  flushDistance();
+void LhymicroBoard::runCommand(char c) {
   switch (c) {
     case 'B':
     case 'T':
@@ -353,59 +372,16 @@ void LhymicroBoard::interpret(uint8_t byte) {
       laser_ = false;
       break;
     case 'N':
-      if (mode_ == BoardMode::Default) {
-        runDefaultMove();
-      } else if (!jogging_) {
-        if (laser_) violation(fmt::format("laser on when compact mode ends at ({}, {}) (no U before N)", x(), y()));
-        laser_ = false;
-        jogging_ = true;
-      }
-      if (leavingStep_ == 1) leavingStep_ = 2;
+      runN();
       break;
     case 'S':
-      runDefaultMove();
-      sMode_ = -1;
-      digits_ = Digits::SMode;
-      if (leavingStep_ == 2) leavingStep_ = 3;
+      runS();
       break;
     case 'E':
-      if (leavingStep_ == 3) {
-        // FNSE finishes the job; @NSE leaves compact mode for default mode, where a new speed code may follow.
-        jogging_ = laser_ = false;
-        pendingX_ = pendingY_ = 0;
-        if (leaving_ == 'F') {
-          mode_ = BoardMode::Finished;
-          if (actions_.empty() && onlyPaddingLeft()) finishedLatch_ = true;
-        } else {
-          mode_ = BoardMode::Default;
-        }
-        leaving_ = 0, leavingStep_ = 0;
-      } else if (sMode_ >= 0) {  // "S1E": compact mode at the last speed code, the last direction letter the major axis
-        mode_ = BoardMode::Compact;
-        jogging_ = false;
-        compactSpeed_ = codeSpeed_;
-        if (compactSpeed_ <= 0) violation("compact mode without a speed code");
-        majorAxis_ = engaged_ == 'y' ? 'y' : 'x';
-      } else if (sMode_ == -1) {  // "SE": back from a jog
-        jogging_ = false;
-      }
-      sMode_ = -2;
-      digits_ = Digits::Distance;
+      runE();
       break;
     case 'P':
-      if (sMode_ != -2) {  // "S1P" runs the moves (at 'S') and locks the rail, "S2P" unlocks it
-        if (sMode_ == 1) railLocked_ = true;
-        if (sMode_ == 2) railLocked_ = false;
-        sMode_ = -2;
-        digits_ = Digits::Distance;
-      } else if (peekInPacket() == 'P') {  // two P in one packet: home
-        ++readAt_;
-        runDefaultMove();
-        home();
-      } else {  // a lone P (or "PN") inside the stream
-        if (peekInPacket() == 'N') ++readAt_;
-        paused_ = !paused_;
-      }
+      runP();
       break;
     case 'F':
     case '@':
@@ -424,6 +400,65 @@ void LhymicroBoard::interpret(uint8_t byte) {
       break;
     default:
       break;
+  }
+}
+
+void LhymicroBoard::runN() {
+  if (mode_ == BoardMode::Default) {
+    runDefaultMove();
+  } else if (!jogging_) {
+    if (laser_) violation(fmt::format("laser on when compact mode ends at ({}, {}) (no U before N)", x(), y()));
+    laser_ = false;
+    jogging_ = true;
+  }
+  if (leavingStep_ == 1) leavingStep_ = 2;
+}
+
+void LhymicroBoard::runS() {
+  runDefaultMove();
+  sMode_ = -1;
+  digits_ = Digits::SMode;
+  if (leavingStep_ == 2) leavingStep_ = 3;
+}
+
+void LhymicroBoard::runE() {
+  if (leavingStep_ == 3) {
+    // FNSE finishes the job; @NSE leaves compact mode for default mode, where a new speed code may follow.
+    jogging_ = laser_ = false;
+    pendingX_ = pendingY_ = 0;
+    if (leaving_ == 'F') {
+      mode_ = BoardMode::Finished;
+      if (actions_.empty() && onlyPaddingLeft()) finishedLatch_ = true;
+    } else {
+      mode_ = BoardMode::Default;
+    }
+    leaving_ = 0, leavingStep_ = 0;
+  } else if (sMode_ >= 0) {  // "S1E": compact mode at the last speed code, the last direction letter the major axis
+    mode_ = BoardMode::Compact;
+    jogging_ = false;
+    compactSpeed_ = codeSpeed_;
+    if (compactSpeed_ <= 0) violation("compact mode without a speed code");
+    majorAxis_ = engaged_ == 'y' ? 'y' : 'x';
+  } else if (sMode_ == -1) {  // "SE": back from a jog
+    jogging_ = false;
+  }
+  sMode_ = -2;
+  digits_ = Digits::Distance;
+}
+
+void LhymicroBoard::runP() {
+  if (sMode_ != -2) {  // "S1P" runs the moves (at 'S') and locks the rail, "S2P" unlocks it
+    if (sMode_ == 1) railLocked_ = true;
+    if (sMode_ == 2) railLocked_ = false;
+    sMode_ = -2;
+    digits_ = Digits::Distance;
+  } else if (peekInPacket() == 'P') {  // two P in one packet: home
+    ++readAt_;
+    runDefaultMove();
+    home();
+  } else {  // a lone P (or "PN") inside the stream
+    if (peekInPacket() == 'N') ++readAt_;
+    paused_ = !paused_;
   }
 }
 

@@ -113,6 +113,19 @@ class LhymicroBoard {
   enum class Digits { Distance, Speed, Raster, SMode };
 
   void interpret(uint8_t byte);
+  // The steps of interpret(), in the order it takes them for a byte of the language.
+  void breakOffLeaving(char c);  // forgets a begun "FNSE" / "@NSE" that `c` does not go on with
+  void readDigit(char c);        // into the distance, speed code, raster step or S mode being read
+  // The digits before a letter are complete: true when `c` was a speed code's
+  // low-speed suffix 'C', which they take and which says nothing else.
+  bool endDigits(char c);
+  bool readDistanceLetter(char c);  // '|', 'a'..'z': true when `c` was one
+  void runCommand(char c);          // a command letter, the distance before it flushed
+  // The letters whose meaning depends on the mode and on the letters before them.
+  void runN();
+  void runS();
+  void runE();
+  void runP();
   void reset();
   void abort();
   void violation(std::string text);

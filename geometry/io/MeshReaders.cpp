@@ -308,149 +308,172 @@ class PlyValues {
   int line_;
 };
 
-}  // namespace
+// What a PLY header declares, and where its body starts.
+struct PlyHeader {
+  PlyFormat format = PlyFormat::Ascii;
+  std::vector<PlyElement> elements;
+  size_t bodyStart = 0;  // the byte after the end_header line
+};
 
-PolygonMesh readPly(std::string_view bytes) {
+PlyFormat plyFormatOf(const std::vector<std::string_view>& w, int line) {
+  if (w.size() < 2) failAtLine(line, "the format line names no format");
+  if (w[1] == "ascii") return PlyFormat::Ascii;
+  if (w[1] == "binary_little_endian") return PlyFormat::BinaryLittleEndian;
+  if (w[1] == "binary_big_endian") return PlyFormat::BinaryBigEndian;
+  failAtLine(line, fmt::format("unknown format {}", shownToken(w[1])));
+}
+
+PlyProperty plyPropertyFrom(const std::vector<std::string_view>& w, int line) {
+  if (w.size() >= 5 && w[1] == "list") {
+    auto countType = plyTypeNamed(w[2]);
+    auto type = plyTypeNamed(w[3]);
+    if (!countType) failAtLine(line, fmt::format("unknown list count type {}", shownToken(w[2])));
+    if (!type) failAtLine(line, fmt::format("unknown list value type {}", shownToken(w[3])));
+    return {std::string(w[4]), *type, true, *countType};
+  }
+  if (w.size() >= 3 && w[1] != "list") {
+    auto type = plyTypeNamed(w[1]);
+    if (!type) failAtLine(line, fmt::format("unknown property type {}", shownToken(w[1])));
+    return {std::string(w[2]), *type, false, PlyType::UInt8};
+  }
+  failAtLine(line, "a property needs a type and a name");
+}
+
+PlyHeader readPlyHeader(std::string_view bytes) {
   if (bytes.empty()) throw InvalidMeshError("the file is empty");
   size_t headerEnd = bytes.find("\nend_header");  // at the start of a line, not inside a comment
   if (headerEnd != std::string_view::npos) ++headerEnd;
   if (bytes.substr(0, 3) != "ply") throw InvalidMeshError("line 1: expected 'ply'");
   if (headerEnd == std::string_view::npos) throw InvalidMeshError("truncated: the header has no end_header line");
-  size_t bodyStart = bytes.find('\n', headerEnd);
-  bodyStart = bodyStart == std::string_view::npos ? bytes.size() : bodyStart + 1;
+  PlyHeader result;
+  result.bodyStart = bytes.find('\n', headerEnd);
+  result.bodyStart = result.bodyStart == std::string_view::npos ? bytes.size() : result.bodyStart + 1;
 
   CommentedLines header(bytes.substr(0, headerEnd + 10));
   std::optional<PlyFormat> format;
-  std::vector<PlyElement> elements;
+  std::vector<PlyElement>& elements = result.elements;
   while (auto words = header.next()) {
     const int line = header.lineNumber();
     const auto& w = *words;
     if (w[0] == "ply" || w[0] == "comment" || w[0] == "obj_info" || w[0] == "end_header") continue;
     if (w[0] == "format") {
-      if (w.size() < 2) failAtLine(line, "the format line names no format");
-      if (w[1] == "ascii")
-        format = PlyFormat::Ascii;
-      else if (w[1] == "binary_little_endian")
-        format = PlyFormat::BinaryLittleEndian;
-      else if (w[1] == "binary_big_endian")
-        format = PlyFormat::BinaryBigEndian;
-      else
-        failAtLine(line, fmt::format("unknown format {}", shownToken(w[1])));
+      format = plyFormatOf(w, line);
     } else if (w[0] == "element") {
       if (w.size() < 3) failAtLine(line, "an element needs a name and a count");
       elements.push_back({std::string(w[1]), countFrom(w[2], line, "element"), {}});
     } else if (w[0] == "property") {
       if (elements.empty()) failAtLine(line, "a property before any element");
-      PlyProperty property;
-      if (w.size() >= 5 && w[1] == "list") {
-        auto countType = plyTypeNamed(w[2]);
-        auto type = plyTypeNamed(w[3]);
-        if (!countType) failAtLine(line, fmt::format("unknown list count type {}", shownToken(w[2])));
-        if (!type) failAtLine(line, fmt::format("unknown list value type {}", shownToken(w[3])));
-        property = {std::string(w[4]), *type, true, *countType};
-      } else if (w.size() >= 3 && w[1] != "list") {
-        auto type = plyTypeNamed(w[1]);
-        if (!type) failAtLine(line, fmt::format("unknown property type {}", shownToken(w[1])));
-        property = {std::string(w[2]), *type, false, PlyType::UInt8};
-      } else {
-        failAtLine(line, "a property needs a type and a name");
-      }
-      elements.back().properties.push_back(std::move(property));
+      elements.back().properties.push_back(plyPropertyFrom(w, line));
     }
     // Anything else is a free-form line some writers add (Blender: "Created by
     // Blender3D ..."); like a comment, it is ignored.
   }
   if (!format) throw InvalidMeshError("the header has no format line");
+  result.format = *format;
+  return result;
+}
 
-  const PlyElement* vertexElement = nullptr;
-  for (const auto& e : elements)
-    if (e.name == "vertex") vertexElement = &e;
-  if (!vertexElement) throw InvalidMeshError("the header declares no vertex element");
+// The positions of the vertex element's x, y and z among its properties.
+std::array<int, 3> plyCoordinateProperties(const PlyElement& vertexElement) {
   std::array<int, 3> coordinateProperty{-1, -1, -1};
-  for (size_t p = 0; p < vertexElement->properties.size(); ++p) {
-    const auto& name = vertexElement->properties[p].name;
-    if (name.size() == 1 && name[0] >= 'x' && name[0] <= 'z' && !vertexElement->properties[p].isList) {
+  for (size_t p = 0; p < vertexElement.properties.size(); ++p) {
+    const auto& name = vertexElement.properties[p].name;
+    if (name.size() == 1 && name[0] >= 'x' && name[0] <= 'z' && !vertexElement.properties[p].isList) {
       coordinateProperty[name[0] - 'x'] = static_cast<int>(p);
     }
   }
   if (coordinateProperty[0] < 0 || coordinateProperty[1] < 0 || coordinateProperty[2] < 0) {
     throw InvalidMeshError("the vertex element lacks an x, y or z property");
   }
+  return coordinateProperty;
+}
 
-  const int bodyLine = 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + bodyStart, '\n'));
-  PlyValues values(bytes.substr(bodyStart), *format, bodyLine);
-  PolygonMesh mesh;
-  std::vector<std::string> faceWhere;  // where each face was read, for the index check below
-  long long vertexCount = 0;
-  for (const auto& element : elements) {
-    const bool isVertex = &element == vertexElement;
-    const bool isFace = element.name == "face";
-    int faceList = -1;
-    if (isFace) {
-      for (size_t p = 0; p < element.properties.size(); ++p) {
-        const auto& property = element.properties[p];
-        if (property.isList && (property.name == "vertex_indices" || property.name == "vertex_index")) {
-          faceList = static_cast<int>(p);
-        }
-      }
-      if (faceList < 0) throw InvalidMeshError("the face element has no vertex_indices list");
+// The position of the face element's vertex index list among its properties.
+int plyFaceList(const PlyElement& faceElement) {
+  int faceList = -1;
+  for (size_t p = 0; p < faceElement.properties.size(); ++p) {
+    const auto& property = faceElement.properties[p];
+    if (property.isList && (property.name == "vertex_indices" || property.name == "vertex_index")) {
+      faceList = static_cast<int>(p);
     }
-    // Each instance takes at least one byte (binary) or two (ascii); a count
-    // larger than the rest of the file is a truncated or corrupt file.
-    if (element.count > static_cast<long long>(values.remainingBytes())) {
-      throw InvalidMeshError(
-          fmt::format("truncated: the header states {} {} elements, more than the {} bytes left can hold",
-                      element.count, shownToken(element.name), values.remainingBytes()));
-    }
-    auto truncated = [&](long long read) {
-      return InvalidMeshError(fmt::format("truncated: the header states {} {} elements, the file ends after {}",
-                                          element.count, shownToken(element.name), read));
-    };
-    for (long long i = 0; i < element.count; ++i) {
-      Point3 p = Point3::Zero();
-      std::vector<int> face;
-      for (size_t pi = 0; pi < element.properties.size(); ++pi) {
-        const auto& property = element.properties[pi];
-        if (property.isList) {
-          auto size = values.next(property.countType);
-          if (!size) throw truncated(i);
-          if (*size < 0 || *size != std::floor(*size) || *size > 1e6) {
-            throw InvalidMeshError(
-                fmt::format("{}{} {}: {} is not a list length", values.where(), shownToken(element.name), i, *size));
-          }
-          for (long long k = 0; k < static_cast<long long>(*size); ++k) {
-            auto value = values.next(property.type);
-            if (!value) throw truncated(i);
-            if (static_cast<int>(pi) == faceList) {
-              if (*value != std::floor(*value) || *value < 0 || *value > 2147483647.0) {
-                throw InvalidMeshError(fmt::format("{}face {}: {} is not a vertex index", values.where(), i, *value));
-              }
-              face.push_back(static_cast<int>(*value));
-            }
-          }
-        } else {
-          auto value = values.next(property.type);
-          if (!value) throw truncated(i);
-          if (isVertex) {
-            for (int axis = 0; axis < 3; ++axis)
-              if (coordinateProperty[axis] == static_cast<int>(pi)) p[axis] = *value;
-          }
-        }
-      }
-      if (isVertex) {
-        if (!p.allFinite()) {
-          throw InvalidMeshError(
-              fmt::format("{}vertex {} has a non-finite coordinate {}", values.where(), i, formatPoint(p)));
-        }
-        mesh.positions.push_back(p);
-      }
-      if (isFace) {
-        mesh.faces.push_back(std::move(face));
-        faceWhere.push_back(values.where());
-      }
-    }
-    if (isVertex) vertexCount = element.count;
   }
+  if (faceList < 0) throw InvalidMeshError("the face element has no vertex_indices list");
+  return faceList;
+}
+
+InvalidMeshError plyTruncated(const PlyElement& element, long long read) {
+  return InvalidMeshError(fmt::format("truncated: the header states {} {} elements, the file ends after {}",
+                                      element.count, shownToken(element.name), read));
+}
+
+// One list property of instance `i`; its values go to `indices` where it is the face's vertex list, else nowhere.
+void readPlyList(PlyValues& values, const PlyElement& element, const PlyProperty& property, long long i,
+                 std::vector<int>* indices) {
+  auto size = values.next(property.countType);
+  if (!size) throw plyTruncated(element, i);
+  if (*size < 0 || *size != std::floor(*size) || *size > 1e6) {
+    throw InvalidMeshError(
+        fmt::format("{}{} {}: {} is not a list length", values.where(), shownToken(element.name), i, *size));
+  }
+  for (long long k = 0; k < static_cast<long long>(*size); ++k) {
+    auto value = values.next(property.type);
+    if (!value) throw plyTruncated(element, i);
+    if (indices) {
+      if (*value != std::floor(*value) || *value < 0 || *value > 2147483647.0) {
+        throw InvalidMeshError(fmt::format("{}face {}: {} is not a vertex index", values.where(), i, *value));
+      }
+      indices->push_back(static_cast<int>(*value));
+    }
+  }
+}
+
+// Every instance of one element: the vertex element's positions and the face
+// element's faces go to `mesh` (with where each face was read, in `faceWhere`);
+// any other element is read past.
+void readPlyElement(PlyValues& values, const PlyElement& element, bool isVertex,
+                    const std::array<int, 3>& coordinateProperty, PolygonMesh& mesh,
+                    std::vector<std::string>& faceWhere) {
+  const bool isFace = element.name == "face";
+  const int faceList = isFace ? plyFaceList(element) : -1;
+  // Each instance takes at least one byte (binary) or two (ascii); a count
+  // larger than the rest of the file is a truncated or corrupt file.
+  if (element.count > static_cast<long long>(values.remainingBytes())) {
+    throw InvalidMeshError(
+        fmt::format("truncated: the header states {} {} elements, more than the {} bytes left can hold", element.count,
+                    shownToken(element.name), values.remainingBytes()));
+  }
+  for (long long i = 0; i < element.count; ++i) {
+    Point3 p = Point3::Zero();
+    std::vector<int> face;
+    for (size_t pi = 0; pi < element.properties.size(); ++pi) {
+      const auto& property = element.properties[pi];
+      if (property.isList) {
+        readPlyList(values, element, property, i, static_cast<int>(pi) == faceList ? &face : nullptr);
+      } else {
+        auto value = values.next(property.type);
+        if (!value) throw plyTruncated(element, i);
+        if (isVertex) {
+          for (int axis = 0; axis < 3; ++axis)
+            if (coordinateProperty[axis] == static_cast<int>(pi)) p[axis] = *value;
+        }
+      }
+    }
+    if (isVertex) {
+      if (!p.allFinite()) {
+        throw InvalidMeshError(
+            fmt::format("{}vertex {} has a non-finite coordinate {}", values.where(), i, formatPoint(p)));
+      }
+      mesh.positions.push_back(p);
+    }
+    if (isFace) {
+      mesh.faces.push_back(std::move(face));
+      faceWhere.push_back(values.where());
+    }
+  }
+}
+
+// Checked once every element is read: the face element may come before the vertex element.
+void checkPlyFaceIndices(const PolygonMesh& mesh, const std::vector<std::string>& faceWhere, long long vertexCount) {
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     for (int index : mesh.faces[f]) {
       if (index >= vertexCount) {
@@ -459,6 +482,29 @@ PolygonMesh readPly(std::string_view bytes) {
       }
     }
   }
+}
+
+}  // namespace
+
+PolygonMesh readPly(std::string_view bytes) {
+  const PlyHeader header = readPlyHeader(bytes);
+  const PlyElement* vertexElement = nullptr;
+  for (const auto& e : header.elements)
+    if (e.name == "vertex") vertexElement = &e;
+  if (!vertexElement) throw InvalidMeshError("the header declares no vertex element");
+  const std::array<int, 3> coordinateProperty = plyCoordinateProperties(*vertexElement);
+
+  const int bodyLine = 1 + static_cast<int>(std::count(bytes.begin(), bytes.begin() + header.bodyStart, '\n'));
+  PlyValues values(bytes.substr(header.bodyStart), header.format, bodyLine);
+  PolygonMesh mesh;
+  std::vector<std::string> faceWhere;  // where each face was read, for the index check
+  long long vertexCount = 0;
+  for (const auto& element : header.elements) {
+    const bool isVertex = &element == vertexElement;
+    readPlyElement(values, element, isVertex, coordinateProperty, mesh, faceWhere);
+    if (isVertex) vertexCount = element.count;
+  }
+  checkPlyFaceIndices(mesh, faceWhere, vertexCount);
   return mesh;
 }
 
