@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab devices [--json]` (SPEC, "Command line"): the serial ports and
+// `rotafab devices [--json]` (docs/CONTRACT.md, "Command line"): the serial ports and
 // cutters plugged in, and the driver and URI for each.
 
 #include <CLI/CLI.hpp>

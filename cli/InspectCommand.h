@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab inspect MESH [--json]` (SPEC, "Command line").
+// `rotafab inspect MESH [--json]` (docs/CONTRACT.md, "Command line").
 
 #include <CLI/CLI.hpp>
 

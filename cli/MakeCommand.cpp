@@ -36,8 +36,9 @@ std::string stabilityLine(const geometry::Stability& stability) {
 void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const CommandContext& command) {
   const auto& s = job.seconds;
   if (options.json) {
-    // SPEC's summary, and the notes and warnings printed on the way (also
-    // on standard error), for a script that reads only the object.
+    // The summary (docs/CONTRACT.md, "make"), and the notes and warnings
+    // printed on the way (also on standard error), for a script that reads only
+    // the object.
     nlohmann::ordered_json summary = jobs::summaryJson(job);
     summary["notes"] = command.notes();
     summary["warnings"] = command.warnings();
@@ -106,8 +107,8 @@ void addMakeCommand(CLI::App& app, int& status) {
   addMakeOptions(*make, *options);
   make->footer(
       "Writes into the output folder: sheet-001.eps/.svg/.dxf, ... (one set per sheet, for the cutter) and\n"
-      "sheet-001.preview.svg (for people), manifest.json (SPEC), manifest.txt (what it takes, and the assembly\n"
-      "steps), structure.obj (the panels in 3D, a group per panel). Lengths take in, mm or cm.\n"
+      "sheet-001.preview.svg (for people), manifest.json (docs/CONTRACT.md), manifest.txt (what it takes, and\n"
+      "the assembly steps), structure.obj (the panels in 3D, a group per panel). Lengths take in, mm or cm.\n"
       "Default scale: the mean edge becomes 2 in. Ctrl-C stops at once and writes nothing.\n\n"
       "Examples:\n"
       "  rotafab make examples/bunny.obj --structure band\n"

@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab make MESH --structure band` (SPEC, "Command line"): from a
+// `rotafab make MESH --structure band` (docs/CONTRACT.md, "Command line"): from a
 // mesh to laser sheets, an assembly manifest and the 3D structure; and
 // `rotafab manifest DIR` to print that manifest again.
 

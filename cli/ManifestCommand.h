@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab manifest DIR [--format text|json|html]` (SPEC, "Command line"):
+// `rotafab manifest DIR [--format text|json|html]` (docs/CONTRACT.md, "Command line"):
 // the assembly manifest of a `make` output folder, again.
 
 #include <CLI/CLI.hpp>

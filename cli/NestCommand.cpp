@@ -33,8 +33,9 @@ struct NestOptions {
   int threads = 0;
 };
 
-// The bed: the machine profile's (SPEC's workshop bed when the profiles
-// cannot be read and none was named), with --bed and --margin over it.
+// The bed: the machine profile's (the workshop bed of docs/CONTRACT.md,
+// "Units and scale", when the profiles cannot be read and none was named), with
+// --bed and --margin over it.
 profiles::Bed bedOf(const NestOptions& options) {
   profiles::Bed bed;
   try {
@@ -146,7 +147,8 @@ void addNestCommand(CLI::App& app, int& status) {
       "area of all sheets; in strip mode density is part area over strip_height x strip_length.\n\n"
       "Examples:\n"
       "  rotafab nest parts.json --out layout/\n"
-      "  rotafab nest ../shared/benchmarks/esicup/shirts.json --strip --time 60 --json");
+      "  rotafab nest $ESICUP/shirts.json --strip --time 60 --json   (ESICUP: the benchmark instances, in the\n"
+      "  jagua-rs / sparrow JSON format; docs/PERFORMANCE.md, \"ESICUP, strip mode\")");
   command->callback([options, &status] { status = runNest(*options); });
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab nest INSTANCE.json` (SPEC, "nest"): nest the parts of a jagua-rs /
+// `rotafab nest INSTANCE.json` (docs/CONTRACT.md, "nest"): nest the parts of a jagua-rs /
 // sparrow instance file onto beds or into a strip.
 
 #include <CLI/CLI.hpp>

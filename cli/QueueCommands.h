@@ -1,5 +1,5 @@
 #pragma once
-// The verbs that talk to the fabrication daemon (SPEC, "Command line"):
+// The verbs that talk to the fabrication daemon (docs/CONTRACT.md, "Command line"):
 // submit, jobs, status, cancel, pause, resume, start, next, move; and the
 // daemon's side of `devices --daemon` and `manifest JOB`.
 

@@ -1,5 +1,5 @@
 #pragma once
-// `rotafab run DIR|SHEET --device URI` (SPEC, "Command line"): drive a
+// `rotafab run DIR|SHEET --device URI` (docs/CONTRACT.md, "Command line"): drive a
 // cutter directly, with a progress bar, Ctrl-C stopping it safely.
 
 #include <CLI/CLI.hpp>

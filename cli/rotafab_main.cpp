@@ -1,4 +1,4 @@
-// rotafab: the command line (SPEC, "Command line"). Wiring only.
+// rotafab: the command line (docs/CONTRACT.md, "Command line"). Wiring only.
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>

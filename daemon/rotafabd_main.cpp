@@ -1,4 +1,4 @@
-// rotafabd: the fabrication daemon (SPEC, "Daemon"). Wiring only: the
+// rotafabd: the fabrication daemon (docs/CONTRACT.md, "Daemon"). Wiring only: the
 // configuration, the state directory's lock, the logs, the signals; the
 // queue is daemon/service/Service.h, the API daemon/service/HttpServer.h.
 
@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
   std::string configFile, token;
   app.add_option("--config", configFile,
                  "YAML configuration: state_dir, store (sqlite, or postgresql://USER@HOST:PORT/DB), listen, devices, "
-                 "tokens (SPEC \"Daemon\"; every key optional)")
+                 "tokens (docs/CONTRACT.md, \"Daemon\"; every key optional)")
       ->check(CLI::ExistingFile);
   app.add_option("--hash-token", token, "Print the salted hash of TOKEN for the configuration's tokens, and exit");
   app.footer(

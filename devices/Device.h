@@ -97,7 +97,7 @@ class Device {
   // machine it stands for; progress and estimates are said in real time.
   [[nodiscard]] virtual double timeScale() const { return 1.0; }
   // The bytes run() would send for these toolpaths, one after another, as a
-  // dry run writes them (SPEC, "Devices"), and what they are, for people:
+  // dry run writes them (docs/CONTRACT.md, "Devices"), and what they are, for people:
   // "G-code for 1 sheet (108 strokes), as the driver would send it".
   [[nodiscard]] virtual std::string program(const std::vector<jobs::Toolpath>& toolpaths) const = 0;
   [[nodiscard]] virtual std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const = 0;

@@ -1,7 +1,7 @@
 #pragma once
 // The drivers as the rest of the program knows them, registered from their
 // own folders (libsigrok's SR_REGISTER_DEV_DRIVER is the model): each says
-// which device URIs it takes (SPEC, "Devices"), which USB devices it drives,
+// which device URIs it takes (docs/CONTRACT.md, "Devices"), which USB devices it drives,
 // how to parse its URI into an address of its own kind and how to open the
 // device; the device itself says what a dry run of it writes (Device::program).
 // Discovery, URI parsing and the loop that runs a job ask the registry;

@@ -15,8 +15,8 @@
 // area), so that every band is counter-clockwise seen from outside: the
 // eigenvector's sign alone would mirror some bands.
 //
-// Open meshes (SPEC `--holes keep`): a boundary vertex has no closed dual
-// face; its dual polygon is the fan's centroids closed through the
+// Open meshes (`--holes keep`, docs/CONTRACT.md, "make"): a boundary vertex
+// has no closed dual face; its dual polygon is the fan's centroids closed through the
 // midpoints of its two boundary edges and the vertex itself (the usual
 // dual with boundary), so every face, boundary or not, gets a whole vertex
 // band; boundary edges get no edge band.

@@ -1,5 +1,5 @@
 #pragma once
-// The construction size of a structure (SPEC, "Units and scale"): the
+// The construction size of a structure (docs/CONTRACT.md, "Units and scale"): the
 // factor that makes the mesh's mean edge 2 in, or its largest bounding-box
 // side a given length, or a factor given as it is.
 

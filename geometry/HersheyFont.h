@@ -2,8 +2,8 @@
 // Single-stroke text for etched labels: a Hershey font read from Debian's
 // hershey-fonts-data (.jhf files, James Hurt's format), turned into polylines
 // that a laser follows once. Outline fonts would be traced twice (both sides
-// of every stroke) and need filling; a stroke font is what SPEC's "single-
-// stroke labels" need.
+// of every stroke) and need filling; a stroke font is what the "single-stroke
+// labels" of docs/CONTRACT.md ("Layout") need.
 //
 // The .jhf format: one record per glyph, "IIIIINNNLR" then pairs: a 5-column
 // glyph number, a 3-column count of pairs (the bounds pair included), the
@@ -88,8 +88,9 @@ bool readsDifferentlyUpsideDown(std::string_view label);
 
 // The mark is a period after the label, as in "6." and "9.": upside down it
 // stands before the number at the top, where no period goes. (A period rather
-// than an underline, because SPEC already gives the underline a meaning: the
-// neighbouring edge index of a woven panel.)
+// than an underline, because docs/CONTRACT.md ("What Rotafab is") already
+// gives the underline a meaning: the neighbouring edge index of a woven
+// panel.)
 std::string labelText(std::string_view label);
 
 // font.strokes(labelText(label), ...).

@@ -1,7 +1,7 @@
 #pragma once
-// Filling the holes of an open mesh (SPEC `--holes`). Both ways walk each
-// boundary loop in the rotation system (III.1.2's face tracing continued
-// over the boundary), so that what closes it is oriented like the faces
+// Filling the holes of an open mesh (`--holes`, docs/CONTRACT.md, "make").
+// Both ways walk each boundary loop in the rotation system (III.1.2's face
+// tracing continued over the boundary), so that what closes it is oriented like the faces
 // around it:
 // - `fill` caps a loop with one polygon face;
 // - `patch` closes it with triangles about as long as the loop's own edges,

@@ -1,7 +1,8 @@
 #pragma once
-// Topology and validity of an imported mesh: the counts of SPEC's `inspect`,
-// the problems that make a mesh unusable for construction (named element by
-// element), and the repair of an inconsistent orientation.
+// Topology and validity of an imported mesh: the counts of `inspect`
+// (docs/CONTRACT.md, "inspect"), the problems that make a mesh unusable for
+// construction (named element by element), and the repair of an inconsistent
+// orientation.
 
 #include <optional>
 #include <string>

@@ -35,7 +35,7 @@
 namespace rotafab::geometry {
 
 struct MeshRepair {
-  std::string kind;   // as above: SPEC's manifest "repairs"[].kind
+  std::string kind;   // as above: the manifest's "repairs"[].kind (docs/CONTRACT.md, "manifest.json (version 1)")
   int count = 0;      // of the elements repaired
   std::string first;  // "vertex 44", "edge (12, 57)", "face 9" (the file's numbering)
   int leftOpen = 0;   // split-nonmanifold-edge: edge sides that no other face closes (an inner wall's)

@@ -1,9 +1,9 @@
 #pragma once
-// A panel count the builders choose (SPEC `make --panels N`): the mesh is
-// simplified to about N faces before anything is built, so that a scan of
-// thousands of triangles becomes a job of the size the builders can cut and
-// assemble (the dissertation's bunny, ch. VII, had 2,104 panels, and the size
-// of the job was its limit).
+// A panel count the builders choose (`make --panels N`, docs/CONTRACT.md,
+// "Command line"): the mesh is simplified to about N faces before anything is
+// built, so that a scan of thousands of triangles becomes a job of the size the
+// builders can cut and assemble (the dissertation's bunny, ch. VII, had 2,104
+// panels, and the size of the job was its limit).
 //
 // Quadric edge collapse (Garland and Heckbert, "Surface Simplification Using
 // Quadric Error Metrics", SIGGRAPH 1997) by OpenMesh's decimater: each step

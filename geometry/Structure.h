@@ -22,13 +22,15 @@ namespace rotafab::geometry {
 using Polyline2 = std::vector<Point2>;
 
 enum class StructureKind { Band, Weave };
-// SPEC's names in manifest.json: "band", "weave".
+// The names in manifest.json's "structure" (docs/CONTRACT.md,
+// "manifest.json (version 1)"): "band", "weave".
 std::string_view structureName(StructureKind kind);
 
-// What a label says (SPEC's `labels[].role`): an edge number, the panel's
-// number, the neighbouring edge's number (a woven panel's underlined one),
-// the edge of a woven panel's up or down crossing; and the name of a piece
-// cut off a panel (ours, on the piece's tab).
+// What a label says (`labels[].role`, docs/CONTRACT.md,
+// "manifest.json (version 1)"): an edge number, the panel's number, the
+// neighbouring edge's number (a woven panel's underlined one), the edge of a
+// woven panel's up or down crossing; and the name of a piece cut off a panel
+// (ours, on the piece's tab).
 enum class LabelRole { Edge, Panel, Neighbor, Up, Down, Piece };
 // "edge", "panel", "neighbor", "up", "down", "piece".
 std::string_view roleName(LabelRole role);
@@ -47,9 +49,10 @@ struct PanelLabel {
   std::vector<Polyline2> strokes;
 };
 
-// Where a panel comes from (SPEC's `source`): a band panel from an input
-// face (its index in the file) or from a face capping a hole (`cap`, no
-// face); a woven panel from the edge of its up crossing and its cycle.
+// Where a panel comes from (`source`, docs/CONTRACT.md,
+// "manifest.json (version 1)"): a band panel from an input face (its index in
+// the file) or from a face capping a hole (`cap`, no face); a woven panel from
+// the edge of its up crossing and its cycle.
 struct PanelSource {
   int face = -1;
   bool cap = false;

@@ -9,7 +9,8 @@
 
 namespace rotafab::jobs {
 
-// What the job takes (SPEC's summary, "material use"): the sheets, the
+// What the job takes (docs/CONTRACT.md, "make": the summary, and the
+// manifest's "cost"; docs/sheets.md, "What the job takes"): the sheets, the
 // fasteners to buy, and the cutting time of each sheet as its toolpath runs
 // on the machine of the profile (its `motion`).
 struct JobCost {

@@ -366,10 +366,11 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   };
   try {
     if (request.size) {
-      // --size is the structure's largest side (SPEC), and the structure is
-      // smaller than the mesh (its vertex bands are cut back at the corners),
-      // by a ratio that does not depend on the scale: measured on a first
-      // build (glued, so that no band's room stops it), then the mesh scaled by it.
+      // --size is the structure's largest side (docs/CONTRACT.md,
+      // "Units and scale"), and the structure is smaller than the mesh (its
+      // vertex bands are cut back at the corners), by a ratio that does not
+      // depend on the scale: measured on a first build (glued, so that no
+      // band's room stops it), then the mesh scaled by it.
       geometry::BandOptions measuring = band;
       measuring.glueBandsWithoutRoom = true;
       const double side = builtSize(geometry::buildBandStructure(mesh, measuring, context)).maxCoeff();

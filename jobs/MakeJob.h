@@ -1,10 +1,10 @@
 #pragma once
-// The whole of `rotafab make` (SPEC, "make") as one call, for the command
-// line and the daemon alike: a request in (a mesh file and the options), a
-// planned job out (its structure, sheets and files). The
-// phases, each reported as progress: import (read, check, fill holes,
-// scale), geometry (the structure's builder), nesting (the planner), writing
-// (the output folder, by OutputFolder's rule).
+// The whole of `rotafab make` (docs/CONTRACT.md, "make") as one call, for the
+// command line and the daemon alike: a request in (a mesh file and the
+// options), a planned job out (its structure, sheets and files). The phases,
+// each reported as progress: import (read, check, fill holes, scale), geometry
+// (the structure's builder), nesting (the planner), writing (the output folder,
+// by OutputFolder's rule).
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -26,8 +26,9 @@
 
 namespace rotafab::jobs {
 
-// SPEC's --holes: leave the boundary open, cap each hole with one face, close
-// it with a patch of triangles like the mesh's own, or refuse an open mesh.
+// --holes (docs/CONTRACT.md, "make"): leave the boundary open, cap each hole
+// with one face, close it with a patch of triangles like the mesh's own, or
+// refuse an open mesh.
 enum class HolesMode { Keep, Fill, Patch, Error };
 
 // A woven ribbon's least offset over or under the surface, inches: paper's thickness.
@@ -47,7 +48,9 @@ struct MakeRequest {
   std::optional<double> mergeCoplanar;
   // Simplify to about this many faces, one panel each (geometry/Simplification.h).
   std::optional<int> panels;
-  bool repair = true;  // SPEC's --repair auto (geometry/MeshRepair.h); false: none, a broken mesh is refused
+  // --repair auto (docs/CONTRACT.md, "Command line"; geometry/MeshRepair.h);
+  // false: none, a broken mesh is refused.
+  bool repair = true;
   // The band decomposition's options (geometry/BandStructure.h).
   std::optional<double> tension;
   int samples = 8;
@@ -85,7 +88,7 @@ struct PlannedJob {
   profiles::Bed bed;               // the machine's
   geometry::Structure structure;
   geometry::Stability stability;                     // of the structure as built, standing on the request's up axis
-  geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches (SPEC's manifest "size")
+  geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches ("size", docs/CONTRACT.md)
   SheetPlan sheets;
   SheetFormats formats;
   JobCost cost;
@@ -115,9 +118,9 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
 // written, core::Cancelled.
 void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::WorkContext& context);
 
-// SPEC's summary of a written job (`make --json`): {"panels", "sheets",
-// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "estimate", "writing"}}, and
-// "simplified": {"asked", "faces"} when a panel count was asked, "size": [X, Y, Z] (the
+// The summary of a written job (`make --json`; docs/CONTRACT.md, "make"): {"panels", "sheets",
+// "fasteners", "utilization", "seconds": {"import", "geometry", "nesting", "estimate", "writing"}},
+// and "simplified": {"asked", "faces"} when a panel count was asked, "size": [X, Y, Z] (the
 // structure's box, inches), and "stability" (stabilityJson()).
 nlohmann::ordered_json summaryJson(const PlannedJob& job);
 

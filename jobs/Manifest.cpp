@@ -31,8 +31,9 @@ double onGrid(double v) {
 }
 nlohmann::ordered_json point(const Point2& p) { return {onGrid(p.x()), onGrid(p.y())}; }
 
-// SPEC's `source`: a band panel's face (a cap of --holes fill has none in
-// the file), a woven panel's edge and cycle.
+// The manifest's `source` (docs/CONTRACT.md, "manifest.json (version 1)"): a
+// band panel's face (a cap of --holes fill has none in the file), a woven
+// panel's edge and cycle.
 nlohmann::ordered_json sourceOf(const geometry::PanelSource& source) {
   if (source.edge >= 0) return {{"edge", source.edge}, {"cycle", source.cycle}};
   if (source.cap) return {{"face", nullptr}, {"cap", true}};

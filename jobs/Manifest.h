@@ -1,9 +1,9 @@
 #pragma once
-// The assembly manifest (SPEC "manifest.json", version 1): what the builders
-// follow, step by step in assembly order (the flood fill's, dissertation
-// V.5, for bands), and what the cutter's operator needs, sheet by sheet.
-// Built from a structure (geometry/Structure.h) and its sheet plan; printed
-// as text (manifest.txt, `rotafab manifest`) and as a page to print.
+// The assembly manifest (docs/CONTRACT.md, "manifest.json (version 1)"): what
+// the builders follow, step by step in assembly order (the flood fill's,
+// dissertation V.5, for bands), and what the cutter's operator needs, sheet by
+// sheet. Built from a structure (geometry/Structure.h) and its sheet plan;
+// printed as text (manifest.txt, `rotafab manifest`) and as a page to print.
 
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
@@ -21,8 +21,9 @@
 
 namespace rotafab::jobs {
 
-// The mesh as built (repaired, its holes filled if asked): SPEC's "mesh"
-// counts, and the repairs made to it ("repairs", named and counted).
+// The mesh as built (repaired, its holes filled if asked): the manifest's
+// "mesh" counts (docs/CONTRACT.md, "manifest.json (version 1)"), and the
+// repairs made to it ("repairs", named and counted).
 struct BuiltMesh {
   int vertices = 0, edges = 0, faces = 0;
   std::optional<int> genus;
@@ -31,15 +32,18 @@ struct BuiltMesh {
   std::optional<int> start;  // the flood fill's first face as asked, or the face it was merged into
 };
 
-// SPEC's manifest "repairs": [{"kind", "count", "first"}], in the order made.
+// The manifest's "repairs" (docs/CONTRACT.md, "manifest.json (version 1)"):
+// [{"kind", "count", "first"}], in the order made.
 nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs);
 
-// SPEC's manifest "simplified": {"asked": N, "faces": M}, the faces the mesh was left with.
+// The manifest's "simplified" (docs/CONTRACT.md, "manifest.json (version 1)"):
+// {"asked": N, "faces": M}, the faces the mesh was left with.
 nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified);
 
-// SPEC's manifest "stability": {"stands", "margin", "center_of_mass", "mass_kg" (null when the
-// material's areal density is not known), "hang_points" (two when it does not stand, else empty),
-// "footprint" (its corners on the ground)}; inches.
+// The manifest's "stability" (docs/CONTRACT.md, "manifest.json (version 1)"):
+// {"stands", "margin", "center_of_mass", "mass_kg" (null when the material's
+// areal density is not known), "hang_points" (two when it does not stand, else
+// empty), "footprint" (its corners on the ground)}; inches.
 nlohmann::ordered_json stabilityJson(const geometry::Stability& stability);
 
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
@@ -53,8 +57,9 @@ std::string manifestText(const nlohmann::ordered_json& manifest);
 // indented, a large job's manifest was twice the bytes).
 std::string manifestJsonText(const nlohmann::ordered_json& manifest);
 
-// `make`'s manifest.json (SPEC's version 1 for the structure as planned, and
-// then the members of `more`, as manifestJsonText() gives it) and
+// `make`'s manifest.json (docs/CONTRACT.md, "manifest.json (version 1)", for
+// the structure as planned, and then the members of `more`, as
+// manifestJsonText() gives it) and
 // manifest.txt (manifestText()), made without the whole manifest in memory:
 // the panels' lines a chunk at a time, on the context's threads (a
 // 50,000-panel manifest was 660 MB). `files[s]`: the files written for

@@ -1,7 +1,7 @@
 #pragma once
-// `rotafab nest` (SPEC, "nest") as one call: the parts of an instance file
-// nested onto beds or into a strip, checked exactly, with SPEC's summary,
-// and layout.json and layout.svg written where asked.
+// `rotafab nest` (docs/CONTRACT.md, "nest") as one call: the parts of an
+// instance file nested onto beds or into a strip, checked exactly, with the
+// contract's summary, and layout.json and layout.svg written where asked.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -29,8 +29,9 @@ struct NestedInstance {
   NestingOptions options;  // as nested
   NestingResult result;
   double margin = 0;  // of the bed (0 in the strip)
-  // SPEC's summary: sheets, utilization, strip_length, density, seconds; and
-  // "layouts" (our extension: how many layouts the search tried).
+  // The summary (docs/CONTRACT.md, "nest"): sheets, utilization, strip_length,
+  // density, seconds; and "layouts" (our extension: how many layouts the search
+  // tried).
   nlohmann::ordered_json summary;
 };
 

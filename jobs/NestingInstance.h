@@ -1,8 +1,8 @@
 #pragma once
-// Instance files of the jagua-rs / sparrow format (SPEC, "nest"): {"name",
-// "strip_height", "items": [{"id", "demand", "allowed_orientations": [deg...],
-// "shape": {"type": "simple_polygon", "data": [[x, y], ...]}}]}. One part per
-// copy of each item, numbered in file order.
+// Instance files of the jagua-rs / sparrow format (docs/CONTRACT.md, "nest"):
+// {"name", "strip_height", "items": [{"id", "demand", "allowed_orientations":
+// [deg...], "shape": {"type": "simple_polygon", "data": [[x, y], ...]}}]}. One
+// part per copy of each item, numbered in file order.
 
 #include <nlohmann/json_fwd.hpp>
 #include <string>
@@ -27,10 +27,10 @@ struct NestingInstance {
 // Throws std::invalid_argument "FILE: items[3].shape.data: what is wrong".
 NestingInstance readNestingInstance(const std::string& file);
 
-// SPEC's layout.json: {"placements": [{"item", "copy", "sheet", "x", "y",
-// "rotation"}]}, one per part copy in cutting order, on the bed (the usable
-// area's placements moved by `margin`), with our extension "moved": how
-// far the layout moved the part from its order in the file.
+// layout.json (docs/CONTRACT.md, "nest"): {"placements": [{"item", "copy",
+// "sheet", "x", "y", "rotation"}]}, one per part copy in cutting order, on the
+// bed (the usable area's placements moved by `margin`), with our extension
+// "moved": how far the layout moved the part from its order in the file.
 nlohmann::ordered_json layoutJson(const NestingInstance& instance, const NestingResult& result, double margin);
 
 }  // namespace rotafab::jobs

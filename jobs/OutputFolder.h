@@ -1,12 +1,13 @@
 #pragma once
-// SPEC's rule for an output folder: no partial set, no stale files. A job's
-// files are all written into a hidden folder inside the target first (the
-// same file system, whatever links lead there) and move in only when all are
-// written, so that a failure or a cancel leaves the folder as it was (and a
-// folder that was not there is not left behind). Each new file then
-// replaces its old namesake in one rename, the one named last moving last,
-// and only after that are the old job's files that the new one does not
-// have (a stale sheet-009.eps beside a new 8-sheet job) removed.
+// The rule for an output folder (docs/CONTRACT.md, "Command line" and "make"):
+// no partial set, no stale files. A job's files are all written into a hidden
+// folder inside the target first (the same file system, whatever links lead
+// there) and move in only when all are written, so that a failure or a cancel
+// leaves the folder as it was (and a folder that was not there is not left
+// behind). Each new file then replaces its old namesake in one rename, the one
+// named last moving last, and only after that are the old job's files that the
+// new one does not have (a stale sheet-009.eps beside a new 8-sheet job)
+// removed.
 
 #include <filesystem>
 #include <functional>

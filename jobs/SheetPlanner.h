@@ -48,7 +48,7 @@ struct PlannedPart {
 struct SheetFormats {
   bool eps = true, svg = true, dxf = false;
 };
-// SPEC's EPS and SVG, and what the machine profile's `formats` adds.
+// EPS and SVG (docs/CONTRACT.md, "make"), and what the machine profile's `formats` adds.
 SheetFormats defaultFormats(const profiles::MachineProfile& machine);
 // "eps,svg,dxf" or any of them; throws std::invalid_argument saying what is wrong.
 SheetFormats formatsOf(const std::string& list);

@@ -1,5 +1,5 @@
 #pragma once
-// Lengths as users write them (SPEC, "Units and scale"): a number with an
+// Lengths as users write them (docs/CONTRACT.md, "Units and scale"): a number with an
 // optional unit, `in`, `mm` or `cm`; a bare number is in inches, the internal
 // unit. "0.25in", "6.35mm", "0.635cm" and "0.25" are the same length.
 
@@ -28,10 +28,11 @@ std::string formatLength(double inches, std::string_view unit);
 // Millimetres or centimetres per inch, or 1 for inches.
 double unitsPerInch(std::string_view unit);
 
-// A size WIDTHxHEIGHT (SPEC: a unit written once at the end applies to both
-// numbers, "800x600mm"; or one each, "32inx18in"; none, inches: "31.5x17.5"),
-// in inches; nullopt when it is not two lengths joined by an x, or when only
-// the first has a unit ("32inx18": which unit the second has is a guess).
+// A size WIDTHxHEIGHT (docs/CONTRACT.md, "Units and scale": a unit written once
+// at the end applies to both numbers, "800x600mm"; or one each, "32inx18in";
+// none, inches: "31.5x17.5"), in inches; nullopt when it is not two lengths
+// joined by an x, or when only the first has a unit ("32inx18": which unit the
+// second has is a guess).
 std::optional<std::pair<double, double>> parseSize(std::string_view text);
 
 }  // namespace rotafab::profiles

@@ -1,7 +1,7 @@
 #pragma once
-// The operations of SPEC that a machine profile maps to colours, and the
-// colours themselves. Profiles own these: jobs and devices know profiles,
-// never the other way round.
+// The operations that a machine profile maps to colours (docs/CONTRACT.md,
+// "Profiles"), and the colours themselves. Profiles own these: jobs and devices
+// know profiles, never the other way round.
 
 #include <array>
 #include <cstdint>

@@ -33,7 +33,7 @@ LaserMode laserMode(const ProfileReader& reader, const YAML::Node& node, const s
   reader.fail(node, key, fmt::format("expected vector, raster or raster+vector, found '{}'", mode));
 }
 
-// The URI schemes each driver accepts (SPEC, "Devices").
+// The URI schemes each driver accepts (docs/CONTRACT.md, "Devices").
 void checkConnection(const ProfileReader& reader, const YAML::Node& node, const std::string& driver,
                      const std::string& uri) {
   const std::map<std::string, std::vector<std::string>> schemes{

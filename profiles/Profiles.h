@@ -1,5 +1,5 @@
 #pragma once
-// Machine and material profiles (SPEC, "Profiles"): what a cutter is (bed,
+// Machine and material profiles (docs/CONTRACT.md, "Profiles"): what a cutter is (bed,
 // driver, connection, the colour table of the dissertation's fig. 65 and which
 // colour each operation is drawn in) and what a material needs (thickness,
 // kerf, fastener hole, power and speed per machine). Lengths in inches.
@@ -50,12 +50,13 @@ struct MachineProfile {
   std::string description;
   Bed bed;
   std::string driver;      // "spool", "grbl" or "m2nano"
-  std::string connection;  // the default device URI (SPEC, "Devices")
+  std::string connection;  // the default device URI (docs/CONTRACT.md, "Devices")
   std::vector<ColourSetting> colours;
   std::map<Operation, std::string> operationColour;  // every operation has one
   std::optional<MachineMotion> motion;
-  // Sheet files that `make` writes for this machine besides SPEC's EPS and
-  // SVG, as its software wants them: "dxf" (`formats: [dxf]`).
+  // Sheet files that `make` writes for this machine besides EPS and SVG
+  // (docs/CONTRACT.md, "make"), as its software wants them: "dxf"
+  // (`formats: [dxf]`).
   std::vector<std::string> formats;
   std::filesystem::path source;
 

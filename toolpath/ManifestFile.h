@@ -1,6 +1,7 @@
 #pragma once
-// Reading a job's manifest.json (SPEC, "manifest.json"): for the commands
-// that print it and for those that cut the sheets it lists.
+// Reading a job's manifest.json (docs/CONTRACT.md,
+// "manifest.json (version 1)"): for the commands that print it and for those
+// that cut the sheets it lists.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>

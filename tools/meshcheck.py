@@ -8,8 +8,9 @@ Reads OBJ (v/f, `f a/b/c` forms, negative indices, groups ignored), OFF
 extra per-vertex and per-face values ignored; not 4OFF or binary OFF), PLY
 (ascii, binary little/big endian; `vertex` x/y/z and the `face`
 `vertex_indices`/`vertex_index` list, other elements skipped) and STL (ascii,
-and binary even when its header starts with "solid"), cleans the mesh the way SPEC.md says `rotafab inspect` does, and
-prints the `inspect --json` object:
+and binary even when its header starts with "solid"), cleans the mesh the way
+docs/CONTRACT.md ("inspect") says `rotafab inspect` does, and prints the
+`inspect --json` object:
 
     {"vertices":V,"edges":E,"faces":F,"boundary_loops":B,"components":C,
      "euler":X,"genus":G,"orientable":bool,"manifold":bool}

@@ -1,5 +1,5 @@
 #pragma once
-// The daemon's configuration (SPEC, "Daemon"): `rotafabd --config FILE`,
+// The daemon's configuration (docs/CONTRACT.md, "Daemon"): `rotafabd --config FILE`,
 // YAML, validated as the profiles are (one line, "FILE:LINE:COL: key: what
 // is wrong"), every key optional. With no file at all the daemon runs with
 // the defaults: state in $XDG_STATE_HOME/rotafab (else
@@ -14,13 +14,13 @@
 
 namespace rotafab::service {
 
-// The workshop page's port on loopback by default (SPEC, "Daemon").
+// The workshop page's port on loopback by default (docs/CONTRACT.md, "Daemon").
 constexpr int kPagePort = 8730;
 
 struct DeviceConfig {
   std::string name;                      // how people and the API call it: "laser1"
   std::string machine;                   // its machine profile: what jobs for it are planned against
-  std::string uri;                       // SPEC's device URI
+  std::string uri;                       // a device URI (docs/CONTRACT.md, "Devices")
   std::string material = "posterboard";  // the power and speed overrides its jobs are cut with
   bool autoStart = false;                // cut a job once planned, with no operator's `start`
 };

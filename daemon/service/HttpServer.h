@@ -1,5 +1,5 @@
 #pragma once
-// The daemon's API (SPEC, "Daemon"; docs/API.md): JSON over HTTP/1.1 with
+// The daemon's API (docs/CONTRACT.md, "Daemon"; docs/API.md): JSON over HTTP/1.1 with
 // Boost.Beast, on the Unix socket (mode 0600: the user who runs the daemon)
 // and on any TCP listener configured (a bearer token, checked against the
 // salted hashes of the configuration, whenever tokens are configured, and

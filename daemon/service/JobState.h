@@ -1,5 +1,5 @@
 #pragma once
-// A job's states (SPEC, "Daemon") and the one table of the moves between
+// A job's states (docs/CONTRACT.md, "Daemon") and the one table of the moves between
 // them. Every change of state goes through the store's transition(), which
 // checks it here, so no other code decides what may follow what.
 

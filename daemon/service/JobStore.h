@@ -1,5 +1,5 @@
 #pragma once
-// Where the daemon keeps its jobs (SPEC, "Daemon"): jobs, every transition
+// Where the daemon keeps its jobs (docs/CONTRACT.md, "Daemon"): jobs, every transition
 // of each with its time and reason, and events. A small interface of its
 // own so that another engine can stand behind it: SQLite (SqliteStore.cpp)
 // or PostgreSQL (PostgresStore.cpp), a store several hosts share. Every call

@@ -1,5 +1,5 @@
 #pragma once
-// The fabrication queue (SPEC, "Daemon"): jobs submitted, planned once
+// The fabrication queue (docs/CONTRACT.md, "Daemon"): jobs submitted, planned once
 // against their device's machine profile, cut one per device with a stop
 // between sheets, and every change of state kept in the store before
 // anyone is told of it.

@@ -1,4 +1,4 @@
-// The workshop page (README, "The workshop page"): the queue, the machines, the sheets and
+// The workshop page (docs/daemon.md, "The workshop page"): the queue, the machines, the sheets and
 // the assembly guide, over the daemon's documented API (docs/API.md) and its
 // event stream. Every button calls the API; a refusal shows the API's own words.
 //

@@ -69,7 +69,7 @@ LhymicroJob jobProgram(const jobs::Toolpath& toolpath, size_t firstStroke = 0);
 // Framing: home, then the box of the strokes traced in compact mode with the laser off.
 std::vector<std::string> frameLines(const jobs::Toolpath& toolpath, double mmPerSecond);
 
-// The .egv file K40 Whisperer and MeerK40t open (SPEC, "Devices").
+// The .egv file K40 Whisperer and MeerK40t open (docs/CONTRACT.md, "Devices").
 std::string egvFile(const std::vector<std::string>& lines);
 
 // The .egv file of the sheets' jobs one after another, as a dry run writes

@@ -26,7 +26,8 @@ constexpr double kWeightFade = 0.95, kHeaviest = 1e9;
 constexpr double kDecayShare = 0.01;
 constexpr double kNoLimit = std::numeric_limits<double>::max();
 // Strip compaction: the first shortening (2%), the least (0.1%), and tries
-// per shortening before it is halved (docs/PERFORMANCE.md).
+// per shortening before it is halved (docs/PERFORMANCE-LOG.md,
+// "ESICUP, strip mode, 60 s per instance").
 constexpr double kFirstShrink = 0.02, kLeastShrink = 0.001;
 constexpr int kTriesPerShrink = 5;
 

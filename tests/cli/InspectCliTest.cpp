@@ -1,5 +1,6 @@
-// `rotafab inspect` through the built program: SPEC's JSON, exit statuses and
-// one-line errors, on our examples and on meshes we did not make.
+// `rotafab inspect` through the built program: the JSON and exit statuses of
+// docs/CONTRACT.md ("inspect", "Command line"), and one-line errors, on our
+// examples and on meshes we did not make.
 
 #include <gtest/gtest.h>
 

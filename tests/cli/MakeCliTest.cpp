@@ -1,6 +1,7 @@
-// `rotafab make MESH --structure band` and `rotafab manifest` through the
-// built program: the files of SPEC, manifest.json as SPEC describes it,
-// sheets Ghostscript reads, exit statuses and one-line errors.
+// `rotafab make MESH --structure band` and `rotafab manifest` through the built
+// program: the files of docs/CONTRACT.md ("make"), manifest.json as its
+// "manifest.json (version 1)" describes it, sheets Ghostscript reads, exit
+// statuses and one-line errors.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -42,7 +43,7 @@ TEST(MakeCli, WritesEveryFileOfSpec) {
   const int sheets = static_cast<int>(manifest.at("sheets").size());
   ASSERT_GE(sheets, 1);
   for (int s = 1; s <= sheets; ++s) {
-    // SPEC's EPS and SVG; DXF only when asked for (SheetFormatsAreThoseAskedFor).
+    // EPS and SVG (docs/CONTRACT.md, "make"); DXF only when asked for (SheetFormatsAreThoseAskedFor).
     for (const char* extension : {"eps", "svg", "dxf"}) {
       char name[32];
       std::snprintf(name, sizeof name, "sheet-%03d.%s", s, extension);
@@ -118,13 +119,14 @@ void expectHolesADiameterIn(const nlohmann::json& part, const std::string& name)
   }
 }
 
-// SPEC's manifest.json panels of a band structure of `faceCount` faces:
-// numbered 1..n, one per face, each on a sheet inside the bed's margins,
-// outlines counter-clockwise with their areas, no hole nearer than a
-// diameter to its part's outline, and every interior edge's holes on
-// exactly two panels (with the pieces cut off them), as many on each;
-// `interiorEdges` < 0: as many as the panels name. Every side's edge number
-// is etched but for at most `unlabelled` (make warns of each it could not fit).
+// The manifest.json panels (docs/CONTRACT.md, "manifest.json (version 1)")
+// of a band structure of `faceCount` faces: numbered 1..n, one per face, each
+// on a sheet inside the bed's margins, outlines counter-clockwise with their
+// areas, no hole nearer than a diameter to its part's outline, and every
+// interior edge's holes on exactly two panels (with the pieces cut off them),
+// as many on each; `interiorEdges` < 0: as many as the panels name. Every
+// side's edge number is etched but for at most `unlabelled` (make warns of
+// each it could not fit).
 // (`splitFaces`: faces split in two, each two panels of one face)
 // (`glued`: bands with no room for a hole, no holes on either copy)
 void expectSpecPanels(const nlohmann::json& m, int faceCount, int interiorEdges, int unlabelled = 0, int splitFaces = 0,
@@ -282,7 +284,7 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 
 // Meshes nobody here wrote, from Debian's packages and npm, through `make`
 // with the default mesh options (repaired, merged, sized as make chooses),
-// and through every invariant of SPEC's manifest: CGAL's cow (a bow-tie
+// and through every invariant of docs/CONTRACT.md's manifest: CGAL's cow (a bow-tie
 // vertex, and a panel that would overlap itself with a shallow vertex band),
 // pig, triple torus, elephant (106 holes) and mushroom (open); the npm
 // teapot (open, a bow-tie); STLs OpenSCAD and another program wrote; CGAL's
@@ -710,9 +712,10 @@ TEST(MakeCli, ThePanelCountIsTheOneAsked) {
   EXPECT_NE(bad.err.find("--panels"), std::string::npos) << bad.err;
 }
 
-// --size L is the largest side of what gets built (SPEC), not of the mesh:
-// the panels are cut back at the corners, so the mesh is scaled up to make
-// structure.obj L across; the summary gives the three sides, as Pepakura does.
+// --size L is the largest side of what gets built (docs/CONTRACT.md,
+// "Units and scale"), not of the mesh: the panels are cut back at the corners,
+// so the mesh is scaled up to make structure.obj L across; the summary gives
+// the three sides, as Pepakura does.
 TEST(MakeCli, SizeIsTheLargestSideOfTheStructureBuilt) {
   TempDir dir;
   for (const std::filesystem::path& mesh : {kSource / "examples/cube.obj", kSource / "examples/soccer-ball.obj"}) {

@@ -1,5 +1,5 @@
-// `rotafab nest` through the built program: SPEC's summary, layout.json, and
-// one-line refusals of bad instance files.
+// `rotafab nest` through the built program: the summary and layout.json of
+// docs/CONTRACT.md ("nest"), and one-line refusals of bad instance files.
 
 #include <gtest/gtest.h>
 

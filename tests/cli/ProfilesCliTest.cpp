@@ -45,7 +45,8 @@ TEST(ProfilesCli, LengthsAreShownInTheirFilesUnits) {
       << line("plywood-3mm");
   EXPECT_NE(line("posterboard").find(" 0.8 mm thick, kerf 0.004 in, fastener 0.125 in "), std::string::npos)
       << line("posterboard");
-  // JSON keeps SPEC's inches, and says which unit the file used.
+  // JSON keeps inches (docs/CONTRACT.md, "Units and scale"), and says which
+  // unit the file used.
   const CommandResult json = run("cd " + std::string(ROTAFAB_SOURCE_DIR) + " && " + ROTAFAB_CLI + " profiles --json");
   EXPECT_NE(
       json.out.find(

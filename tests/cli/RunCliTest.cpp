@@ -1,6 +1,6 @@
 // `rotafab run` through the built program against the simulated GRBL: a
 // `make` output cut to the end with progress, the dry run's G-code, Ctrl-C
-// stopping safely, and one-line errors with SPEC's exit statuses.
+// stopping safely, and one-line errors with the contract's exit statuses (docs/CONTRACT.md).
 
 #include <gtest/gtest.h>
 

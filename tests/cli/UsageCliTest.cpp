@@ -1,6 +1,7 @@
-// Usage errors as a new user meets them: a mistyped command, a command of
-// SPEC's that is not built yet, an option of the woven structure with band, and a bad
-// option of a command, each one line with exit status 2 and the `--help` to read.
+// Usage errors as a new user meets them: a mistyped command, a command of the contract's
+// that is not built yet (docs/CONTRACT.md, "Command line"), an option of the woven
+// structure with band, and a bad option of a command, each one line with exit status 2
+// and the `--help` to read.
 
 #include <gtest/gtest.h>
 

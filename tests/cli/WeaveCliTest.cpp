@@ -1,9 +1,10 @@
 // `rotafab make MESH --structure weave` through the built program
-// (dissertation ch. IV): the soccer ball's 90 panels with SPEC's woven
-// manifest (each edge index `up` on one panel and `down` on two, `source`
-// naming the edge and its cycle), sheets Ghostscript reads, the assembly
-// steps thread by thread; single-cycle weaves; open meshes filled by
-// default; the weave's options refused with band and band's with weave.
+// (dissertation ch. IV): the soccer ball's 90 panels with the woven manifest
+// of docs/CONTRACT.md, "manifest.json (version 1)" (each edge index `up` on
+// one panel and `down` on two, `source` naming the edge and its cycle),
+// sheets Ghostscript reads, the assembly steps thread by thread; single-cycle
+// weaves; open meshes filled by default; the weave's options refused with
+// band and band's with weave.
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -20,14 +21,15 @@
 namespace rotafab::test {
 namespace {
 
-// SPEC's woven rule and what a builder needs of each panel: numbered 1..n
-// in order, panel k from edge k of cycle >= 1, on a sheet; `up` k on panel
-// k alone and each edge `down` on two panels; two holes (or one) of each of
-// its three crossings, the same count on the three panels of a crossing,
-// none nearer its outline than a diameter. Returns the cycles. With
-// `lapses`, what make warns of is counted there instead: crossings with no
-// holes on any of their panels (no room for them: glued), and up and down
-// numbers not etched (no room for them on a narrowed ribbon).
+// The woven rule (docs/CONTRACT.md, "manifest.json (version 1)") and what a
+// builder needs of each panel: numbered 1..n in order, panel k from edge k of
+// cycle >= 1, on a sheet; `up` k on panel k alone and each edge `down` on two
+// panels; two holes (or one) of each of its three crossings, the same count on
+// the three panels of a crossing, none nearer its outline than a diameter.
+// Returns the cycles. With `lapses`, what make warns of is counted there
+// instead: crossings with no holes on any of their panels (no room for them:
+// glued), and up and down numbers not etched (no room for them on a narrowed
+// ribbon).
 struct Lapses {
   size_t glued = 0, unlabelled = 0;
 };
@@ -93,7 +95,8 @@ std::set<int> expectWovenManifest(const nlohmann::json& m, size_t panels, Lapses
       for (const auto& hole : part->at("holes")) {
         const double nearest = distanceToOutline(outline, hole.at("xy")[0], hole.at("xy")[1]);
         EXPECT_TRUE(insideOutline(outline, hole.at("xy")[0], hole.at("xy")[1])) << "panel " << id;
-        // (The outline as written is within 0.0002 in of the planned one, SPEC.)
+        // (The outline as written is within 0.0002 in of the planned one:
+        // docs/sheets.md, "What `make` writes".)
         EXPECT_GE(nearest, hole.at("diameter").get<double>() - 2e-4) << "panel " << id;
       }
     }

@@ -1,10 +1,10 @@
 // A plain-woven structure end to end (dissertation ch. IV; docs/WEAVE.md,
-// M9-M11): one panel per edge, panel k over edge k; each edge number `up`
-// on one panel and `down` on two (SPEC's woven rule), with an underlined
-// neighbour number naming a panel under it; two holes per crossing on each
-// of its three panels, the three of each position on one line through the
-// stacked ribbons; every crossing fastened once, with two fasteners, at
-// the step of its last panel.
+// M9-M11): one panel per edge, panel k over edge k; each edge number `up` on
+// one panel and `down` on two (the woven rule, docs/CONTRACT.md,
+// "manifest.json (version 1)"), with an underlined neighbour number naming a
+// panel under it; two holes per crossing on each of its three panels, the three
+// of each position on one line through the stacked ribbons; every crossing
+// fastened once, with two fasteners, at the step of its last panel.
 #include "geometry/WeaveStructure.h"
 
 #include <gtest/gtest.h>
@@ -93,7 +93,8 @@ TEST(WeaveStructure, TheSoccerBallIsNinetyPanelsEachOverItsEdgeAndUnderTwo) {
     for (const auto& [edge, count] : holes) EXPECT_EQ(count, 2) << "edge " << edge;
     EXPECT_EQ(holes.count(panel.id), 1U);
   }
-  // SPEC: each edge index `up` on one panel and `down` on two.
+  // docs/CONTRACT.md, "manifest.json (version 1)": each edge index `up` on one
+  // panel and `down` on two.
   for (int e = 1; e <= 90; ++e) {
     EXPECT_EQ(up[e], 1) << e;
     EXPECT_EQ(down[e], 2) << e;

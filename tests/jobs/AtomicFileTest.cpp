@@ -1,6 +1,6 @@
-// SPEC: no partial output files left behind on failure. A file written
-// atomically is either complete or absent (or still the old one), and the
-// temporary file never outlives the call.
+// docs/CONTRACT.md, "Command line": no partial output, files written whole
+// or not at all. A file written atomically is either complete or absent (or
+// still the old one), and the temporary file never outlives the call.
 
 #include "toolpath/AtomicFile.h"
 
