@@ -108,6 +108,17 @@ struct Shape {
   double rotation = 0;
 };
 
+// Discs of one radius inside a polygon (Poles.cpp). The largest: a grid
+// search for the point farthest from the boundary, refined around the best
+// point, its radius the distance from there rounded down to `radiusStep`.
+// Then up to `maxDiscs - 1` more of that radius, each at the grid point with
+// room for it that is farthest from the centres so far, while that is at
+// least a radius away. Every radius is a true distance to the boundary, so
+// every disc is inside.
+std::pair<cInt, std::vector<IntPoint>> clearDiscs(const Path& polygon, cInt radiusStep, int maxDiscs = 5);
+// The poles of a polygon (see Shape::poles; Poles.cpp), at most `most`.
+std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most);
+
 // `forNoFitPolygons`: with the convex pieces and discs only the bottom-left
 // packer needs. `turnedFrom`, the same part's shape in another rotation:
 // for a quarter turn from a quarter turn, the whole shape is turned on the

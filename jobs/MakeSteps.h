@@ -1,0 +1,50 @@
+#pragma once
+// The steps of make's pipeline (MakeJob.h) that have files of their own:
+// the mesh's preparation (MeshPreparation.cpp) and the structure built at
+// the size asked or chosen (StructureSizing.cpp); the pipeline itself is
+// MakeJob.cpp. Not an interface of its own: MakeJob.h is.
+
+#include <optional>
+#include <string>
+
+#include "core/WorkContext.h"
+#include "geometry/PolygonMesh.h"
+#include "geometry/Structure.h"
+#include "jobs/MakeJob.h"
+#include "jobs/Manifest.h"
+
+namespace rotafab::jobs::making {
+
+inline const char* plural(int n) { return n == 1 ? "" : "s"; }
+
+// The mesh as read, checked, repaired, merged and simplified as asked, its
+// holes filled if asked, at construction size; `counts` says what it was and what was done.
+geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context);
+
+// How the structure's size was chosen, when make chose it.
+struct Sizing {
+  double grown = 1;         // times the default size (1: as it was)
+  bool bedLimited = false;  // limited by the bed or by the narrowest bands, which are glued
+};
+
+// The sides of the box of the structure as built (its panels in 3D).
+geometry::Point3 builtSize(const geometry::Structure& structure);
+
+// What to add to a refusal when the mesh's holes were capped with one face
+// each: such a cap across a wide or bent hole folds back over its
+// neighbours or makes panels as wide as the hole, and a patch avoids it.
+std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh);
+
+// A plain-woven structure (dissertation ch. IV) of the mesh as built. The
+// ribbons follow the surface within the offset, so --size scales the mesh;
+// with no size or scale given it grows until every crossing has room for
+// its two holes.
+geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
+                               const core::WorkContext& context);
+
+// A band structure (dissertation ch. V) of the mesh as built, sized the same
+// way. `start`: the flood fill's first face in the mesh as built.
+geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
+                                   Sizing& sizing, const core::WorkContext& context);
+
+}  // namespace rotafab::jobs::making
