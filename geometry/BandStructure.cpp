@@ -638,16 +638,7 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
   context.parallelFor(mesh.faceCount(), [&](size_t number) {
     result.panels[number] = bandPanel(b, holes, font, static_cast<int>(number), unfittedOf[number]);
   });
-  std::vector<std::string> unfitted;
-  for (auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
-  if (!unfitted.empty()) {
-    std::string some;
-    for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];
-    result.warnings.push_back(fmt::format("{} label{} not etched, too large for {} band even at {} in: {}{}",
-                                          unfitted.size(), unfitted.size() == 1 ? " is" : "s are",
-                                          unfitted.size() == 1 ? "its" : "their", kSmallestLabel, some,
-                                          unfitted.size() > 3 ? ", ..." : ""));
-  }
+  if (auto warning = unetchedLabelsWarning(unfittedOf, "band")) result.warnings.push_back(std::move(*warning));
   result.steps = stepsInPanelOrder(result.panels);
   return result;
 }

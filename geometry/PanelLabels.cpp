@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "geometry/FastenerHoles.h"
 
 namespace rotafab::geometry {
@@ -140,6 +142,18 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     }
   }
   return std::nullopt;
+}
+
+std::optional<std::string> unetchedLabelsWarning(const std::vector<std::vector<std::string>>& unfittedOf,
+                                                 const std::string& strip) {
+  std::vector<std::string> unfitted;
+  for (const auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
+  if (unfitted.empty()) return std::nullopt;
+  std::string some;
+  for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];
+  return fmt::format("{} label{} not etched, too large for {} {} even at {} in: {}{}", unfitted.size(),
+                     unfitted.size() == 1 ? " is" : "s are", unfitted.size() == 1 ? "its" : "their", strip,
+                     kSmallestLabel, some, unfitted.size() > 3 ? ", ..." : "");
 }
 
 }  // namespace rotafab::geometry

@@ -45,4 +45,10 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
                                const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
                                const std::vector<Point2>& candidates);
 
+// The warning for labels that fit nowhere, even at kSmallestLabel (one
+// list per panel, built in parallel): "N labels are not etched, too large
+// for their `strip` even at 0.06 in: ..."; none when every label fits.
+std::optional<std::string> unetchedLabelsWarning(const std::vector<std::vector<std::string>>& unfittedOf,
+                                                 const std::string& strip);
+
 }  // namespace rotafab::geometry

@@ -382,16 +382,7 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
 // in three (refused: nobody could cut and build them) or were cut apart.
 void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf, const std::vector<char>& stillFolded,
                  const PolygonMesh& mesh, const WeaveOptions& options, Structure& result) {
-  std::vector<std::string> unfitted;
-  for (const auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
-  if (!unfitted.empty()) {
-    std::string some;
-    for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];
-    result.warnings.push_back(fmt::format("{} label{} not etched, too large for {} ribbon even at {} in: {}{}",
-                                          unfitted.size(), unfitted.size() == 1 ? " is" : "s are",
-                                          unfitted.size() == 1 ? "its" : "their", kSmallestLabel, some,
-                                          unfitted.size() > 3 ? ", ..." : ""));
-  }
+  if (auto warning = unetchedLabelsWarning(unfittedOf, "ribbon")) result.warnings.push_back(std::move(*warning));
   std::vector<int> overlapping;
   for (size_t k = 0; k < result.panels.size(); ++k) {
     if (stillFolded[k]) overlapping.push_back(result.panels[k].id);
