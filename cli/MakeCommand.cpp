@@ -51,13 +51,13 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const
   fmt::print("{}: {} panel{} on {} sheet{} ({:.1f}% of the usable bed area), {} fastener{}; written to {}/\n",
              options.mesh, panels, panels == 1 ? "" : "s", sheets, sheets == 1 ? "" : "s", 100 * job.sheets.utilization,
              fasteners, fasteners == 1 ? "" : "s", job.folder.string());
-  if (const auto& simplified = job.mesh.simplified) {
-    if (simplified->simplified()) {
-      fmt::print("  panels asked: {}; the mesh simplified from {} faces to {}\n", simplified->asked,
-                 simplified->facesBefore, simplified->facesAfter);
+  if (const auto& count = job.mesh.panelCount) {
+    const geometry::Remeshing& remeshing = count->remeshing;
+    if (remeshing.remeshed) {
+      fmt::print("  panels asked: {}; the mesh remeshed from {} faces to {} even triangles\n", count->asked,
+                 remeshing.facesBefore, remeshing.facesAfter);
     } else {
-      fmt::print("  panels asked: {}; the mesh has {} faces, not simplified\n", simplified->asked,
-                 simplified->facesAfter);
+      fmt::print("  panels asked: {}; the mesh has {} faces, kept as drawn\n", count->asked, remeshing.facesAfter);
     }
   }
   fmt::print("  built, {:.1f} x {:.1f} x {:.1f} in; {}\n", job.size.x(), job.size.y(), job.size.z(),

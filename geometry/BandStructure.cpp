@@ -151,6 +151,12 @@ struct BandBuild {
     return mesh.sourceFaceIndex(f) >= 0 ? fmt::format("face {}", mesh.sourceFaceIndex(f))
                                         : std::string("the face filling a hole");
   }
+  // The error with the vertices of its bands' edges in the mesh (not the file's numbers).
+  [[nodiscard]] NoRoomForHoleError withPlaces(NoRoomForHoleError error) const {
+    error.places.clear();
+    for (int e : error.edges) error.places.push_back({rs.origin(2 * e), rs.target(2 * e)});
+    return error;
+  }
   // Edges as a user finds them in the file: by their two vertices.
   [[nodiscard]] std::string edgeName(int e) const {
     return fmt::format("the edge between vertices {} and {}", mesh.sourceVertexIndex(rs.origin(2 * e)),
@@ -248,7 +254,12 @@ void OverlapMending::mendFace(int f) {
       if (mostRoom > 0 && !options.glueBandsWithoutRoom) {
         NoRoomForHoleError error(what, 1, 1.02 / mostRoom, options.fastener, options.names);
         error.estimate = true;
-        throw error;
+        // (Mended where the band is, or else anywhere about the face.)
+        error.edges = {flat[f].bands[j].edge};
+        for (const FlatBand& other : flat[f].bands) {
+          if (other.edge >= 0 && other.edge != flat[f].bands[j].edge) error.edges.push_back(other.edge);
+        }
+        throw b_.withPlaces(error);
       }
       // A tab glued where it has no room for its hole and bands may be glued.
       if (options.glueBandsWithoutRoom &&
@@ -625,9 +636,14 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
   result.edges = numberEdges(b);
 
   context.report({"geometry", "fastener holes", 0, static_cast<size_t>(result.edges)});
-  const std::vector<BandHoles> holes = placeFastenerHoles(
-      b.bands, b.flat, options.fastener, context, [&](int e) { return b.edgeName(e); }, options.names,
-      options.glueBandsWithoutRoom);
+  std::vector<BandHoles> holes;
+  try {
+    holes = placeFastenerHoles(
+        b.bands, b.flat, options.fastener, context, [&](int e) { return b.edgeName(e); }, options.names,
+        options.glueBandsWithoutRoom);
+  } catch (NoRoomForHoleError& error) {
+    throw b.withPlaces(error);
+  }
   countFasteners(b, holes, mended, result);
 
   context.report({"geometry", "labels", 0, static_cast<size_t>(mesh.faceCount())});

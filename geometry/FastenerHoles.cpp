@@ -278,22 +278,26 @@ void glueBand(std::vector<BandHoles>& result, const std::vector<EdgeBand>& bands
 
 // Every band without room, in one error: the first by edge, how many, and
 // the scale that gives the smallest of them room.
-void throwIfWithoutRoom(const std::vector<std::optional<BandTooSmall>>& tooSmall, double diameter,
-                        const ParameterNames& names) {
+void throwIfWithoutRoom(const std::vector<EdgeBand>& bands, const std::vector<std::optional<BandTooSmall>>& tooSmall,
+                        double diameter, const ParameterNames& names) {
   const BandTooSmall* first = nullptr;
   int small = 0;
   double scaleNeeded = 1;
   std::vector<double> scales;
-  for (const auto& some : tooSmall) {
+  std::vector<int> edges;
+  for (size_t e = 0; e < tooSmall.size(); ++e) {
+    const auto& some = tooSmall[e];
     if (!some) continue;
     if (!first) first = &*some;
     ++small;
     scaleNeeded = std::max(scaleNeeded, some->scaleNeeded);
     scales.push_back(some->scaleNeeded);
+    edges.push_back(bands[e].edge);
   }
   if (first) {
     NoRoomForHoleError error(first->what, small, scaleNeeded, diameter, names);
     error.scales = std::move(scales);
+    error.edges = std::move(edges);
     throw error;
   }
 }
@@ -339,7 +343,11 @@ void placeAgainBesideEarlierBands(const std::vector<EdgeBand>& bands, const std:
       try {
         result[band.edge] = BandHolePlacer(band, panels, diameter, holesOn, edgeName).place();
       } catch (const BandTooSmall& small) {
-        if (!glueWithoutRoom) throw NoRoomForHoleError(small.what, 1, small.scaleNeeded, diameter, names);
+        if (!glueWithoutRoom) {
+          NoRoomForHoleError error(small.what, 1, small.scaleNeeded, diameter, names);
+          error.edges = {band.edge};
+          throw error;
+        }
         glueBand(result, bands, static_cast<size_t>(band.edge));
       }
     }
@@ -378,7 +386,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
       if (tooSmall[e]) glueBand(result, bands, e), tooSmall[e].reset();
     }
   }
-  throwIfWithoutRoom(tooSmall, diameter, names);
+  throwIfWithoutRoom(bands, tooSmall, diameter, names);
   placeAgainBesideEarlierBands(bands, panels, diameter, edgeName, names, glueWithoutRoom, result);
   return result;
 }

@@ -74,6 +74,10 @@ class NoRoomForHoleError : public std::invalid_argument {
   int bands;                     // how many have no room
   bool estimate = false;         // scaleNeeded may not be enough (a tab's room stops growing)
   std::vector<double> scales;    // what each band without room needs, scaleNeeded the largest
+  std::vector<int> edges;        // the edge numbers of the bands without room, as `placeFastenerHoles` has them
+  // Their edges' two vertices in the mesh built (filled by the structure's
+  // builder), for mending the design there (MeshMending.h).
+  std::vector<std::array<int, 2>> places;
 };
 
 // One entry per edge (boundary edges: edge -1, no holes). `panels` indexed

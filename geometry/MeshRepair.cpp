@@ -247,9 +247,16 @@ std::string MeshRepair::line() const {
     what = fmt::format("split {} bow-tie vert{} into one copy per fan of faces", count, one ? "ex" : "ices");
   } else if (kind == "orient") {
     what = fmt::format("reversed {} face{} to orient the surface consistently and outwards", count, one ? "" : "s");
+  } else if (kind == "merge-narrow-band") {
+    what = fmt::format("merged the two faces beside {} band{} too narrow for a fastener into one panel each", count,
+                       one ? "" : "s");
+  } else if (kind == "collapse-short-edge") {
+    what = fmt::format("collapsed {} short edge{} or sliver{} whose band had no room for a fastener", count,
+                       one ? "" : "s", one ? "" : "s");
   } else {
     what = fmt::format("{}: {}", kind, count);
   }
+  if (moved > 0) what += fmt::format(", moving the surface at most {:.2g} in", moved);
   std::string open;
   if (leftOpen > 0) {
     open = fmt::format("; {} side{} of them left open, where no two faces belonged together", leftOpen,

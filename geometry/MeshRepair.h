@@ -39,6 +39,7 @@ struct MeshRepair {
   int count = 0;      // of the elements repaired
   std::string first;  // "vertex 44", "edge (12, 57)", "face 9" (the file's numbering)
   int leftOpen = 0;   // split-nonmanifold-edge: edge sides that no other face closes (an inner wall's)
+  double moved = 0;   // a mend of the design (MeshMending.h): the farthest a vertex moved, inches
 
   // One line for people: "split 2 bow-tie vertices (the first: vertex 44)".
   [[nodiscard]] std::string line() const;

@@ -26,6 +26,10 @@ std::string parameterInWords(Parameter parameter) {
       return "ribbon width";
     case Parameter::Offset:
       return "ribbon offset";
+    case Parameter::KeepFaces:
+      return "faces kept as drawn";
+    case Parameter::GlueNarrow:
+      return "narrow bands glued";
   }
   return "parameter";
 }

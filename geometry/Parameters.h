@@ -14,20 +14,22 @@ enum class Parameter {
   Holes,          // what to do with an open mesh's holes: keep, fill, refuse
   Repair,         // whether to repair a broken mesh (MeshRepair.h) or refuse it
   MergeCoplanar,  // the angle within which adjacent faces are merged into one (CoplanarMerge.h)
-  Panels,         // the face count the mesh is simplified to (Simplification.h)
+  Panels,         // the panel count the mesh is remeshed for (Remeshing.h)
   Size,           // the largest side of the structure
   Scale,          // inches per mesh unit
   Fastener,       // the fastener hole's diameter
   Start,          // the flood fill's first face
   Width,          // a woven ribbon's share of its edge region across it
   Offset,         // how far a woven ribbon stands over or under the surface
+  KeepFaces,      // keep every face as drawn: no short edge collapsed to give a band room (MeshMending.h)
+  GlueNarrow,     // glue the bands that have no room for a fastener, rather than refuse
 };
 
 // How messages name a parameter.
 using ParameterNames = std::function<std::string(Parameter)>;
 
 // In words: "structure", "holes", "repair", "coplanar merge angle", "panel count", "structure size", "scale", "fastener
-// diameter", "start face", "ribbon width", "ribbon offset".
+// diameter", "start face", "ribbon width", "ribbon offset", "faces kept as drawn", "narrow bands glued".
 std::string parameterInWords(Parameter parameter);
 
 // A parameter's value that cannot be built with; the message names it as

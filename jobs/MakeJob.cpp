@@ -20,7 +20,6 @@
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/Simplification.h"
 #include "geometry/WeaveStructure.h"
 #include "geometry/io/MeshImport.h"
 #include "jobs/OutputFolder.h"
@@ -113,7 +112,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   Sizing sizing;
   job.structure = request.structure == geometry::StructureKind::Weave
                       ? builtWeave(request, mesh, sizing, context)
-                      : builtStructure(request, mesh, job.mesh.start, sizing, context);
+                      : builtStructure(request, mesh, job.mesh, sizing, context);
   for (const auto& note : job.structure.notes) context.note(fmt::format("{}: {}", name, note));
   for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
@@ -204,7 +203,7 @@ nlohmann::ordered_json summaryJson(const PlannedJob& job) {
                                       {"nesting", s.nesting},
                                       {"estimate", s.estimate},
                                       {"writing", s.writing}}}};
-  if (job.mesh.simplified) summary["simplified"] = simplifiedJson(*job.mesh.simplified);
+  if (job.mesh.panelCount) summary["simplified"] = simplifiedJson(*job.mesh.panelCount);
   summary["size"] = {job.size.x(), job.size.y(), job.size.z()};
   summary["stability"] = stabilityJson(job.stability);
   summary["cost"] = costJson(job.cost);

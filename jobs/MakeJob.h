@@ -46,7 +46,7 @@ struct MakeRequest {
   // (geometry/CoplanarMerge.h); by default 1 for an STL file (triangles
   // only), off (0) for every other format.
   std::optional<double> mergeCoplanar;
-  // Simplify to about this many faces, one panel each (geometry/Simplification.h).
+  // Remesh to even triangles that give about this many panels (geometry/Remeshing.h).
   std::optional<int> panels;
   // --repair auto (docs/CONTRACT.md, "Command line"; geometry/MeshRepair.h);
   // false: none, a broken mesh is refused.
@@ -58,6 +58,10 @@ struct MakeRequest {
   std::optional<int> start;
   int up = 1;
   bool scoreFolds = false;
+  // No mend of the design (geometry/MeshMending.h): a band without room stops the job.
+  bool keepFaces = false;
+  // A band without room even after mending is glued, not refused.
+  bool glueNarrow = false;
   // The plain weave's (geometry/WeaveStructure.h); `samples` too, per Bézier segment.
   std::optional<double> width;  // default: geometry::RibbonShape's, narrowed where ribbons would meet
   double curve = 0.6;

@@ -171,8 +171,8 @@ const std::vector<MakeOption>& makeOptionTable() {
                  &M::mergeCoplanar)
           .within(0.0, 45.0),
       MakeOption("panels", V::Whole,
-                 "Simplify the mesh to about this many faces, one panel each (quadric edge collapse that keeps the "
-                 "shape, the genus and the boundary; polygons become triangles)",
+                 "Remesh to even triangles that give about this many panels (N faces for band, about 2N/3 for\n"
+                 "weave, a panel an edge), keeping the shape, the genus, the boundary and sharp creases",
                  &M::panels)
           .within(4, 10000000),
       MakeOption("tension", V::Number,
@@ -212,6 +212,16 @@ const std::vector<MakeOption>& makeOptionTable() {
           .only(OptionFor::Band),
       MakeOption("up", V::Choice, "The vertical axis, for the lowest face", &M::up).among({"x", "y", "z"}).shown(),
       MakeOption("score-folds", V::Flag, "Score the folds between each vertex band and its bands", &M::scoreFolds)
+          .only(OptionFor::Band),
+      MakeOption("keep-faces", V::Flag,
+                 "Keep every face as drawn: a band with no room for its fastener stops the job, rather than its\n"
+                 "short edge or the sliver beside it being collapsed (a repair, listed in manifest.json)",
+                 &M::keepFaces)
+          .only(OptionFor::Band),
+      MakeOption("glue-narrow", V::Flag,
+                 "Glue the bands that have no room for a fastener even after mending, rather than stop the job\n"
+                 "(manifest.txt lists them)",
+                 &M::glueNarrow)
           .only(OptionFor::Band),
       MakeOption("time", V::Number,
                  "Nesting time budget in seconds, first layout included: the best layout found\n"
@@ -405,6 +415,10 @@ std::string flagOf(geometry::Parameter parameter) {
       return "--width";
     case geometry::Parameter::Offset:
       return "--offset";
+    case geometry::Parameter::KeepFaces:
+      return "--keep-faces";
+    case geometry::Parameter::GlueNarrow:
+      return "--glue-narrow";
   }
   return "--" + geometry::parameterInWords(parameter);
 }
@@ -438,6 +452,8 @@ MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalog
   request.start = options.start;
   request.up = options.up == "x" ? 0 : options.up == "y" ? 1 : 2;
   request.scoreFolds = options.scoreFolds;
+  request.keepFaces = options.keepFaces;
+  request.glueNarrow = options.glueNarrow;
   request.width = options.width;
   if (options.curve) request.curve = *options.curve;
   if (!options.offset.empty()) request.offset = lengthOption(options.offset, "--offset", true);

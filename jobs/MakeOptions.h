@@ -31,7 +31,7 @@ struct MakeOptions {
   std::optional<int> start, panels;
   int samples = 8, window = 8, evaluations = 0;
   double seconds = kDefaultNestingSeconds;
-  bool json = false, scoreFolds = false;
+  bool json = false, scoreFolds = false, keepFaces = false, glueNarrow = false;
   // The options given, by name ("order", "machine"): an --order given is
   // kept even where the free order would save a sheet; a --machine given
   // must be the device's.

@@ -17,7 +17,7 @@ namespace rotafab::jobs::making {
 
 inline const char* plural(int n) { return n == 1 ? "" : "s"; }
 
-// The mesh as read, checked, repaired, merged and simplified as asked, its
+// The mesh as read, checked, repaired, merged and remeshed as asked, its
 // holes filled if asked, at construction size; `counts` says what it was and what was done.
 geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context);
 
@@ -42,9 +42,15 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
 geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
                                const core::WorkContext& context);
 
-// A band structure (dissertation ch. V) of the mesh as built, sized the same
-// way. `start`: the flood fill's first face in the mesh as built.
-geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
+// A band structure (dissertation ch. V) of the mesh as built, at the size
+// asked (--size within half a percent, --scale exactly) or the default,
+// grown by at most 10% where that alone gives every band room for its
+// fastener. A band still without room has its short edge or a sliver beside
+// it collapsed (MeshMending.h; not with --keep-faces), recorded among
+// `built`'s repairs; where no mend gives it room, the bands are glued with
+// --glue-narrow, or make stops with the size and the fastener at which it
+// builds as drawn. `built.start`: the flood fill's first face.
+geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
 
 }  // namespace rotafab::jobs::making

@@ -45,13 +45,19 @@ nlohmann::ordered_json sourceOf(const geometry::PanelSource& source) {
 nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   for (const geometry::MeshRepair& repair : repairs) {
-    list.push_back({{"kind", repair.kind}, {"count", repair.count}, {"first", repair.first}});
+    nlohmann::ordered_json item = {{"kind", repair.kind}, {"count", repair.count}, {"first", repair.first}};
+    if (repair.moved > 0) item["moved"] = std::round(repair.moved * 10000) / 10000;
+    list.push_back(std::move(item));
   }
   return list;
 }
 
-nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified) {
-  return {{"asked", simplified.asked}, {"faces", simplified.facesAfter}};
+nlohmann::ordered_json simplifiedJson(const PanelCount& count) {
+  const geometry::Remeshing& remeshing = count.remeshing;
+  nlohmann::ordered_json json = {
+      {"asked", count.asked}, {"faces", remeshing.facesAfter}, {"remeshed", remeshing.remeshed}};
+  if (remeshing.remeshed) json["smallest_face"] = std::round(remeshing.smallestAreaRatio * 1000) / 1000;
+  return json;
 }
 
 nlohmann::ordered_json stabilityJson(const geometry::Stability& stability) {
@@ -104,7 +110,7 @@ nlohmann::ordered_json manifestHead(const geometry::Structure& structure, const 
                       {"faces", mesh.faces},
                       {"genus", mesh.genus ? nlohmann::ordered_json(*mesh.genus) : nlohmann::ordered_json(nullptr)}};
   if (!mesh.repairs.empty()) manifest["repairs"] = repairsJson(mesh.repairs);
-  if (mesh.simplified) manifest["simplified"] = simplifiedJson(*mesh.simplified);
+  if (mesh.panelCount) manifest["simplified"] = simplifiedJson(*mesh.panelCount);
   manifest["bed"] = {{"width", bed.width}, {"height", bed.height}, {"margin", bed.margin}};
   manifest["fasteners"] = structure.fasteners;
   const std::vector<std::pair<int, int>> owners = partOwners(structure);

@@ -12,7 +12,7 @@
 
 #include "core/WorkContext.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/Simplification.h"
+#include "geometry/Remeshing.h"
 #include "geometry/Stability.h"
 #include "geometry/Structure.h"
 #include "jobs/Part.h"
@@ -21,6 +21,14 @@
 
 namespace rotafab::jobs {
 
+// A panel count asked (`--panels N`): the mesh remeshed to the faces that
+// give about N panels (one a face for a band structure, one an edge for a
+// woven one), or kept as drawn where it had about that many.
+struct PanelCount {
+  int asked = 0;  // panels
+  geometry::Remeshing remeshing;
+};
+
 // The mesh as built (repaired, its holes filled if asked): the manifest's
 // "mesh" counts (docs/CONTRACT.md, "manifest.json (version 1)"), and the
 // repairs made to it ("repairs", named and counted).
@@ -28,8 +36,8 @@ struct BuiltMesh {
   int vertices = 0, edges = 0, faces = 0;
   std::optional<int> genus;
   std::vector<geometry::MeshRepair> repairs;
-  std::optional<geometry::Simplification> simplified;  // when a panel count was asked
-  std::optional<int> start;  // the flood fill's first face as asked, or the face it was merged into
+  std::optional<PanelCount> panelCount;  // when a panel count was asked
+  std::optional<int> start;              // the flood fill's first face as asked, or the face it was merged into
 };
 
 // The manifest's "repairs" (docs/CONTRACT.md, "manifest.json (version 1)"):
@@ -37,8 +45,10 @@ struct BuiltMesh {
 nlohmann::ordered_json repairsJson(const std::vector<geometry::MeshRepair>& repairs);
 
 // The manifest's "simplified" (docs/CONTRACT.md, "manifest.json (version 1)"):
-// {"asked": N, "faces": M}, the faces the mesh was left with.
-nlohmann::ordered_json simplifiedJson(const geometry::Simplification& simplified);
+// {"asked": N panels, "faces": M, the faces the mesh was left with,
+// "remeshed": whether it was remeshed, "smallest_face": the smallest face's
+// area over the median's}.
+nlohmann::ordered_json simplifiedJson(const PanelCount& count);
 
 // The manifest's "stability" (docs/CONTRACT.md, "manifest.json (version 1)"):
 // {"stands", "margin", "center_of_mass", "mass_kg" (null when the material's

@@ -329,7 +329,7 @@ std::string headline(const nlohmann::ordered_json& manifest) {
 }
 
 // What the builders should know before they start, from the manifest's
-// optional keys: how the mesh was repaired and simplified, and whether the
+// optional keys: how the mesh was repaired and remeshed, and whether the
 // structure will stand or must be hung. One sentence each.
 std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
   std::vector<std::string> notes;
@@ -337,15 +337,19 @@ std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
     notes.push_back(fmt::format("It takes {}.", costLine(costFromJson(manifest.at("cost")))));
   if (manifest.contains("repairs")) {
     for (const auto& repair : manifest.at("repairs")) {
-      const geometry::MeshRepair made{repair.at("kind").get<std::string>(), repair.at("count").get<int>(),
-                                      repair.at("first").get<std::string>()};
+      geometry::MeshRepair made{repair.at("kind").get<std::string>(), repair.at("count").get<int>(),
+                                repair.at("first").get<std::string>()};
+      made.moved = repair.value("moved", 0.0);
       notes.push_back(fmt::format("The mesh was repaired: {}.", made.line()));
     }
   }
   if (manifest.contains("simplified")) {
     const auto& simplified = manifest.at("simplified");
-    notes.push_back(fmt::format("The mesh was simplified to {} faces ({} panels asked).",
-                                simplified.at("faces").get<int>(), simplified.at("asked").get<int>()));
+    // ("remeshed" is absent from the manifests of versions that simplified by collapses.)
+    const bool remeshed = simplified.value("remeshed", false);
+    notes.push_back(fmt::format("The mesh was {} {} faces ({} panels asked).",
+                                remeshed ? "remeshed to" : "simplified to", simplified.at("faces").get<int>(),
+                                simplified.at("asked").get<int>()));
   }
   if (manifest.contains("stability")) {
     const auto& stability = manifest.at("stability");

@@ -18,7 +18,7 @@
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/Simplification.h"
+#include "geometry/Remeshing.h"
 #include "geometry/WeaveStructure.h"
 #include "geometry/io/MeshImport.h"
 
@@ -43,39 +43,50 @@ namespace {
 
 using geometry::Parameter;
 
-// --panels N: the mesh simplified to about N faces (after the merge of
-// coplanar faces, so that flat regions are taken first and nothing merges
-// the count down after), its topology checked to be the same.
-geometry::Simplification simplifiedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
-                                        geometry::MeshAnalysis& analysis, const core::WorkContext& context) {
+// --panels N: the mesh remeshed to even triangles that give about N panels
+// (after the merge of coplanar faces and the filling of holes, so that the
+// count is the one built), its topology checked to be the same. A band
+// structure has a panel a face; a woven one a panel an edge, and a closed
+// triangle mesh has 3/2 edges a face.
+PanelCount remeshedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh, geometry::MeshAnalysis& analysis,
+                        const core::WorkContext& context) {
   const std::string name = request.mesh.string();
   const geometry::MeshTopology before = analysis.topology;
-  geometry::Simplification simplified;
+  PanelCount count;
+  count.asked = *request.panels;
+  const bool woven = request.structure == geometry::StructureKind::Weave;
+  const int faces = woven ? std::max(1, static_cast<int>(std::lround(count.asked * 2.0 / 3.0))) : count.asked;
   try {
-    simplified = geometry::simplifyMesh(mesh, *request.panels, context);
+    count.remeshing = geometry::remeshEvenly(mesh, faces, context);
   } catch (const geometry::InvalidMeshError& error) {
     throw core::UserError(fmt::format("{}: {}", name, error.what()));
   } catch (const std::invalid_argument& error) {
     throw core::UserError(
         fmt::format("{}: {} {}: {}", name, request.names(Parameter::Panels), *request.panels, error.what()));
   }
-  if (!simplified.simplified()) {
-    context.note(fmt::format("{}: {} faces, no more than the {} asked: not simplified", name, simplified.facesBefore,
-                             simplified.asked));
-    return simplified;
+  const geometry::Remeshing& remeshing = count.remeshing;
+  if (!remeshing.remeshed) {
+    context.note(fmt::format("{}: {} faces, within {:g}% of the {} asked: kept as drawn", name, remeshing.facesBefore,
+                             100 * geometry::kKeptAsDrawn, remeshing.asked));
+    return count;
   }
   analysis = geometry::analyzeMesh(mesh);
   const geometry::MeshTopology& after = analysis.topology;
   if (after.genus != before.genus || after.components != before.components ||
       after.boundaryLoops != before.boundaryLoops || !analysis.problems.empty()) {
-    // The decimater refuses every collapse that changes the topology; this is the proof.
-    throw core::UserError(fmt::format("{}: simplified to {} faces it would not keep its topology; build it without {}",
-                                      name, simplified.facesAfter, request.names(Parameter::Panels)));
+    // No collapse breaks the link condition; this is the proof.
+    throw core::UserError(fmt::format("{}: remeshed to {} faces it would not keep its topology; build it without {}",
+                                      name, remeshing.facesAfter, request.names(Parameter::Panels)));
   }
-  context.note(fmt::format("{}: simplified from {} faces{} to {} ({} asked), keeping its genus and boundary", name,
-                           simplified.facesBefore, simplified.triangulated ? " (polygons split into triangles)" : "",
-                           simplified.facesAfter, simplified.asked));
-  return simplified;
+  const double diagonal = geometry::boundingBoxDiagonal(mesh);
+  context.note(fmt::format(
+      "{}: remeshed from {} faces to {} even triangles{}, keeping its genus, boundary{} (the surface within {:.2g}% "
+      "of its size; the smallest face {:.0f}% of the median's)",
+      name, remeshing.facesBefore, remeshing.facesAfter,
+      woven ? fmt::format(" ({} panels asked, one an edge)", count.asked) : fmt::format(" ({} asked)", count.asked),
+      remeshing.creaseEdges > 0 ? fmt::format(" and {} crease edges", remeshing.creaseEdges) : "",
+      diagonal > 0 ? 100 * remeshing.largestMove / diagonal : 0.0, 100 * remeshing.smallestAreaRatio));
+  return count;
 }
 
 }  // namespace
@@ -149,13 +160,11 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
     }
   }
   // After the holes are filled, so that their caps are among the faces counted.
-  std::optional<geometry::Simplification> simplified;
-  if (request.panels) {
-    simplified = simplifiedMesh(request, mesh, analysis, context);
-  }
+  std::optional<PanelCount> panelCount;
+  if (request.panels) panelCount = remeshedMesh(request, mesh, analysis, context);
   // The mesh as built (after --holes fill): one panel per face.
   const geometry::MeshTopology& topology = analysis.topology;
-  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs), simplified, start};
+  counts = {topology.vertices, topology.edges, topology.faces, topology.genus, std::move(repairs), panelCount, start};
   double scale = 0;
   try {
     scale = geometry::constructionScale(mesh, request.size, request.scale, request.names);

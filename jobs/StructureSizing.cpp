@@ -7,6 +7,8 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <optional>
 #include <regex>
 
 #include "core/UserError.h"
@@ -17,8 +19,8 @@
 #include "geometry/FastenerHoles.h"
 #include "geometry/HoleFilling.h"
 #include "geometry/MeshAnalysis.h"
+#include "geometry/MeshMending.h"
 #include "geometry/MeshRepair.h"
-#include "geometry/Simplification.h"
 #include "geometry/WeaveStructure.h"
 #include "geometry/io/MeshImport.h"
 
@@ -47,6 +49,264 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
                                    names(Parameter::Fastener), smaller, larger, verb, places)
                      : fmt::format("{} or larger {} give every {} room", larger, verb, places);
 }
+
+// The default size grows by at most this much (10%) to give every band its
+// fastener; past that, the narrow places are mended where they are.
+constexpr double kMostGrowth = 1.10;
+// Rounds of mends (each mends each band without room once), at most, and
+// rounds in a row that leave no fewer bands without room before make stops.
+constexpr int kMendRounds = 40;
+constexpr int kStalledRounds = 3;
+// Mends are made only where at most this share of the bands have no room.
+constexpr double kMostMendedShare = 0.4;
+// --size is kept within this share.
+constexpr double kSizeTolerance = 0.005;
+
+// --size is the structure's largest side (docs/CONTRACT.md, "Units and
+// scale"), and the structure is smaller than the mesh (its vertex bands are
+// cut back at the corners), by a ratio that does not depend on the scale:
+// measured on a first build (glued, so that no band's room stops it), then
+// the mesh scaled by it.
+void scaleToBuiltSize(geometry::PolygonMesh& mesh, double size, geometry::BandOptions band,
+                      const core::WorkContext& context) {
+  band.glueBandsWithoutRoom = true;
+  const double side = builtSize(geometry::buildBandStructure(mesh, band, context)).maxCoeff();
+  if (side > 0) {
+    for (geometry::Point3& p : mesh.positions) p *= size / side;
+  }
+}
+
+// Mends the design where each band of `error` has no room (MeshMending.h;
+// `merges`: faces may be merged where no edge collapses), if that keeps the mesh usable and its topology; adds what it
+// did to `mends`. Returns whether it did anything.
+bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHoleError& error, bool merges,
+                       geometry::Mends& mends) {
+  if (error.places.empty()) return false;
+  geometry::PolygonMesh before = mesh;
+  const geometry::Mends made = geometry::mendNarrowPlaces(mesh, error.places, merges);
+  if (made.count() == 0) return false;
+  const geometry::MeshAnalysis was = geometry::analyzeMesh(before), is = geometry::analyzeMesh(mesh);
+  if (!is.usable() || is.topology.genus != was.topology.genus || is.topology.components != was.topology.components ||
+      is.topology.boundaryLoops != was.topology.boundaryLoops) {
+    mesh = std::move(before);
+    return false;
+  }
+  for (const auto& [sum, add] : {std::pair{&mends.collapsed, &made.collapsed}, {&mends.merged, &made.merged}}) {
+    if (sum->count == 0) sum->first = add->first;
+    sum->count += add->count;
+    sum->moved = std::max(sum->moved, add->moved);
+  }
+  return true;
+}
+
+// The mends, among the repairs of the mesh as built, said, and its counts as built.
+void recordMends(const geometry::Mends& mends, geometry::PolygonMesh& mesh, BuiltMesh& built, const std::string& name,
+                 const core::WorkContext& context) {
+  for (const geometry::MeshRepair* made : {&mends.collapsed, &mends.merged}) {
+    if (made->count == 0) continue;
+    context.note(fmt::format("{}: repaired: {}", name, made->line()));
+    built.repairs.push_back(*made);
+  }
+  const geometry::MeshTopology topology = geometry::analyzeMesh(mesh).topology;
+  built.vertices = topology.vertices;
+  built.edges = topology.edges;
+  built.faces = topology.faces;
+}
+
+// The edges between two faces, about (a boundary edge counts half).
+double innerEdges(const geometry::PolygonMesh& mesh) {
+  double sides = 0;
+  for (const auto& face : mesh.faces) sides += static_cast<double>(face.size());
+  return sides / 2;
+}
+
+// What make says when bands have no room and no mend gives it: the size,
+// and the fastener at this size, at which every band of `mesh` (as drawn,
+// before any mend) has room, found by building it (every length of the
+// structure scales with it); the fastener alone where that size's panels
+// miss the bed.
+std::string triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh,
+                        const geometry::BandOptions& band, const core::WorkContext& context) {
+  const auto& names = request.names;
+  geometry::PolygonMesh larger = mesh;
+  try {
+    const geometry::GrownStructure grown = geometry::buildBandStructureWithRoom(larger, band, context);
+    const double smaller = std::floor(band.fastener / grown.grown * 1000) / 1000;
+    const double side = std::ceil(builtSize(grown.structure).maxCoeff());
+    const std::string size = fmt::format("{} {:.0f}in", names(Parameter::Size), side);
+    const std::string glue = fmt::format("{} glues them", names(Parameter::GlueNarrow));
+    const double kerf = request.kerf.value_or(request.material.kerf);
+    if (roomOnTheBed(structureParts(grown.structure), request.machine, kerf) < 1) {
+      // (Every length scales with the structure: the same at this size with a fastener that much smaller.)
+      return smaller > 0
+                 ? fmt::format(
+                       "{} {:.3f}in or smaller builds it at this size (tried at {:.0f} in with this "
+                       "fastener, where a panel is larger than the bed); {}",
+                       names(Parameter::Fastener), smaller, side, glue)
+                 : fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed; {}", side, glue);
+    }
+    return smaller > 0 ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size; {}", size,
+                                     names(Parameter::Fastener), smaller, glue)
+                       : fmt::format("{} or larger builds it as drawn (tried); {}", size, glue);
+  } catch (const geometry::NoRoomForHoleError& error) {
+    return roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true);
+  }
+}
+
+// The band structure at the size asked or the default, mended where its
+// bands have no room (builtStructure(), MakeSteps.h).
+class MendingBuild {
+ public:
+  MendingBuild(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built, Sizing& sizing,
+               const core::WorkContext& context)
+      : request_(request),
+        mesh_(mesh),
+        built_(built),
+        sizing_(sizing),
+        context_(context),
+        name_(request.mesh.string()) {
+    band_.tension = request.tension;
+    band_.samples = request.samples;
+    band_.fastener = request.fastener.value_or(request.material.fastenerDiameter);
+    band_.start = built.start;
+    band_.up = request.up;
+    band_.scoreFolds = request.scoreFolds;
+    band_.names = request.names;
+  }
+
+  geometry::Structure build() {
+    if (request_.size) scaleToBuiltSize(mesh_, *request_.size, band_, context_);
+    asDrawn_ = mesh_;
+    for (int round = 0;; ++round) {
+      try {
+        geometry::Structure structure = geometry::buildBandStructure(mesh_, band_, context_);
+        if (resizedAfterMending(structure)) continue;
+        return finished(std::move(structure));
+      } catch (const geometry::NoRoomForHoleError& error) {
+        // The default size grows by at most kMostGrowth, where that alone gives every band room.
+        const bool scaleChosen = !request_.size && !request_.scale;
+        if (scaleChosen && round == 0 && !error.estimate && error.scaleNeeded <= kMostGrowth) {
+          for (geometry::Point3& p : mesh_.positions) p *= error.scaleNeeded;
+          sizing_.grown = error.scaleNeeded;
+          continue;
+        }
+        if (mended(error)) continue;
+        return withoutRoom(error);
+      } catch (const std::invalid_argument&) {
+        if (!unmended_) throw;
+        if (retriedWithoutMerges()) continue;
+        return withoutRoom(*lastError_);
+      } catch (const geometry::InvalidMeshError&) {
+        // (A merged face split again along a diagonal an edge has already.)
+        if (!unmended_) throw;
+        if (retriedWithoutMerges()) continue;
+        return withoutRoom(*lastError_);
+      }
+    }
+  }
+
+ private:
+  // What the mesh was before the last mend, and why it was mended.
+  struct Unmended {
+    geometry::PolygonMesh mesh;
+    geometry::Mends mends;
+    geometry::NoRoomForHoleError error;
+  };
+
+  // The last mend made a design that cannot be built (two faces merged
+  // into one too far from planar): undone, and mended again with collapses
+  // alone; after those, no more mends. Says whether it mended again.
+  bool retriedWithoutMerges() {
+    mesh_ = std::move(unmended_->mesh);
+    mends_ = unmended_->mends;
+    lastError_ = unmended_->error;
+    unmended_.reset();
+    if (merges_) {
+      merges_ = false;
+      if (mended(*lastError_)) return true;
+    }
+    mendsStopped_ = true;
+    return false;
+  }
+
+  bool mended(const geometry::NoRoomForHoleError& error) {
+    if (request_.keepFaces || mendsStopped_ || ++rounds_ > kMendRounds) return false;
+    // Where most bands have no room, the fastener is too large for the
+    // design: mending them all would make another shape.
+    if (!error.estimate && error.bands > kMostMendedShare * innerEdges(mesh_)) return false;
+    // Rounds go on while they leave fewer bands without room (a tab's
+    // error, which names one band and stops the build there, does not count).
+    if (!error.estimate) {
+      if (error.bands < fewest_) {
+        fewest_ = error.bands;
+        stalled_ = 0;
+      } else if (++stalled_ >= kStalledRounds) {
+        return false;
+      }
+    }
+    unmended_ = Unmended{mesh_, mends_, error};
+    if (!mendedWhereNarrow(mesh_, error, merges_, mends_)) return false;
+    context_.report({"geometry", "narrow bands mended", static_cast<size_t>(mends_.count()), 0});
+    return true;
+  }
+
+  // A mend moves a few vertices, and may move the box's side a little: --size kept.
+  bool resizedAfterMending(const geometry::Structure& structure) {
+    if (!request_.size || mends_.count() == 0 || resized_) return false;
+    const double side = builtSize(structure).maxCoeff();
+    if (!(side > 0) || std::abs(side / *request_.size - 1) <= kSizeTolerance) return false;
+    for (geometry::Point3& p : mesh_.positions) p *= *request_.size / side;
+    resized_ = true;
+    return true;
+  }
+
+  geometry::Structure finished(geometry::Structure structure) {
+    if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, context_);
+    if (sizing_.grown > 1) {
+      context_.note(fmt::format(
+          "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.0f}% larger, {:.1f} in at its largest side): at "
+          "that size every band has room for its {:.3f} in fastener; {} or {} sets the size",
+          name_, geometry::kMeanEdgeInches * sizing_.grown, geometry::kMeanEdgeInches, 100 * (sizing_.grown - 1),
+          builtSize(structure).maxCoeff(), band_.fastener, request_.names(Parameter::Size),
+          request_.names(Parameter::Scale)));
+    }
+    return structure;
+  }
+
+  // Bands without room that no mend gives room: glued if asked, else the job refused with a way out.
+  geometry::Structure withoutRoom(const geometry::NoRoomForHoleError& error) {
+    const auto& names = request_.names;
+    if (request_.glueNarrow) {
+      band_.glueBandsWithoutRoom = true;
+      geometry::Structure glued = finished(geometry::buildBandStructure(mesh_, band_, context_));
+      const size_t n = glued.glued.size();
+      glued.warnings.push_back(fmt::format("{} band{} without room for a {:.3f} in fastener {} glued, as {} asks", n,
+                                           plural(static_cast<int>(n)), band_.fastener, n == 1 ? "is" : "are",
+                                           names(Parameter::GlueNarrow)));
+      return glued;
+    }
+    const std::string after = mends_.count() > 0   ? fmt::format(" after {} narrow place{} mended", mends_.count(),
+                                                               mends_.count() == 1 ? " was" : "s were")
+                              : request_.keepFaces ? fmt::format(" ({} keeps every face)", names(Parameter::KeepFaces))
+                                                   : std::string();
+    throw core::UserError(fmt::format("{}: {}{}; {}", name_, error.bandsWithoutRoom, after,
+                                      triedAdvice(request_, asDrawn_, band_, context_)));
+  }
+
+  const MakeRequest& request_;
+  geometry::PolygonMesh& mesh_;
+  geometry::PolygonMesh asDrawn_;  // at the size asked, before any mend
+  BuiltMesh& built_;
+  Sizing& sizing_;
+  const core::WorkContext& context_;
+  const std::string name_;
+  geometry::BandOptions band_;
+  geometry::Mends mends_;
+  std::optional<Unmended> unmended_;
+  std::optional<geometry::NoRoomForHoleError> lastError_;
+  bool resized_ = false, mendsStopped_ = false, merges_ = true;
+  int rounds_ = 0, stalled_ = 0, fewest_ = std::numeric_limits<int>::max();
+};
 
 }  // namespace
 
@@ -166,126 +426,19 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
   }
 }
 
-geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, std::optional<int> start,
+geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context) {
-  const std::string name = request.mesh.string();
-  geometry::BandOptions band;
-  band.tension = request.tension;
-  band.samples = request.samples;
-  band.fastener = request.fastener.value_or(request.material.fastenerDiameter);
-  band.start = start;
-  band.up = request.up;
-  band.scoreFolds = request.scoreFolds;
-  band.names = request.names;
-  // With no size or scale given, the structure grows until every band has room for its fastener.
-  const bool scaleChosen = !request.size && !request.scale;
-  const double defaultSide = geometry::boundingBoxSize(mesh).maxCoeff();
-  const auto grownBy = [&] { return geometry::boundingBoxSize(mesh).maxCoeff() / defaultSide; };
-  const double kerf = request.kerf.value_or(request.material.kerf);
-  const auto roomOnTheBedFor = [&](const geometry::Structure& structure) {
-    return roomOnTheBed(structureParts(structure), request.machine, kerf);
-  };
-  const auto sized = [&](const std::string& why, const geometry::Structure& structure) {
-    return fmt::format(
-        "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.1f} in at its largest side), {}; {} N, fewer and "
-        "evener faces, may need less; {} or {} sets the size",
-        name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches, builtSize(structure).maxCoeff(), why,
-        request.names(Parameter::Panels), request.names(Parameter::Size), request.names(Parameter::Scale));
-  };
   try {
-    if (request.size) {
-      // --size is the structure's largest side (docs/CONTRACT.md,
-      // "Units and scale"), and the structure is smaller than the mesh (its
-      // vertex bands are cut back at the corners), by a ratio that does not
-      // depend on the scale: measured on a first build (glued, so that no
-      // band's room stops it), then the mesh scaled by it.
-      geometry::BandOptions measuring = band;
-      measuring.glueBandsWithoutRoom = true;
-      const double side = builtSize(geometry::buildBandStructure(mesh, measuring, context)).maxCoeff();
-      if (side > 0) {
-        for (geometry::Point3& p : mesh.positions) p *= *request.size / side;
-      }
-    }
-    if (!scaleChosen) return geometry::buildBandStructure(mesh, band, context);
-    std::optional<geometry::GrownStructure> built;
-    int narrow = 0;
-    std::optional<geometry::NoRoomForHoleError> noRoom;
-    try {
-      built = geometry::buildBandStructureWithRoom(mesh, band, context);
-      narrow = built->bandsWithoutRoom;
-    } catch (const geometry::NoRoomForHoleError& error) {
-      narrow = error.bands;
-      noRoom = error;
-    }
-    sizing.grown = grownBy();
-    if (built && (sizing.grown <= 1 || roomOnTheBedFor(built->structure) >= 1)) {
-      if (sizing.grown > 1) {
-        context.note(sized(fmt::format("the smallest size at which every band has room for its {:.3f} in fastener "
-                                       "hole {:g} diameter from every outline ({} band{} had none: narrow faces)",
-                                       band.fastener, geometry::kLeastClearance, narrow, narrow == 1 ? "" : "s"),
-                           built->structure));
-      }
-      return std::move(built->structure);
-    }
-    // The size at which every band has room misses the bed, or growing did
-    // not find one: the largest size that fits the bed, no smaller than the
-    // default, and the bands still without room glued.
-    band.glueBandsWithoutRoom = true;
-    // Nor larger than needed: a few slivers may ask for a size many times
-    // any other band's. At most the size at which all but one band in a
-    // hundred have room (each band without room at the default size said
-    // how much larger it needs to be).
-    std::vector<double> scales = built ? built->scalesNeeded : noRoom ? noRoom->scales : std::vector<double>{};
-    std::sort(scales.begin(), scales.end(), std::greater<>());
-    size_t sides = 0;
-    for (const auto& face : mesh.faces) sides += face.size();
-    const size_t mayGlue = sides / 2 / 100;  // of the edges, about
-    if (mayGlue < scales.size() && scales[mayGlue] < grownBy()) {
-      const double shrink = std::max(scales[mayGlue], 1.0) / grownBy();
-      for (geometry::Point3& p : mesh.positions) p *= shrink;
-    }
-    geometry::Structure glued;
-    constexpr int kShrinkAttempts = 3;
-    for (int attempt = 1;; ++attempt) {
-      glued = geometry::buildBandStructure(mesh, band, context);
-      const double room = roomOnTheBedFor(glued);
-      if (room >= 1 || attempt == kShrinkAttempts || grownBy() <= 1) break;
-      // (1% to spare: a tab's and a label's sizes do not grow with the rest)
-      const double shrink = std::max(0.99 * room, 1 / grownBy());
-      for (geometry::Point3& p : mesh.positions) p *= shrink;
-      context.report({"geometry", "smaller, for the bed", static_cast<size_t>(attempt), 0});
-    }
-    // Glue alone is not what a fastener was chosen for: then the size at
-    // which the fasteners fit, and the error that it misses the bed.
-    if (glued.fasteners == 0) {
-      if (noRoom) throw *noRoom;
-      sizing.grown = grownBy();
-      for (geometry::Point3& p : mesh.positions) p *= built->grown / sizing.grown;
-      sizing.grown = grownBy();
-      return std::move(built->structure);
-    }
-    sizing.grown = grownBy();
-    sizing.bedLimited = true;
-    if (sizing.grown > 1) {
-      const size_t n = glued.glued.size();
-      context.note(sized(
-          fmt::format("at most the largest size that fits the bed and that at which all but 1 in 100 bands have room "
-                      "for its {:.3f} in fastener; {} band{} without room {} glued (narrow faces)",
-                      band.fastener, n, n == 1 ? "" : "s", n == 1 ? "is" : "are"),
-          glued));
-    }
-    return glued;
+    return MendingBuild(request, mesh, built, sizing, context).build();
   } catch (const geometry::NoRoomForHoleError& error) {
-    if (error.estimate) {
-      throw core::UserError(
-          fmt::format("{}: {}; a larger {} may give it room, or split that face in the mesh, or "
-                      "simplify the mesh ({} N)",
-                      name, error.bandsWithoutRoom, request.names(Parameter::Size), request.names(Parameter::Panels)));
-    }
-    throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
-                                      roomAdvice(request, mesh, band.fastener, error.scaleNeeded)));
+    // (The measuring build of --size glues; a tab's estimate may still be thrown.)
+    const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
+    throw core::UserError(fmt::format("{}: {}; {}", request.mesh.string(), error.bandsWithoutRoom,
+                                      roomAdvice(request, mesh, fastener, error.scaleNeeded, "band", error.estimate)));
   } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+    throw core::UserError(fmt::format("{}: {}", request.mesh.string(), error.what()));
+  } catch (const geometry::InvalidMeshError& error) {
+    throw core::UserError(fmt::format("{}: {}", request.mesh.string(), error.what()));
   }
 }
 

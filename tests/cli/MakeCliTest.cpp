@@ -284,30 +284,43 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 
 // Meshes nobody here wrote, from Debian's packages and npm, through `make`
 // with the default mesh options (repaired, merged, sized as make chooses),
-// and through every invariant of docs/CONTRACT.md's manifest: CGAL's cow (a bow-tie
-// vertex, and a panel that would overlap itself with a shallow vertex band),
-// pig, triple torus, elephant (106 holes) and mushroom (open); the npm
-// teapot (open, a bow-tie); STLs OpenSCAD and another program wrote; CGAL's
-// L-shaped prism (a panel that overlaps itself at a reflex corner) and
-// "mpi" (polygons far from planar), whose faces are split; and meshes whose
-// narrowest bands would need a size that misses the bed, so that some are
-// glued: CGAL's anchor, and its boeing, whose sliver triangles leave no
-// room even for a tab's hole. The layout in rows, at once: how fast nesting
-// is does not matter here.
+// and through every invariant of docs/CONTRACT.md's manifest: CGAL's cow (a
+// bow-tie vertex, slivers, and a panel that would overlap itself with a
+// shallow vertex band), elephant (106 holes) and mushroom (open); STLs OpenSCAD and another program wrote; CGAL's
+// L-shaped prism (a panel that overlaps itself at a reflex corner). Each is built at the default size, grown by at most
+// 10%, its narrow places mended where they are (repairs in manifest.json), no band glued. Those no mend gives room
+// (CGAL's pig, triple torus, "mpi" (polygons far from planar) and anchor (slivers everywhere: too many to mend); the
+// npm teapot) are refused with a size, or a fastener, that was tried, and that builds them as drawn. The layout in
+// rows, at once: how fast nesting is does not matter here.
 TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
-  std::vector<std::string> meshes = {cgalMesh("pig.off"),
-                                     cgalMesh("3torus.off"),
-                                     (kSource / "tests/data/external/teapot.obj").string(),
-                                     "/usr/share/openscad/testdata/scad/3D/features/import.stl",
-                                     "/usr/share/assimp/models/STL/sphereWithHole.stl",
-                                     cgalMesh("corner_poly.off"),
-                                     cgalMesh("mpi.off"),
-                                     cgalMesh("anchor.off")};
+  std::vector<std::string> meshes = {"/usr/share/openscad/testdata/scad/3D/features/import.stl",
+                                     "/usr/share/assimp/models/STL/sphereWithHole.stl", cgalMesh("corner_poly.off")};
+  std::vector<std::string> refused = {cgalMesh("pig.off"), cgalMesh("3torus.off"), cgalMesh("mpi.off"),
+                                      cgalMesh("anchor.off"), (kSource / "tests/data/external/teapot.obj").string()};
 #ifndef ROTAFAB_SANITIZED
-  // The four of 2,300 to 2,900 faces take a minute or more each under the
+  // The three of 2,300 to 2,900 faces take a minute or more each under the
   // sanitizers, which the smaller ones above exercise the same code with.
-  for (const char* large : {"cow.off", "elephant.off", "mushroom.off", "boeing.off"}) meshes.push_back(cgalMesh(large));
+  for (const char* large : {"cow.off", "elephant.off", "mushroom.off"}) meshes.push_back(cgalMesh(large));
 #endif
+  for (const std::string& where : refused) {
+    SCOPED_TRACE(where);
+    TempDir dir;
+    const std::string mesh = quoted(publicMesh(where));
+    const CommandResult made =
+        run(kCli + " make " + mesh + " --structure band --layout rows --out " + quoted(dir.path() / "out"));
+    EXPECT_EQ(made.status, 1) << made.err;
+    std::smatch advice;
+    ASSERT_TRUE(std::regex_search(made.err, advice,
+                                  std::regex(R"((--size \d+in) or larger builds it as drawn \(tried\))"
+                                             R"(|(--fastener \S+) or smaller builds it at this size \(tried)")))
+        << made.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
+    // As drawn: with --keep-faces too.
+    const std::string option = advice[1].matched ? advice[1].str() : advice[2].str();
+    const CommandResult followed = run(kCli + " make " + mesh + " --structure band --layout rows " + option +
+                                       " --keep-faces --out " + quoted(dir.path() / "followed"));
+    EXPECT_EQ(followed.status, 0) << option << ": " << followed.err;
+  }
   for (const std::string& where : meshes) {
     SCOPED_TRACE(where);
     TempDir dir;
@@ -322,50 +335,55 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
     const int split = std::regex_search(made.err, warned, std::regex(R"((\d+) faces? split in two)"))
                           ? std::stoi(warned[1].str())
                           : 0;
-    const int glued =
-        std::regex_search(made.err, warned, std::regex(R"((\d+) bands? ha(s|ve) no room for a \S+ in fastener hole)"))
-            ? std::stoi(warned[1].str())
-            : 0;
-    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split, glued);
-    if (glued > 0) {
-      // The size is the largest at which every part fits the bed, and the steps say which joins to glue.
-      EXPECT_NE(made.err.find("the largest size that fits the bed"), std::string::npos) << made.err;
-      const std::string steps = readFile(dir.path() / "out/manifest.txt");
-      std::ptrdiff_t glueSteps = 0;
-      for (size_t at = steps.find("(glue it: no room for a fastener"); at != std::string::npos;
-           at = steps.find("(glue it: no room for a fastener", at + 1)) {
-        ++glueSteps;
-      }
-      EXPECT_EQ(glueSteps, glued) << "each glued band is one join, at the later of its two panels";
-    }
+    expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split, 0);
+    EXPECT_EQ(made.err.find(" glued"), std::string::npos) << "no band glued unless asked: " << made.err;
+    const double grown =
+        std::regex_search(made.err, warned, std::regex(R"(\((\d+)% larger,)")) ? std::stod(warned[1].str()) : 0;
+    EXPECT_LE(grown, 10) << made.err;
     EXPECT_TRUE(m.at("stability").contains("stands"));
     EXPECT_TRUE(m.at("mesh").at("genus").is_number()) << "repaired into an orientable manifold";
     if (where.ends_with("cow.off")) {
-      EXPECT_EQ(m.at("repairs"), nlohmann::json::parse(R"([{"kind":"split-bowtie","count":1,"first":"vertex 44"}])"));
-      bool pieces = false;
-      for (const auto& panel : m.at("panels")) pieces = pieces || panel.contains("pieces");
-      EXPECT_TRUE(pieces) << "the cow's panel that would overlap itself has a band cut off";
-    }
-    if (where.ends_with("anchor.off") || where.ends_with("boeing.off")) {
-      EXPECT_GT(glued, 0) << "at the size at which every band has room, a part misses the bed";
-    }
-    if (where.ends_with("boeing.off")) {
-      // Sliver triangles, too thin for a tab's hole: the band is cut off and its tab glued.
-      EXPECT_NE(made.err.find("tabs are glued"), std::string::npos) << made.err;
-      EXPECT_NE(readFile(dir.path() / "out/manifest.txt").find("first glue piece "), std::string::npos);
-    }
-    if (where.ends_with("corner_poly.off")) {
-      // An L-shaped face: the bands at its reflex corner overlap, and no
-      // tab can be cut from a vertex band that is not convex. The face is
-      // split in two along a diagonal, and the parts are joined by the new
-      // edge's band, fastened as any other (each edge's holes, both panels).
-      EXPECT_EQ(split, 1) << made.err;
-      EXPECT_NE(made.err.find("(the first: face 1)"), std::string::npos) << made.err;
-      int ofFaceOne = 0;
-      for (const auto& panel : m.at("panels")) ofFaceOne += panel.at("source").at("face") == 1;
-      EXPECT_EQ(ofFaceOne, 2);
+      EXPECT_EQ(m.at("repairs")[0], nlohmann::json::parse(R"({"kind":"split-bowtie","count":1,"first":"vertex 44"})"));
+      ASSERT_GE(m.at("repairs").size(), 2u);
+      EXPECT_EQ(m.at("repairs")[1].at("kind"), "collapse-short-edge");
+      EXPECT_GT(m.at("repairs")[1].at("moved").get<double>(), 0);
+      EXPECT_LT(m.at("repairs")[1].at("moved").get<double>(), 2.0) << "a sliver's short edge, not a part of the cow";
     }
   }
+}
+
+// --glue-narrow: the bands no mend gives room are glued, as asked, and the
+// steps say which joins to glue; --keep-faces mends nothing and refuses.
+TEST(MakeCli, NarrowBandsAreGluedOnlyWhenAsked) {
+  TempDir dir;
+  const std::string pig = quoted(publicMesh(cgalMesh("pig.off")));
+  const CommandResult glued = run(kCli + " make " + pig + " --structure band --layout rows --glue-narrow --out " +
+                                  quoted(dir.path() / "glued"));
+  ASSERT_EQ(glued.status, 0) << glued.err;
+  std::smatch warned;
+  ASSERT_TRUE(std::regex_search(glued.err, warned, std::regex(R"((\d+) bands? without room for a \S+ in fastener)")))
+      << glued.err;
+  const int count = std::stoi(warned[1].str());
+  EXPECT_GT(count, 0);
+  EXPECT_NE(glued.err.find("as --glue-narrow asks"), std::string::npos) << glued.err;
+  const std::string steps = readFile(dir.path() / "glued/manifest.txt");
+  int glueSteps = 0;
+  for (size_t at = steps.find("(glue it: no room for a fastener"); at != std::string::npos;
+       at = steps.find("(glue it: no room for a fastener", at + 1)) {
+    ++glueSteps;
+  }
+  EXPECT_EQ(glueSteps, count) << "each glued band is one join, at the later of its two panels";
+  const auto m = nlohmann::json::parse(readFile(dir.path() / "glued/manifest.json"));
+  const int unlabelled = std::regex_search(glued.err, warned, std::regex(R"((\d+) labels? (is|are) not etched)"))
+                             ? std::stoi(warned[1].str())
+                             : 0;
+  expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, 0, count);
+
+  const CommandResult kept =
+      run(kCli + " make " + pig + " --structure band --layout rows --keep-faces --out " + quoted(dir.path() / "kept"));
+  EXPECT_EQ(kept.status, 1) << kept.err;
+  EXPECT_NE(kept.err.find("(--keep-faces keeps every face)"), std::string::npos) << kept.err;
+  EXPECT_EQ(kept.err.find("repaired: collapsed"), std::string::npos) << kept.err;
 }
 
 TEST(MakeCli, ManifestCommandPrintsTheSteps) {
@@ -554,32 +572,30 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   fails(mesh + " --structure band --tension 1.5", 1, "tension");
   fails(mesh + " --structure band --start 32", 1, "--start 32");
   fails(mesh + " --structure band --size 20in --fastener 2in", 1, "no room for a 2.000 in fastener hole");
-  // With no size given, the ball grows until its bands have room, as long as its panels fit the bed.
-  fails(mesh + " --structure band --fastener 2in", 1,
-        "does not fit the usable area of 31.5 x 17.5 in any allowed rotation at 5.00 times the default size, the "
-        "smallest at which every band has room for its fastener; a smaller --fastener, or fewer and evener faces "
-        "(--panels N), needs less");
-  const CommandResult grown =
-      run(kCli + " make " + mesh + " --structure band --fastener 1in --time 0 --out " + quoted(dir.path() / "grown"));
-  EXPECT_EQ(grown.status, 0) << grown.err;
-  EXPECT_NE(grown.err.find("scaled to a mean edge of 5.00 in, not 2 in (21.7 in at its largest side), the smallest "
-                           "size at which every band has room for its 1.000 in fastener hole 1 diameter from every "
-                           "outline (90 bands had none: narrow faces); --panels N, fewer and evener faces, may need "
-                           "less; --size or --scale sets the size"),
-            std::string::npos)
-      << grown.err;
-  // At a size the user fixed, the error says which --fastener or --size would do, and either one does.
-  const CommandResult large = run(kCli + " make " + mesh + " --structure band --fastener 1in --size 12in --out " +
-                                  quoted(dir.path() / "large"));
-  std::smatch advice;
-  ASSERT_TRUE(std::regex_search(large.err, advice,
-                                std::regex(R"(\(nor have 89 other bands\); (--fastener \S+) or smaller, or )"
-                                           R"((--size \S+) or larger, would give every band room)")))
-      << large.err;
-  for (const auto& option : {advice[1].str(), "--fastener 1in " + advice[2].str()}) {
-    const CommandResult followed = run(kCli + " make " + mesh + " --structure band --time 0 " + option + " --out " +
-                                       quoted(dir.path() / "followed"));
-    EXPECT_EQ(followed.status, 0) << option << ": " << followed.err;
+  // With no size given, the ball grows by at most 10%; a fastener no band
+  // has room for is not mended away (the ball would be another shape): the
+  // error gives the size that was tried, and the fastener at this size, and
+  // either one builds it. A size whose panels miss the bed is not offered.
+  fails(mesh + " --structure band --fastener 2in", 1, "a panel is larger than the bed");
+  for (const std::string& asked : {std::string("--fastener 1in"), std::string("--fastener 1in --size 12in")}) {
+    SCOPED_TRACE(asked);
+    const CommandResult large =
+        run(kCli + " make " + mesh + " --structure band " + asked + " --out " + quoted(dir.path() / "large"));
+    EXPECT_EQ(large.status, 1) << large.err;
+    EXPECT_EQ(large.err.find("repaired"), std::string::npos) << large.err;
+    std::smatch advice;
+    ASSERT_TRUE(
+        std::regex_search(large.err, advice,
+                          std::regex(R"(\(nor have 89 other bands\); (--size \S+) or larger builds it as drawn )"
+                                     R"(\(tried\), or (--fastener \S+) at this size)")))
+        << large.err;
+    const std::string size = asked.find("--size") != std::string::npos ? " --size 12in" : "";
+    for (const auto& option : {advice[2].str() + size, "--fastener 1in " + advice[1].str()}) {
+      const CommandResult followed = run(kCli + " make " + mesh + " --structure band --time 0 " + option + " --out " +
+                                         quoted(dir.path() / "followed"));
+      EXPECT_EQ(followed.status, 0) << option << ": " << followed.err;
+      std::filesystem::remove_all(dir.path() / "followed");
+    }
   }
   fails(mesh + " --structure band --fastener big", 1, "--fastener big");
   fails(quoted(dir.path() / "none.obj") + " --structure band", 1, "none.obj");
@@ -680,8 +696,9 @@ TEST(MakeCli, AnStlCubeIsSixPanels) {
   EXPECT_NE(openscad.err.find("merged its 46 faces into 22"), std::string::npos) << openscad.err;
 }
 
-// --panels N: the bunny of 3,674 triangles as the 2,000 panels asked (+- 5%),
-// its genus kept; the summary and the manifest say what was asked and got.
+// --panels N: the bunny of 3,674 triangles remeshed to the 2,000 panels
+// asked (+- 5%), its genus kept; the summary and the manifest say what was
+// asked and got. A woven structure has a panel an edge: its count too.
 TEST(MakeCli, ThePanelCountIsTheOneAsked) {
   TempDir dir;
   const std::string bunny = quoted(kSource / "examples/bunny.obj");
@@ -693,19 +710,35 @@ TEST(MakeCli, ThePanelCountIsTheOneAsked) {
   EXPECT_NEAR(summary.at("panels").get<double>(), 2000, 100);
   EXPECT_EQ(summary.at("simplified").at("asked"), 2000);
   EXPECT_EQ(summary.at("simplified").at("faces"), summary.at("panels"));
-  EXPECT_NE(made.err.find("simplified from 3674 faces to "), std::string::npos) << made.err;
+  EXPECT_EQ(summary.at("simplified").at("remeshed"), true);
+  EXPECT_GE(summary.at("simplified").at("smallest_face").get<double>(), 1.0 / 3);
+  EXPECT_NE(made.err.find("remeshed from 3674 faces to 2000 even triangles"), std::string::npos) << made.err;
   const auto manifest = nlohmann::json::parse(readFile(dir.path() / "a/manifest.json"));
   EXPECT_EQ(manifest.at("simplified"), summary.at("simplified"));
   EXPECT_EQ(manifest.at("mesh").at("genus"), 0);
   EXPECT_EQ(manifest.at("mesh").at("faces"), summary.at("panels"));
   EXPECT_EQ(manifest.at("panels").size(), summary.at("panels").get<size_t>());
 
-  // The text summary says it too; a count above the faces leaves the mesh alone.
+  // The text summary says it too; a count above the faces splits them, one
+  // about the faces there are leaves the mesh as drawn.
   const CommandResult text = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
                                  " --structure band --panels 100 --time 0 --out " + quoted(dir.path() / "b"));
   ASSERT_EQ(text.status, 0) << text.err;
-  EXPECT_NE(text.out.find("panels asked: 100; the mesh has 6 faces, not simplified"), std::string::npos) << text.out;
-  EXPECT_NE(text.err.find("6 faces, no more than the 100 asked: not simplified"), std::string::npos) << text.err;
+  EXPECT_NE(text.out.find("100 panels on "), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("panels asked: 100; the mesh remeshed from 6 faces to 100 even triangles"), std::string::npos)
+      << text.out;
+  const CommandResult kept = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                 " --structure band --panels 6 --time 0 --out " + quoted(dir.path() / "k"));
+  ASSERT_EQ(kept.status, 0) << kept.err;
+  EXPECT_NE(kept.out.find("panels asked: 6; the mesh has 6 faces, kept as drawn"), std::string::npos) << kept.out;
+  EXPECT_NE(kept.err.find("6 faces, within 5% of the 6 asked: kept as drawn"), std::string::npos) << kept.err;
+  const CommandResult woven =
+      run(kCli + " make " + bunny + " --structure weave --panels 300 --layout rows --json --out " +
+          quoted(dir.path() / "w"));
+  ASSERT_EQ(woven.status, 0) << woven.err;
+  const auto weave = nlohmann::json::parse(woven.out);
+  EXPECT_NEAR(weave.at("panels").get<double>(), 300, 15);
+  EXPECT_EQ(weave.at("simplified").at("asked"), 300);
   const CommandResult bad =
       run(kCli + " make " + bunny + " --structure band --panels 2 --out " + quoted(dir.path() / "c"));
   EXPECT_EQ(bad.status, 2) << bad.err;
@@ -821,7 +854,8 @@ TEST(MakeCli, TheSummarySaysWhetherItStands) {
   EXPECT_LT(steps.find("It will tip over: its centre of mass is "), steps.find("step    1:")) << steps;
   EXPECT_NE(steps.find("Hang it from ("), std::string::npos) << steps;
   EXPECT_NE(readFile(dir.path() / "a/manifest.txt").find("It stands: its centre of mass is "), std::string::npos);
-  EXPECT_NE(readFile(dir.path() / "a/manifest.txt").find("The mesh was simplified to "), std::string::npos);
+  EXPECT_NE(readFile(dir.path() / "a/manifest.txt").find("The mesh was remeshed to 2000 faces (2000 panels asked)."),
+            std::string::npos);
   EXPECT_FALSE(leaning.at("stands").get<bool>());
   EXPECT_LT(leaning.at("margin").get<double>(), 0);
   EXPECT_EQ(leaning.at("hang_points").size(), 2u);
@@ -834,7 +868,7 @@ TEST(MakeCli, TheSummarySaysWhetherItStands) {
 TEST(MakeCli, InterruptStopsAtOnceAndWritesNothing) {
   // SIGINT in the first layout, SIGTERM while the parts' shapes are made.
   for (const auto& [signal, after] :
-       {std::pair<std::string, std::string>{"INT", "nesting: first layout"}, {"TERM", "make: nesting 3674"}}) {
+       {std::pair<std::string, std::string>{"INT", "nesting: first layout"}, {"TERM", "make: nesting [0-9]"}}) {
     TempDir dir;
     const auto out = dir.path() / "bunny", err = dir.path() / "err";
     const CommandResult r =

@@ -70,10 +70,17 @@ inline std::vector<Vec> samplesOf(const geometry::PolygonMesh& mesh, int steps) 
   return samples;
 }
 
-// The largest distance from a sample of `from` to the surface `to`.
-inline double oneSidedDistance(const geometry::PolygonMesh& from, const geometry::PolygonMesh& to, int steps) {
-  const std::vector<Triangle> triangles = trianglesOf(to);
+struct SampledDistances {
   double largest = 0;
+  double mean = 0;
+};
+
+// The largest and the mean distance from a sample of `from` to the surface `to`.
+inline SampledDistances sampledDistances(const geometry::PolygonMesh& from, const geometry::PolygonMesh& to,
+                                         int steps) {
+  const std::vector<Triangle> triangles = trianglesOf(to);
+  double largest = 0, sum = 0;
+  size_t count = 0;
   size_t hint = 0;  // the last sample's nearest triangle: a good first bound for the next
   for (const Vec& p : samplesOf(from, steps)) {
     double best = (closestOnTriangle(p, triangles[hint].a, triangles[hint].b, triangles[hint].c) - p).norm();
@@ -87,8 +94,15 @@ inline double oneSidedDistance(const geometry::PolygonMesh& from, const geometry
       }
     }
     largest = std::max(largest, best);
+    sum += best;
+    ++count;
   }
-  return largest;
+  return {largest, count > 0 ? sum / static_cast<double>(count) : 0};
+}
+
+// The largest distance from a sample of `from` to the surface `to`.
+inline double oneSidedDistance(const geometry::PolygonMesh& from, const geometry::PolygonMesh& to, int steps) {
+  return sampledDistances(from, to, steps).largest;
 }
 
 inline double hausdorffDistance(const geometry::PolygonMesh& a, const geometry::PolygonMesh& b, int steps = 3) {

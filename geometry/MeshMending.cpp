@@ -1,0 +1,278 @@
+#include "geometry/MeshMending.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <set>
+
+namespace rotafab::geometry {
+namespace {
+
+// No collapse turns a face by more than 60 degrees (the cosine).
+constexpr double kLeastNormalCosine = 0.5;
+// Two faces are merged across a band only where they turn from each other
+// by less than this: the panel bends that much (posterboard does).
+constexpr double kMostMergeDegrees = 30.0;
+
+Point3 normalOf(const std::vector<Point3>& corners) {
+  Point3 normal = Point3::Zero();
+  for (size_t i = 0; i < corners.size(); ++i) normal += corners[i].cross(corners[(i + 1) % corners.size()]);
+  return normal;
+}
+
+// The mesh's adjacency, as the collapses of one call need it: the faces
+// about each vertex, and the faces on each edge.
+class Collapser {
+ public:
+  explicit Collapser(PolygonMesh& mesh) : mesh_(mesh), facesOf_(mesh.positions.size()), moved_(facesOf_.size(), 0) {
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      const auto& face = mesh.faces[f];
+      for (size_t i = 0; i < face.size(); ++i) {
+        facesOf_[face[i]].push_back(f);
+        ++sides_[key(face[i], face[(i + 1) % face.size()])];
+      }
+    }
+    for (const auto& [edge, count] : sides_) {
+      if (count == 1) boundary_.insert(edge.first), boundary_.insert(edge.second);
+    }
+  }
+
+  [[nodiscard]] double length(int a, int b) const { return (mesh_.positions[a] - mesh_.positions[b]).norm(); }
+
+  // The faces on edge (a, b).
+  [[nodiscard]] std::vector<int> facesOn(int a, int b) const {
+    std::vector<int> on;
+    for (int f : facesOf_[a]) {
+      const auto& face = mesh_.faces[f];
+      for (size_t i = 0; i < face.size(); ++i) {
+        const int p = face[i], q = face[(i + 1) % face.size()];
+        if ((p == a && q == b) || (p == b && q == a)) on.push_back(f);
+      }
+    }
+    return on;
+  }
+
+  // The shortest side of face f.
+  [[nodiscard]] std::array<int, 2> shortestSide(int f) const {
+    const auto& face = mesh_.faces[f];
+    std::array<int, 2> best{face[0], face[1]};
+    for (size_t i = 0; i < face.size(); ++i) {
+      const int p = face[i], q = face[(i + 1) % face.size()];
+      if (length(p, q) < length(best[0], best[1])) best = {p, q};
+    }
+    return best;
+  }
+
+  // Where (a, b) would collapse to, if it may: its midpoint, or its end on
+  // the boundary when only one end is.
+  [[nodiscard]] std::optional<Point3> collapsePoint(int a, int b) const {
+    if (a == b || moved_[a] || moved_[b]) return std::nullopt;
+    const std::vector<int> on = facesOn(a, b);
+    if (on.empty()) return std::nullopt;
+    const bool boundaryA = boundary_.contains(a), boundaryB = boundary_.contains(b);
+    if (boundaryA && boundaryB && on.size() != 1) return std::nullopt;  // an inner edge across the boundary
+    // The link condition: a and b share no neighbour but the corners
+    // opposite the edge in its triangles; and no face holds both apart.
+    std::set<int> opposite;
+    for (int f : on) {
+      const auto& face = mesh_.faces[f];
+      if (face.size() == 3) {
+        for (int v : face) {
+          if (v != a && v != b) opposite.insert(v);
+        }
+      }
+    }
+    std::set<int> common;
+    const std::set<int> nearA = neighbours(a);
+    for (int v : neighbours(b)) {
+      if (nearA.contains(v)) common.insert(v);
+    }
+    if (common != opposite) return std::nullopt;
+    for (int f : facesOf_[a]) {
+      const auto& face = mesh_.faces[f];
+      if (std::find(face.begin(), face.end(), b) != face.end() && std::find(on.begin(), on.end(), f) == on.end()) {
+        return std::nullopt;
+      }
+    }
+    const Point3 target = boundaryA == boundaryB ? Point3((mesh_.positions[a] + mesh_.positions[b]) / 2)
+                                                 : mesh_.positions[boundaryA ? a : b];
+    // No face about either end turned by more than 60 degrees, nor left flat.
+    std::set<int> around(facesOf_[a].begin(), facesOf_[a].end());
+    around.insert(facesOf_[b].begin(), facesOf_[b].end());
+    for (int f : around) {
+      std::vector<Point3> before, after;
+      for (int v : mesh_.faces[f]) {
+        before.push_back(mesh_.positions[v]);
+        const Point3 p = v == a || v == b ? target : mesh_.positions[v];
+        if (after.empty() || !(after.back() - p).isZero(0)) after.push_back(p);
+      }
+      while (after.size() > 1 && (after.front() - after.back()).isZero(0)) after.pop_back();
+      if (after.size() < 3) continue;  // the face vanishes with the edge
+      const Point3 n0 = normalOf(before), n1 = normalOf(after);
+      if (n1.norm() <= 1e-9 * n0.norm()) return std::nullopt;
+      if (n0.normalized().dot(n1.normalized()) < kLeastNormalCosine) return std::nullopt;
+    }
+    return target;
+  }
+
+  // Collapses (a, b) to `target`: b's faces take a, and a face left with
+  // fewer than three corners is emptied (dropped by compact()). Returns
+  // the farthest either end moved.
+  double collapse(int a, int b, const Point3& target) {
+    const double moved = std::max((mesh_.positions[a] - target).norm(), (mesh_.positions[b] - target).norm());
+    // Every vertex whose adjacency this changes waits for the next call.
+    for (int v : neighbours(a)) moved_[v] = 1;
+    for (int v : neighbours(b)) moved_[v] = 1;
+    moved_[a] = moved_[b] = 1;
+    mesh_.positions[a] = target;
+    for (int f : facesOf_[b]) {
+      auto& face = mesh_.faces[f];
+      std::replace(face.begin(), face.end(), b, a);
+      face.erase(std::unique(face.begin(), face.end()), face.end());
+      while (face.size() > 1 && face.front() == face.back()) face.pop_back();
+      if (face.size() < 3) face.clear();
+      facesOf_[a].push_back(f);
+    }
+    facesOf_[b].clear();
+    return moved;
+  }
+
+  // Whether the two faces on inner edge (a, b) may become one: they share
+  // no other corner, and turn from each other by less than kMostMergeDegrees.
+  [[nodiscard]] bool mayMerge(int a, int b) const {
+    if (moved_[a] || moved_[b]) return false;
+    const std::vector<int> on = facesOn(a, b);
+    if (on.size() != 2 || on[0] == on[1]) return false;
+    const auto& f = mesh_.faces[on[0]];
+    const auto& g = mesh_.faces[on[1]];
+    for (int v : f) {
+      if (v != a && v != b && std::find(g.begin(), g.end(), v) != g.end()) return false;
+    }
+    const auto normal = [&](const std::vector<int>& face) {
+      std::vector<Point3> corners;
+      for (int v : face) corners.push_back(mesh_.positions[v]);
+      return normalOf(corners);
+    };
+    const Point3 n = normal(f), m = normal(g);
+    if (!(n.norm() > 0 && m.norm() > 0)) return false;
+    return n.normalized().dot(m.normalized()) >= std::cos(kMostMergeDegrees * std::numbers::pi / 180);
+  }
+
+  // The two faces on (a, b) made one: the first takes the second's corners
+  // past the edge, the second is emptied.
+  void merge(int a, int b) {
+    const std::vector<int> on = facesOn(a, b);
+    auto& f = mesh_.faces[on[0]];
+    auto& g = mesh_.faces[on[1]];
+    // Each face's corners from one end of the edge round to the other.
+    const auto from = [](const std::vector<int>& face, int first) {
+      const auto at = std::find(face.begin(), face.end(), first) - face.begin();
+      std::vector<int> walk;
+      for (size_t i = 0; i < face.size(); ++i) walk.push_back(face[(static_cast<size_t>(at) + i) % face.size()]);
+      return walk;
+    };
+    // f runs ... x, y ... along the edge; g runs y, x.
+    const auto next = [&](const std::vector<int>& face, int v) {
+      const auto at = std::find(face.begin(), face.end(), v) - face.begin();
+      return face[(static_cast<size_t>(at) + 1) % face.size()];
+    };
+    const int x = next(f, a) == b ? a : b, y = x == a ? b : a;
+    std::vector<int> merged = from(f, y);      // y ... x
+    const std::vector<int> rest = from(g, x);  // x ... y
+    merged.insert(merged.end(), rest.begin() + 1, rest.end() - 1);
+    for (int v : g) {
+      moved_[v] = 1;
+      for (int w : neighbours(v)) moved_[w] = 1;
+      if (std::find(facesOf_[v].begin(), facesOf_[v].end(), on[0]) == facesOf_[v].end()) facesOf_[v].push_back(on[0]);
+    }
+    for (int v : f) moved_[v] = 1;
+    f = std::move(merged);
+    g.clear();
+  }
+
+  // The faces emptied and the vertices no face uses, gone.
+  void compact() {
+    PolygonMesh kept;
+    std::vector<int> index(mesh_.positions.size(), -1);
+    for (int f = 0; f < mesh_.faceCount(); ++f) {
+      if (mesh_.faces[f].empty()) continue;
+      std::vector<int> face;
+      for (int v : mesh_.faces[f]) {
+        if (index[v] < 0) {
+          index[v] = kept.vertexCount();
+          kept.positions.push_back(mesh_.positions[v]);
+          kept.sourceVertex.push_back(mesh_.sourceVertexIndex(v));
+        }
+        face.push_back(index[v]);
+      }
+      kept.faces.push_back(std::move(face));
+      kept.sourceFace.push_back(mesh_.sourceFaceIndex(f));
+    }
+    mesh_ = std::move(kept);
+  }
+
+ private:
+  static std::pair<int, int> key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
+
+  [[nodiscard]] std::set<int> neighbours(int v) const {
+    std::set<int> near;
+    for (int f : facesOf_[v]) {
+      const auto& face = mesh_.faces[f];
+      for (size_t i = 0; i < face.size(); ++i) {
+        if (face[i] != v) continue;
+        near.insert(face[(i + 1) % face.size()]);
+        near.insert(face[(i + face.size() - 1) % face.size()]);
+      }
+    }
+    return near;
+  }
+
+  PolygonMesh& mesh_;
+  std::vector<std::vector<int>> facesOf_;
+  std::map<std::pair<int, int>, int> sides_;
+  std::set<int> boundary_;
+  std::vector<char> moved_;
+};
+
+}  // namespace
+
+Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges) {
+  Mends mends;
+  MeshRepair& repair = mends.collapsed;
+  MeshRepair& merged = mends.merged;
+  Collapser collapser(mesh);
+  for (const auto& [u, v] : places) {
+    if (u < 0 || v < 0 || u >= mesh.vertexCount() || v >= mesh.vertexCount()) continue;
+    std::vector<std::array<int, 2>> candidates{{u, v}};
+    for (int f : collapser.facesOn(u, v)) candidates.push_back(collapser.shortestSide(f));
+    std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& p, const auto& q) {
+      return collapser.length(p[0], p[1]) < collapser.length(q[0], q[1]);
+    });
+    bool mended = false;
+    for (const auto& [a, b] : candidates) {
+      const std::optional<Point3> target = collapser.collapsePoint(a, b);
+      if (!target) continue;
+      if (repair.count == 0) {
+        repair.first = fmt::format("edge ({}, {})", mesh.sourceVertexIndex(a), mesh.sourceVertexIndex(b));
+      }
+      repair.moved = std::max(repair.moved, collapser.collapse(a, b, *target));
+      ++repair.count;
+      mended = true;
+      break;
+    }
+    if (!mended && merges && collapser.mayMerge(u, v)) {
+      if (merged.count == 0)
+        merged.first = fmt::format("edge ({}, {})", mesh.sourceVertexIndex(u), mesh.sourceVertexIndex(v));
+      collapser.merge(u, v);
+      ++merged.count;
+    }
+  }
+  if (repair.count + merged.count > 0) collapser.compact();
+  return mends;
+}
+
+}  // namespace rotafab::geometry
