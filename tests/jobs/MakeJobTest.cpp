@@ -85,9 +85,11 @@ TEST(MakeJob, CancelledInAnyPhaseStopsWithinASecondAndLeavesNothing) {
 
 TEST(MakeJob, ErrorsNameTheMeshAndTheOptionAsTheCallerNamesIt) {
   MakeRequest request = bunny(true);
-  request.fastener = 2.0;  // no band of the bunny has room for a 2 in hole
-  request.size = 12.0;     // at the size the user fixed (with none, the bunny grows until they have room)
-  request.names = [](geometry::Parameter p) { return p == geometry::Parameter::Fastener ? "fastener" : "size"; };
+  request.fastener = 0.5;  // no band of the bunny has room for a 1/2 in hole
+  request.size = 12.0;     // at the size the user fixed
+  request.names = [](geometry::Parameter p) {
+    return p == geometry::Parameter::Fastener ? "fastener" : p == geometry::Parameter::Size ? "size" : "other";
+  };
   test::TempDir dir;
   try {
     makeJob(request, dir.path() / "out", test::context());
@@ -95,8 +97,8 @@ TEST(MakeJob, ErrorsNameTheMeshAndTheOptionAsTheCallerNamesIt) {
   } catch (const core::UserError& error) {
     const std::string what = error.what();
     EXPECT_EQ(what.rfind(request.mesh.string() + ": ", 0), 0u) << what;
-    EXPECT_NE(what.find("; fastener 0."), std::string::npos) << what;
-    EXPECT_NE(what.find(", or size "), std::string::npos) << what;
+    EXPECT_NE(what.find("; size "), std::string::npos) << what;
+    EXPECT_NE(what.find(" or larger builds it as drawn (tried), or fastener 0."), std::string::npos) << what;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
 }
