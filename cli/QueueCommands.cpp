@@ -163,6 +163,12 @@ void printStatus(const json& job) {
       line += fmt::format(", about {} to cut", core::minutes(summary["cost"].value("cutting_seconds", 0.0)));
     }
     fmt::print("{}\n", line);
+    // What the plan warned of, as make says it: the builders should know.
+    if (summary.contains("warnings") && summary["warnings"].is_array()) {
+      for (const json& warning : summary["warnings"]) {
+        if (warning.is_string()) fmt::print("  warning: {}\n", warning.get<std::string>());
+      }
+    }
   }
   if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
   if (job.value("waiting_for_next", false)) {

@@ -523,10 +523,11 @@ void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half
 
 // Each band's edge number near its holes, reading out from the vertex band
 // (on a piece: and the piece's name on its tab; on a band cut across, the
-// far half's name on it). Returns the boxes taken on the panel.
+// far half's name on it). Returns the boxes taken on the panel; a band
+// whose number fits nowhere on it goes in `onTheBody` (labelOnTheBody()).
 std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>& holes, const FlatPanel& fp,
                                 const HersheyFont& font, const PanelCircles& circles, Panel& panel,
-                                std::vector<std::string>& unfitted) {
+                                std::vector<const FlatBand*>& onTheBody, std::vector<std::string>& unfitted) {
   std::vector<TextBox> taken;
   size_t pieceIndex = 0;
   for (const FlatBand& copy : fp.bands) {
@@ -560,6 +561,8 @@ std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>
       takenHere.push_back(*box);
       labelsHere.push_back({labelText(label), edge, LabelRole::Edge, *box,
                             labelStrokes(font, label, box->origin, box->height, box->angle)});
+    } else if (!piece) {
+      onTheBody.push_back(&copy);  // (tried on the vertex band once the panel's number is there)
     } else {
       unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
     }
@@ -572,9 +575,8 @@ std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>
   return taken;
 }
 
-// The panel number on the vertex band, as near its centre as it fits.
-void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::vector<Circle>& circles,
-                      const std::vector<TextBox>& taken, Panel& panel, std::vector<std::string>& unfitted) {
+// Points over the vertex band, nearest `near` first, for a label's centre.
+std::vector<Point2> vertexBandCandidates(const FlatPanel& fp, const Point2& near) {
   Point2 centre = Point2::Zero();
   for (const Point2& p : fp.vertexBand) centre += p;
   centre /= static_cast<double>(fp.vertexBand.size());
@@ -585,14 +587,50 @@ void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::v
     for (int j = -5; j <= 5; ++j) candidates.push_back(centre + Point2(i, j) * (reach / 5));
   }
   std::stable_sort(candidates.begin(), candidates.end(), [&](const Point2& a, const Point2& b) {
-    return (a - centre).squaredNorm() < (b - centre).squaredNorm();
+    return (a - near).squaredNorm() < (b - near).squaredNorm();
   });
+  return candidates;
+}
+
+Point2 vertexBandCentre(const FlatPanel& fp) {
+  Point2 centre = Point2::Zero();
+  for (const Point2& p : fp.vertexBand) centre += p;
+  return centre / static_cast<double>(fp.vertexBand.size());
+}
+
+// The panel number on the vertex band, as near its centre as it fits.
+void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::vector<Circle>& circles,
+                      std::vector<TextBox>& taken, Panel& panel, std::vector<std::string>& unfitted) {
+  const std::vector<Point2> candidates = vertexBandCandidates(fp, vertexBandCentre(fp));
   const std::string label = std::to_string(panel.id);
   if (const auto box = fitText(font, labelText(label), 0.0, fp.vertexBand, fp.outline, circles, taken, candidates)) {
+    taken.push_back(*box);
     panel.labels.push_back(
         {labelText(label), 0, LabelRole::Panel, *box, labelStrokes(font, label, box->origin, box->height, box->angle)});
   } else {
     unfitted.push_back(fmt::format("panel number {}", panel.id));
+  }
+}
+
+// An edge number too large for its band even at kSmallestLabel, on the
+// panel's body instead (the vertex band), reading along the band, as near
+// the band's root as it fits: moved, never left out (dissertation V.5: the
+// builders find the matching panel by it).
+void labelOnTheBody(const BandBuild& b, const FlatPanel& fp, const FlatBand& copy, const HersheyFont& font,
+                    const std::vector<Circle>& circles, std::vector<TextBox>& taken, Panel& panel,
+                    std::vector<std::string>& unfitted) {
+  const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
+  const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
+  const int edge = b.edgeNumber[copy.edge];
+  const std::string label = std::to_string(edge);
+  const std::vector<Point2> candidates = vertexBandCandidates(fp, copy.at(near, 0.5));
+  if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), fp.vertexBand, fp.outline, circles,
+                               taken, candidates)) {
+    taken.push_back(*box);
+    panel.labels.push_back({labelText(label), edge, LabelRole::Edge, *box,
+                            labelStrokes(font, label, box->origin, box->height, box->angle)});
+  } else {
+    unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
   }
 }
 
@@ -602,8 +640,10 @@ Panel bandPanel(const BandBuild& b, const std::vector<BandHoles>& holes, const H
   const FlatPanel& fp = b.flat[b.order.faceOfPanel[number]];
   PanelCircles circles;
   Panel panel = panelWithBands(b, holes, number, circles);
-  const std::vector<TextBox> taken = labelBands(b, holes, fp, font, circles, panel, unfitted);
+  std::vector<const FlatBand*> onTheBody;
+  std::vector<TextBox> taken = labelBands(b, holes, fp, font, circles, panel, onTheBody, unfitted);
   labelPanelNumber(fp, font, circles.panel, taken, panel, unfitted);
+  for (const FlatBand* copy : onTheBody) labelOnTheBody(b, fp, *copy, font, circles.panel, taken, panel, unfitted);
   if (b.options.scoreFolds) {
     for (size_t side = 0; side < fp.bandOfSide.size(); ++side) {
       if (fp.bandOfSide[side] < 0) continue;

@@ -70,53 +70,20 @@ class Collapser {
   // Where (a, b) would collapse to, if it may: its midpoint, or its end on
   // the boundary when only one end is.
   [[nodiscard]] std::optional<Point3> collapsePoint(int a, int b) const {
-    if (a == b || moved_[a] || moved_[b]) return std::nullopt;
-    const std::vector<int> on = facesOn(a, b);
-    if (on.empty()) return std::nullopt;
+    if (!linkAllows(a, b)) return std::nullopt;
     const bool boundaryA = boundary_.contains(a), boundaryB = boundary_.contains(b);
-    if (boundaryA && boundaryB && on.size() != 1) return std::nullopt;  // an inner edge across the boundary
-    // The link condition: a and b share no neighbour but the corners
-    // opposite the edge in its triangles; and no face holds both apart.
-    std::set<int> opposite;
-    for (int f : on) {
-      const auto& face = mesh_.faces[f];
-      if (face.size() == 3) {
-        for (int v : face) {
-          if (v != a && v != b) opposite.insert(v);
-        }
-      }
-    }
-    std::set<int> common;
-    const std::set<int> nearA = neighbours(a);
-    for (int v : neighbours(b)) {
-      if (nearA.contains(v)) common.insert(v);
-    }
-    if (common != opposite) return std::nullopt;
-    for (int f : facesOf_[a]) {
-      const auto& face = mesh_.faces[f];
-      if (std::find(face.begin(), face.end(), b) != face.end() && std::find(on.begin(), on.end(), f) == on.end()) {
-        return std::nullopt;
-      }
-    }
     const Point3 target = boundaryA == boundaryB ? Point3((mesh_.positions[a] + mesh_.positions[b]) / 2)
                                                  : mesh_.positions[boundaryA ? a : b];
-    // No face about either end turned by more than 60 degrees, nor left flat.
-    std::set<int> around(facesOf_[a].begin(), facesOf_[a].end());
-    around.insert(facesOf_[b].begin(), facesOf_[b].end());
-    for (int f : around) {
-      std::vector<Point3> before, after;
-      for (int v : mesh_.faces[f]) {
-        before.push_back(mesh_.positions[v]);
-        const Point3 p = v == a || v == b ? target : mesh_.positions[v];
-        if (after.empty() || !(after.back() - p).isZero(0)) after.push_back(p);
-      }
-      while (after.size() > 1 && (after.front() - after.back()).isZero(0)) after.pop_back();
-      if (after.size() < 3) continue;  // the face vanishes with the edge
-      const Point3 n0 = normalOf(before), n1 = normalOf(after);
-      if (n1.norm() <= 1e-9 * n0.norm()) return std::nullopt;
-      if (n0.normalized().dot(n1.normalized()) < kLeastNormalCosine) return std::nullopt;
-    }
+    if (!keepsFacesUpright(a, b, target)) return std::nullopt;
     return target;
+  }
+
+  // Whether `gone` may collapse into `keep`, where `keep` is: the boundary
+  // keeps its place.
+  [[nodiscard]] bool mayCollapseInto(int keep, int gone) const {
+    if (!linkAllows(keep, gone)) return false;
+    if (boundary_.contains(gone) && !boundary_.contains(keep)) return false;
+    return keepsFacesUpright(keep, gone, mesh_.positions[keep]);
   }
 
   // Collapses (a, b) to `target`: b's faces take a, and a face left with
@@ -218,6 +185,62 @@ class Collapser {
  private:
   static std::pair<int, int> key(int a, int b) { return {std::min(a, b), std::max(a, b)}; }
 
+  // Whether collapsing (a, b) keeps the topology: neither end moved by this
+  // call, an edge, not an inner edge across the boundary, and the link
+  // condition: a and b share no neighbour but the corners opposite the
+  // edge in its triangles, and no face holds both apart.
+  [[nodiscard]] bool linkAllows(int a, int b) const {
+    if (a == b || moved_[a] || moved_[b]) return false;
+    const std::vector<int> on = facesOn(a, b);
+    if (on.empty()) return false;
+    if (boundary_.contains(a) && boundary_.contains(b) && on.size() != 1) return false;
+    std::set<int> opposite;
+    for (int f : on) {
+      const auto& face = mesh_.faces[f];
+      if (face.size() == 3) {
+        for (int v : face) {
+          if (v != a && v != b) opposite.insert(v);
+        }
+      }
+    }
+    std::set<int> common;
+    const std::set<int> nearA = neighbours(a);
+    for (int v : neighbours(b)) {
+      if (nearA.contains(v)) common.insert(v);
+    }
+    if (common != opposite) return false;
+    for (int f : facesOf_[a]) {
+      const auto& face = mesh_.faces[f];
+      if (std::find(face.begin(), face.end(), b) != face.end() && std::find(on.begin(), on.end(), f) == on.end()) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // Whether a and b moved to `target` turn no face about them by more than
+  // 60 degrees, nor leave one flat (a face of no area before, a degenerate
+  // one, may stay so).
+  [[nodiscard]] bool keepsFacesUpright(int a, int b, const Point3& target) const {
+    std::set<int> around(facesOf_[a].begin(), facesOf_[a].end());
+    around.insert(facesOf_[b].begin(), facesOf_[b].end());
+    for (int f : around) {
+      std::vector<Point3> before, after;
+      for (int v : mesh_.faces[f]) {
+        before.push_back(mesh_.positions[v]);
+        const Point3 p = v == a || v == b ? target : mesh_.positions[v];
+        if (after.empty() || !(after.back() - p).isZero(0)) after.push_back(p);
+      }
+      while (after.size() > 1 && (after.front() - after.back()).isZero(0)) after.pop_back();
+      if (after.size() < 3) continue;  // the face vanishes with the edge
+      const Point3 n0 = normalOf(before), n1 = normalOf(after);
+      if (!(n0.norm() > 0)) continue;
+      if (n1.norm() <= 1e-9 * n0.norm()) return false;
+      if (n0.normalized().dot(n1.normalized()) < kLeastNormalCosine) return false;
+    }
+    return true;
+  }
+
   [[nodiscard]] std::set<int> neighbours(int v) const {
     std::set<int> near;
     for (int f : facesOf_[v]) {
@@ -239,6 +262,42 @@ class Collapser {
 };
 
 }  // namespace
+
+MeshRepair collapseDegenerateFaces(PolygonMesh& mesh) {
+  MeshRepair repair{"collapse-degenerate-face", 0, ""};
+  // Each pass collapses where no earlier collapse of it moved a vertex.
+  for (bool again = true; again;) {
+    again = false;
+    const double diagonal = boundingBoxDiagonal(mesh);
+    const double least = 1e-12 * diagonal * diagonal;
+    Collapser collapser(mesh);
+    for (int f = 0; f < mesh.faceCount(); ++f) {
+      const std::vector<int> face = mesh.faces[f];
+      if (face.size() < 3 || fanArea(mesh, f) > least) continue;
+      // Its sides, shortest first: the shorter end of the shortest goes into the other.
+      std::vector<std::array<int, 2>> sides;
+      for (size_t i = 0; i < face.size(); ++i) sides.push_back({face[i], face[(i + 1) % face.size()]});
+      std::stable_sort(sides.begin(), sides.end(), [&](const auto& p, const auto& q) {
+        return collapser.length(p[0], p[1]) < collapser.length(q[0], q[1]);
+      });
+      const auto collapseOne = [&] {
+        for (const auto& [p, q] : sides) {
+          for (const auto& [keep, gone] : {std::pair{p, q}, std::pair{q, p}}) {
+            if (!collapser.mayCollapseInto(keep, gone)) continue;
+            if (repair.count == 0) repair.first = fmt::format("face {}", mesh.sourceFaceIndex(f));
+            repair.moved = std::max(repair.moved, collapser.collapse(keep, gone, mesh.positions[keep]));
+            ++repair.count;
+            return true;
+          }
+        }
+        return false;
+      };
+      again = collapseOne() || again;
+    }
+    if (again) collapser.compact();
+  }
+  return repair;
+}
 
 Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges) {
   Mends mends;

@@ -41,6 +41,14 @@ struct Mends {
 // go, and vertices no face uses. Returns the mends (count 0: none could be
 // made), each "first" naming the first edge by its vertices in the file's
 // numbering.
+// `--repair auto`'s last repair: each face of zero area (its corners
+// collinear, as CAD programs' STL files have them) collapsed away, the
+// nearer end of its shortest side that may go into the other (so no vertex
+// moves but the one that goes, and the boundary keeps its place). Returns
+// the repair, "collapse-degenerate-face", "first" naming the face in the
+// file's numbering, `moved` the farthest a vertex went (in the mesh's units).
+MeshRepair collapseDegenerateFaces(PolygonMesh& mesh);
+
 Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges = true);
 
 }  // namespace rotafab::geometry

@@ -9,6 +9,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "geometry/MeshMending.h"
+
 #include "geometry/EdgeUses.h"
 #include "geometry/io/MeshImport.h"
 
@@ -247,6 +249,9 @@ std::string MeshRepair::line() const {
     what = fmt::format("split {} bow-tie vert{} into one copy per fan of faces", count, one ? "ex" : "ices");
   } else if (kind == "orient") {
     what = fmt::format("reversed {} face{} to orient the surface consistently and outwards", count, one ? "" : "s");
+  } else if (kind == "collapse-degenerate-face") {
+    what = fmt::format("collapsed {} face{} of zero area (collinear corners) into {} neighbours", count, one ? "" : "s",
+                       one ? "its" : "their");
   } else if (kind == "merge-narrow-band") {
     what = fmt::format("merged the two faces beside {} band{} too narrow for a fastener into one panel each", count,
                        one ? "" : "s");
@@ -270,6 +275,9 @@ std::vector<MeshRepair> repairMesh(PolygonMesh& mesh) {
   weldNear(mesh, repairs);
   dropDuplicateFaces(mesh, repairs);
   splitFans(mesh, repairs);
+  if (MeshRepair degenerate = collapseDegenerateFaces(mesh); degenerate.count > 0) {
+    repairs.push_back(std::move(degenerate));
+  }
   return repairs;
 }
 

@@ -19,6 +19,10 @@
 //                           counted (leftOpen)
 //   split-bowtie            a vertex whose faces form several fans (surfaces
 //                           touching at a point) gets one copy per fan
+//   collapse-degenerate-face  a face of zero area (collinear corners, as in
+//                           CAD programs' STLs) is collapsed away, its
+//                           shortest side's nearer end into the other
+//                           (MeshMending.h)
 //
 // The orientation (consistent, and outward on closed components) is then
 // made by analyzeMesh() (MeshAnalysis.h), and orientRepair() names it. What

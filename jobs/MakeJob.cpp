@@ -114,7 +114,10 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
                       ? builtWeave(request, mesh, sizing, context)
                       : builtStructure(request, mesh, job.mesh, sizing, context);
   for (const auto& note : job.structure.notes) context.note(fmt::format("{}: {}", name, note));
-  for (const auto& warning : job.structure.warnings) context.warn(fmt::format("{}: {}", name, warning));
+  for (const auto& warning : job.structure.warnings) {
+    context.warn(fmt::format("{}: {}", name, warning));
+    job.warnings.push_back(warning);
+  }
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.size = builtSize(job.structure);
   job.seconds.geometry = lap();
@@ -174,9 +177,10 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
         kSheetDecimals);
   });
   {
-    const nlohmann::ordered_json more = {{"size", {job.size.x(), job.size.y(), job.size.z()}},
-                                         {"stability", stabilityJson(job.stability)},
-                                         {"cost", costJson(job.cost)}};
+    nlohmann::ordered_json more = {{"size", {job.size.x(), job.size.y(), job.size.z()}},
+                                   {"stability", stabilityJson(job.stability)},
+                                   {"cost", costJson(job.cost)}};
+    if (!job.warnings.empty()) more["warnings"] = job.warnings;
     ManifestFiles manifest = manifestFiles(job.structure, job.mesh, job.bed, job.sheets, job.files, more, context);
     writeFileAtomically(output.staging() / "manifest.json", manifest.json);
     std::string().swap(manifest.json);

@@ -96,6 +96,10 @@ struct PlannedJob {
   SheetPlan sheets;
   SheetFormats formats;
   JobCost cost;
+  // What the plan warns of (a band with less clearance, labels that do not
+  // fit), as make says it, without the mesh's name: manifest.json's
+  // "warnings" and manifest.txt's, before the steps.
+  std::vector<std::string> warnings;
   // Once written (writeJob()):
   std::filesystem::path folder;
   std::vector<std::vector<std::string>> files;  // per sheet

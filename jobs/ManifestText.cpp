@@ -351,6 +351,11 @@ std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
                                 remeshed ? "remeshed to" : "simplified to", simplified.at("faces").get<int>(),
                                 simplified.at("asked").get<int>()));
   }
+  if (manifest.contains("warnings")) {
+    for (const auto& warning : manifest.at("warnings")) {
+      notes.push_back(fmt::format("Warning: {}.", warning.get<std::string>()));
+    }
+  }
   if (manifest.contains("stability")) {
     const auto& stability = manifest.at("stability");
     const auto& mass = stability.at("mass_kg");

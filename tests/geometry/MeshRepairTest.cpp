@@ -174,6 +174,34 @@ TEST(MeshRepair, MessagesNameTheFilesNumbering) {
   EXPECT_TRUE(analyzeMesh(imported.mesh).usable());
 }
 
+// A face of zero area, as CAD programs write them: a square pyramid
+// whose edge (0, 1) has a vertex 5 in its middle, and the face (0, 1, 5)
+// (the file's face 2) across it. It is collapsed, vertex 5 into 0, and the
+// pyramid is left, named by the file's face.
+TEST(MeshRepair, AFaceOfZeroAreaIsCollapsedAway) {
+  test::TempDir dir;
+  const auto file = dir.write("cap.off",
+                              "OFF\n6 8 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n0.5 0 0\n"
+                              "3 0 3 2\n3 0 2 1\n3 0 1 5\n3 0 5 4\n3 5 1 4\n3 1 2 4\n3 2 3 4\n3 3 0 4\n");
+  ImportedMesh imported = importMesh(file);
+  const MeshAnalysis before = analyzeMesh(imported.mesh);
+  ASSERT_FALSE(before.usable());
+  EXPECT_NE(before.problems.front().message.find("face 2 has zero area"), std::string::npos);
+  const auto repairs = repairMesh(imported.mesh);
+  ASSERT_EQ(kinds(repairs), std::vector<std::string>{"collapse-degenerate-face"});
+  EXPECT_EQ(repairs[0].first, "face 2");
+  EXPECT_EQ(repairs[0].count, 1);
+  EXPECT_DOUBLE_EQ(repairs[0].moved, 0.5);
+  EXPECT_EQ(repairs[0].line(),
+            "collapsed 1 face of zero area (collinear corners) into its neighbours, moving the surface at most 0.5 in "
+            "(the first: face 2)");
+  const MeshAnalysis after = analyzeMesh(imported.mesh);
+  EXPECT_TRUE(after.usable());
+  EXPECT_EQ(after.topology.faces, 6);
+  EXPECT_EQ(after.topology.vertices, 5);
+  EXPECT_EQ(after.topology.genus, 0);
+}
+
 TEST(MeshRepair, AWallInsideASolidIsCutOffAndItsOpenSidesCounted) {
   // Two cubes side by side with the square between them kept: each of its
   // four edges has three faces, and no two of them belong together.
