@@ -575,11 +575,15 @@ std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>
   return taken;
 }
 
-// Points over the vertex band, nearest `near` first, for a label's centre.
-std::vector<Point2> vertexBandCandidates(const FlatPanel& fp, const Point2& near) {
+Point2 vertexBandCentre(const FlatPanel& fp) {
   Point2 centre = Point2::Zero();
   for (const Point2& p : fp.vertexBand) centre += p;
-  centre /= static_cast<double>(fp.vertexBand.size());
+  return centre / static_cast<double>(fp.vertexBand.size());
+}
+
+// Points over the vertex band, nearest `near` first, for a label's centre.
+std::vector<Point2> vertexBandCandidates(const FlatPanel& fp, const Point2& near) {
+  const Point2 centre = vertexBandCentre(fp);
   double reach = 0;
   for (const Point2& p : fp.vertexBand) reach = std::max(reach, (p - centre).norm());
   std::vector<Point2> candidates;
@@ -590,12 +594,6 @@ std::vector<Point2> vertexBandCandidates(const FlatPanel& fp, const Point2& near
     return (a - near).squaredNorm() < (b - near).squaredNorm();
   });
   return candidates;
-}
-
-Point2 vertexBandCentre(const FlatPanel& fp) {
-  Point2 centre = Point2::Zero();
-  for (const Point2& p : fp.vertexBand) centre += p;
-  return centre / static_cast<double>(fp.vertexBand.size());
 }
 
 // The panel number on the vertex band, as near its centre as it fits.
