@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <set>
 #include <stdexcept>
 
@@ -476,10 +477,18 @@ Panel panelWithBands(const BandBuild& b, const std::vector<BandHoles>& holes, in
   return panel;
 }
 
+// A label that fits nowhere even at kSmallestLabel, and the edge whose band
+// (or, for a panel's number, one of whose bands) the design could be
+// mended at to give it room.
+struct Unetched {
+  std::string what;  // "edge 12 on panel 3", "piece 3a", "panel number 3"
+  int edge = -1;
+};
+
 // A detached band's piece named on its tab, along the side it is fastened to.
 void namePieceOnItsTab(const FlatBand& copy, PanelPiece& piece, const HersheyFont& font,
                        const std::vector<Circle>& circles, const std::vector<TextBox>& taken,
-                       std::vector<std::string>& unfitted) {
+                       std::vector<Unetched>& unfitted) {
   std::vector<Point2> onTab;
   const auto& t = copy.tabOutline;
   Point2 middle = Point2::Zero();
@@ -489,19 +498,19 @@ void namePieceOnItsTab(const FlatBand& copy, PanelPiece& piece, const HersheyFon
     for (double v = 0.2; v <= 0.801; v += 0.3) onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * middle);
   }
   const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
-  if (const auto box = fitText(font, piece.name, std::atan2(side.y(), side.x()), copy.tabOutline, copy.pieceOutline,
-                               circles, taken, onTab)) {
+  if (const auto box = fitText(font, piece.name, alongThenAcross(std::atan2(side.y(), side.x())), copy.tabOutline,
+                               copy.pieceOutline, circles, taken, onTab)) {
     piece.labels.push_back(
         {piece.name, 0, LabelRole::Piece, *box, font.strokes(piece.name, box->origin, box->height, box->angle)});
   } else {
-    unfitted.push_back(fmt::format("piece {}", piece.name));
+    unfitted.push_back({fmt::format("piece {}", piece.name), copy.edge});
   }
 }
 
 // A band cut across: the far half's name on it, reading out along the
 // band (`near` to `far`), nearest its middle.
 void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half, const HersheyFont& font,
-                 const std::vector<Circle>& circles, std::vector<std::string>& unfitted) {
+                 const std::vector<Circle>& circles, std::vector<Unetched>& unfitted) {
   const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
   std::vector<Point2> onHalf;
   for (double u = 0.65; u <= 0.951; u += 0.05) {
@@ -512,12 +521,12 @@ void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half
     return (a - middle).squaredNorm() < (b - middle).squaredNorm();
   });
   std::vector<TextBox> halfTaken;
-  if (const auto box = fitText(font, half.name, std::atan2(out.y(), out.x()), copy.pieceOutline, copy.pieceOutline,
-                               circles, halfTaken, onHalf)) {
+  if (const auto box = fitText(font, half.name, alongThenAcross(std::atan2(out.y(), out.x())), copy.pieceOutline,
+                               copy.pieceOutline, circles, halfTaken, onHalf)) {
     half.labels.push_back(
         {half.name, 0, LabelRole::Piece, *box, font.strokes(half.name, box->origin, box->height, box->angle)});
   } else {
-    unfitted.push_back(fmt::format("piece {}", half.name));
+    unfitted.push_back({fmt::format("piece {}", half.name), copy.edge});
   }
 }
 
@@ -527,7 +536,7 @@ void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half
 // whose number fits nowhere on it goes in `onTheBody` (labelOnTheBody()).
 std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>& holes, const FlatPanel& fp,
                                 const HersheyFont& font, const PanelCircles& circles, Panel& panel,
-                                std::vector<const FlatBand*>& onTheBody, std::vector<std::string>& unfitted) {
+                                std::vector<const FlatBand*>& onTheBody, std::vector<Unetched>& unfitted) {
   std::vector<TextBox> taken;
   size_t pieceIndex = 0;
   for (const FlatBand& copy : fp.bands) {
@@ -556,15 +565,15 @@ std::vector<TextBox> labelBands(const BandBuild& b, const std::vector<BandHoles>
     });
     const int edge = b.edgeNumber[copy.edge];
     const std::string label = std::to_string(edge);
-    if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), copy.outline, outlineHere,
-                                 circlesHere, takenHere, candidates)) {
+    if (const auto box = fitText(font, labelText(label), alongThenAcross(std::atan2(out.y(), out.x())), copy.outline,
+                                 outlineHere, circlesHere, takenHere, candidates)) {
       takenHere.push_back(*box);
       labelsHere.push_back({labelText(label), edge, LabelRole::Edge, *box,
                             labelStrokes(font, label, box->origin, box->height, box->angle)});
     } else if (!piece) {
       onTheBody.push_back(&copy);  // (tried on the vertex band once the panel's number is there)
     } else {
-      unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
+      unfitted.push_back({fmt::format("edge {} on panel {}", label, panel.id), copy.edge});
     }
     if (piece) {
       namePieceOnItsTab(copy, *piece, font, circlesHere, takenHere, unfitted);
@@ -598,15 +607,17 @@ std::vector<Point2> vertexBandCandidates(const FlatPanel& fp, const Point2& near
 
 // The panel number on the vertex band, as near its centre as it fits.
 void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::vector<Circle>& circles,
-                      std::vector<TextBox>& taken, Panel& panel, std::vector<std::string>& unfitted) {
+                      std::vector<TextBox>& taken, Panel& panel, std::vector<Unetched>& unfitted,
+                      double largest = kLargestLabel) {
   const std::vector<Point2> candidates = vertexBandCandidates(fp, vertexBandCentre(fp));
   const std::string label = std::to_string(panel.id);
-  if (const auto box = fitText(font, labelText(label), 0.0, fp.vertexBand, fp.outline, circles, taken, candidates)) {
+  if (const auto box = fitText(font, labelText(label), {0.0, std::numbers::pi / 2}, fp.vertexBand, fp.outline, circles,
+                               taken, candidates, largest)) {
     taken.push_back(*box);
     panel.labels.push_back(
         {labelText(label), 0, LabelRole::Panel, *box, labelStrokes(font, label, box->origin, box->height, box->angle)});
   } else {
-    unfitted.push_back(fmt::format("panel number {}", panel.id));
+    unfitted.push_back({fmt::format("panel number {}", panel.id), fp.bands.empty() ? -1 : fp.bands.front().edge});
   }
 }
 
@@ -616,32 +627,67 @@ void labelPanelNumber(const FlatPanel& fp, const HersheyFont& font, const std::v
 // builders find the matching panel by it).
 void labelOnTheBody(const BandBuild& b, const FlatPanel& fp, const FlatBand& copy, const HersheyFont& font,
                     const std::vector<Circle>& circles, std::vector<TextBox>& taken, Panel& panel,
-                    std::vector<std::string>& unfitted) {
+                    std::vector<Unetched>& unfitted, double largest) {
   const double near = copy.fromA ? 0.0 : 1.0, far = 1.0 - near;
   const Point2 out = copy.at(far, 0.5) - copy.at(near, 0.5);
   const int edge = b.edgeNumber[copy.edge];
   const std::string label = std::to_string(edge);
   const std::vector<Point2> candidates = vertexBandCandidates(fp, copy.at(near, 0.5));
-  if (const auto box = fitText(font, labelText(label), std::atan2(out.y(), out.x()), fp.vertexBand, fp.outline, circles,
-                               taken, candidates)) {
+  // Along the band, across it, then along each side of the vertex band (a
+  // thin triangle's body is long only along its sides).
+  std::vector<double> angles = alongThenAcross(std::atan2(out.y(), out.x()));
+  for (size_t i = 0; i < fp.vertexBand.size(); ++i) {
+    const Point2 side = fp.vertexBand[(i + 1) % fp.vertexBand.size()] - fp.vertexBand[i];
+    angles.push_back(std::atan2(side.y(), side.x()));
+  }
+  if (const auto box =
+          fitText(font, labelText(label), angles, fp.vertexBand, fp.outline, circles, taken, candidates, largest)) {
     taken.push_back(*box);
     panel.labels.push_back({labelText(label), edge, LabelRole::Edge, *box,
                             labelStrokes(font, label, box->origin, box->height, box->angle)});
   } else {
-    unfitted.push_back(fmt::format("edge {} on panel {}", label, panel.id));
+    unfitted.push_back({fmt::format("edge {} on panel {}", label, panel.id), copy.edge});
   }
+}
+
+// The panel's number and the edge numbers moved to its body: the number
+// first, at its largest; where that leaves an edge number out, the edge
+// numbers first, each near its band's root, and all of them no taller than
+// a cap lowered until every one fits (or, failing that, the placing that
+// leaves the fewest out).
+void labelTheBody(const BandBuild& b, const FlatPanel& fp, const std::vector<const FlatBand*>& onTheBody,
+                  const HersheyFont& font, const std::vector<Circle>& circles, std::vector<TextBox>& taken,
+                  Panel& panel, std::vector<Unetched>& unfitted) {
+  const size_t labelsBefore = panel.labels.size(), takenBefore = taken.size();
+  const auto place = [&](bool numberFirst, double largest) {
+    panel.labels.resize(labelsBefore);
+    taken.resize(takenBefore);
+    std::vector<Unetched> left;
+    if (numberFirst) labelPanelNumber(fp, font, circles, taken, panel, left);
+    for (const FlatBand* copy : onTheBody) labelOnTheBody(b, fp, *copy, font, circles, taken, panel, left, largest);
+    if (!numberFirst) labelPanelNumber(fp, font, circles, taken, panel, left, largest);
+    return left;
+  };
+  std::vector<Unetched> left = place(true, kLargestLabel);
+  std::optional<double> fewestAt;  // the cap that left the fewest out, if not the number first
+  for (const double cap : {kLargestLabel, 0.15, 0.1, kSmallestLabel}) {
+    if (left.empty()) break;
+    std::vector<Unetched> capped = place(false, cap);
+    if (capped.size() < left.size()) left = std::move(capped), fewestAt = cap;
+  }
+  if (!left.empty()) fewestAt ? place(false, *fewestAt) : place(true, kLargestLabel);
+  unfitted.insert(unfitted.end(), left.begin(), left.end());
 }
 
 // Panel `number` (from 0) whole: its bands, labels and folds to score.
 Panel bandPanel(const BandBuild& b, const std::vector<BandHoles>& holes, const HersheyFont& font, int number,
-                std::vector<std::string>& unfitted) {
+                std::vector<Unetched>& unfitted) {
   const FlatPanel& fp = b.flat[b.order.faceOfPanel[number]];
   PanelCircles circles;
   Panel panel = panelWithBands(b, holes, number, circles);
   std::vector<const FlatBand*> onTheBody;
   std::vector<TextBox> taken = labelBands(b, holes, fp, font, circles, panel, onTheBody, unfitted);
-  labelPanelNumber(fp, font, circles.panel, taken, panel, unfitted);
-  for (const FlatBand* copy : onTheBody) labelOnTheBody(b, fp, *copy, font, circles.panel, taken, panel, unfitted);
+  labelTheBody(b, fp, onTheBody, font, circles.panel, taken, panel, unfitted);
   if (b.options.scoreFolds) {
     for (size_t side = 0; side < fp.bandOfSide.size(); ++side) {
       if (fp.bandOfSide[side] < 0) continue;
@@ -649,6 +695,32 @@ Panel bandPanel(const BandBuild& b, const std::vector<BandHoles>& holes, const H
     }
   }
   return panel;
+}
+
+// Labels that fit nowhere: the bands they belong to have no room
+// (NoRoomForHoleError::forLabels(), mended or refused as bands without room
+// for a hole are: a builder finds the matching panel by its numbers,
+// dissertation V.5); where the user asked for glue instead of mending, a
+// warning.
+void refuseUnetched(const BandBuild& b, const std::vector<std::vector<Unetched>>& unetchedOf, Structure& result) {
+  std::vector<std::vector<std::string>> whatOf(unetchedOf.size());
+  std::set<int> edges;
+  for (size_t panel = 0; panel < unetchedOf.size(); ++panel) {
+    for (const Unetched& label : unetchedOf[panel]) {
+      whatOf[panel].push_back(label.what);
+      if (label.edge >= 0) edges.insert(label.edge);
+    }
+  }
+  if (edges.empty() || b.options.glueBandsWithoutRoom) {
+    if (auto warning = unetchedLabelsWarning(whatOf, "band")) result.warnings.push_back(std::move(*warning));
+    return;
+  }
+  NoRoomForHoleError error =
+      NoRoomForHoleError::forLabels(fmt::format("{}: its number fits on neither its band nor its panel, even at {} in",
+                                                b.edgeName(*edges.begin()), kSmallestLabel),
+                                    static_cast<int>(edges.size()), b.options.names);
+  error.edges.assign(edges.begin(), edges.end());
+  throw b.withPlaces(error);
 }
 
 Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const core::WorkContext& context) {
@@ -688,11 +760,11 @@ Structure buildOnce(const PolygonMesh& mesh, const BandOptions& options, const c
   const HersheyFont& font = HersheyFont::simplex();
   // Each panel on its own, so the panels are shared out among the cores.
   result.panels.resize(mesh.faceCount());
-  std::vector<std::vector<std::string>> unfittedOf(mesh.faceCount());  // labels too large even at the smallest height
+  std::vector<std::vector<Unetched>> unetchedOf(mesh.faceCount());  // labels too large even at the smallest height
   context.parallelFor(mesh.faceCount(), [&](size_t number) {
-    result.panels[number] = bandPanel(b, holes, font, static_cast<int>(number), unfittedOf[number]);
+    result.panels[number] = bandPanel(b, holes, font, static_cast<int>(number), unetchedOf[number]);
   });
-  if (auto warning = unetchedLabelsWarning(unfittedOf, "band")) result.warnings.push_back(std::move(*warning));
+  refuseUnetched(b, unetchedOf, result);
   result.steps = stepsInPanelOrder(result.panels);
   return result;
 }

@@ -82,6 +82,15 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
            : fmt::format("; use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size))));
 }
 
+NoRoomForHoleError NoRoomForHoleError::forLabels(std::string firstBand, int bands, const ParameterNames& names) {
+  NoRoomForHoleError error(std::move(firstBand), bands, kLabelGrowth, 0, names);
+  error.estimate = true;
+  error.labels = true;
+  static_cast<std::invalid_argument&>(error) = std::invalid_argument(
+      error.bandsWithoutRoom + fmt::format("; a larger {} gives them room", names(Parameter::Size)));
+  return error;
+}
+
 namespace {
 
 // Holes already placed, per part cut: a panel (key (face, -1)) and each

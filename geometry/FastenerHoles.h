@@ -41,6 +41,10 @@ namespace rotafab::geometry {
 // Chipboard tears where less than a diameter of it is left between a hole's
 // centre and the edge (a web of half a diameter): no hole is drawn nearer.
 constexpr double kClearance = 1.5, kLeastClearance = 1.0;
+// How much larger each attempt makes a structure whose labels have no room
+// (NoRoomForHoleError::forLabels()): labels keep their smallest height as
+// everything else grows, so the room needed is not known ahead.
+constexpr double kLabelGrowth = 1.1;
 
 // A point of an edge band: a triangle (EdgeBand::triangles() indices) and weights.
 struct BandPoint {
@@ -69,10 +73,16 @@ class NoRoomForHoleError : public std::invalid_argument {
  public:
   NoRoomForHoleError(std::string firstBand, int bands, double scaleNeeded, double diameter,
                      const ParameterNames& names = parameterInWords);
+  // Bands whose holes have room but whose numbers fit nowhere on their
+  // panels, even at the smallest legible height (PanelLabels.h): a larger
+  // size gives them room (by kLabelGrowth each attempt, an estimate), a
+  // smaller fastener may not.
+  static NoRoomForHoleError forLabels(std::string firstBand, int bands, const ParameterNames& names = parameterInWords);
   std::string bandsWithoutRoom;  // "EDGE: its band (L x W in) has no room for ... (nor have N other bands)"
   double scaleNeeded;            // > 1; infinite when a band's middle is off its panel
   int bands;                     // how many have no room
   bool estimate = false;         // scaleNeeded may not be enough (a tab's room stops growing)
+  bool labels = false;           // the bands' numbers have no room (forLabels()), not their holes
   std::vector<double> scales;    // what each band without room needs, scaleNeeded the largest
   std::vector<int> edges;        // the edge numbers of the bands without room, as `placeFastenerHoles` has them
   // Their edges' two vertices in the mesh built (filled by the structure's

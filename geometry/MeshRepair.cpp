@@ -253,11 +253,15 @@ std::string MeshRepair::line() const {
     what = fmt::format("collapsed {} face{} of zero area (collinear corners) into {} neighbours", count, one ? "" : "s",
                        one ? "its" : "their");
   } else if (kind == "merge-narrow-band") {
-    what = fmt::format("merged the two faces beside {} band{} too narrow for a fastener into one panel each", count,
+    what =
+        fmt::format("merged the two faces beside {} band{} too narrow for a fastener or its number into one panel each",
+                    count, one ? "" : "s");
+  } else if (kind == "flip-narrow-band") {
+    what = fmt::format("flipped {} edge{} of a sliver beside a band too narrow for a fastener or its number", count,
                        one ? "" : "s");
   } else if (kind == "collapse-short-edge") {
-    what = fmt::format("collapsed {} short edge{} or sliver{} whose band had no room for a fastener", count,
-                       one ? "" : "s", one ? "" : "s");
+    what = fmt::format("collapsed {} short edge{} or sliver{} whose band had no room for a fastener or its number",
+                       count, one ? "" : "s", one ? "" : "s");
   } else {
     what = fmt::format("{}: {}", kind, count);
   }

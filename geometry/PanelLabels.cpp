@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -41,12 +42,10 @@ bool boxesApart(const TextBox& a, const TextBox& b, double gap) {
   return false;
 }
 
-}  // namespace
-
-std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text, double angle,
-                               const std::vector<Point2>& region, const std::vector<Point2>& outline,
-                               const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
-                               const std::vector<Point2>& candidates) {
+std::optional<TextBox> fitTextAlong(const HersheyFont& font, const std::string& text, double angle,
+                                    const std::vector<Point2>& region, const std::vector<Point2>& outline,
+                                    const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
+                                    const std::vector<Point2>& candidates, double largest) {
   const Point2 along(std::cos(angle), std::sin(angle)), up(-along.y(), along.x());
   // Only the outline's sides within the largest gap of the region can come
   // near a box inside it (and the region lies inside the outline).
@@ -84,7 +83,7 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     return room[c];
   };
   double most = 0;
-  for (size_t c = 0; c < candidates.size() && most < 0.75 * kLargestLabel; ++c) most = std::max(most, roomAt(c));
+  for (size_t c = 0; c < candidates.size() && most < 0.75 * largest; ++c) most = std::max(most, roomAt(c));
   // Clear of the outline by `gap`: a point near a candidate centre is at
   // least the centre's room less their distance from the sides (the
   // triangle inequality), which spares most points their own distance.
@@ -125,7 +124,7 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
     alongLow = std::min(alongLow, p.dot(along)), alongHigh = std::max(alongHigh, p.dot(along));
     upLow = std::min(upLow, p.dot(up)), upHigh = std::max(upHigh, p.dot(up));
   }
-  for (double height = std::min(kLargestLabel, most / 0.75); height >= kSmallestLabel - 1e-12; height *= 0.85) {
+  for (double height = std::min(largest, most / 0.75); height >= kSmallestLabel - 1e-12; height *= 0.85) {
     const double width = font.advance(text, height);
     const double gap = std::max(kLabelGap, height / 4);
     if (width > alongHigh - alongLow || height > upHigh - upLow) continue;
@@ -143,6 +142,20 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
   }
   return std::nullopt;
 }
+
+}  // namespace
+
+std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text, const std::vector<double>& angles,
+                               const std::vector<Point2>& region, const std::vector<Point2>& outline,
+                               const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
+                               const std::vector<Point2>& candidates, double largest) {
+  for (const double angle : angles) {
+    if (auto box = fitTextAlong(font, text, angle, region, outline, holes, taken, candidates, largest)) return box;
+  }
+  return std::nullopt;
+}
+
+std::vector<double> alongThenAcross(double angle) { return {angle, angle - std::numbers::pi / 2}; }
 
 std::optional<std::string> unetchedLabelsWarning(const std::vector<std::vector<std::string>>& unfittedOf,
                                                  const std::string& strip) {

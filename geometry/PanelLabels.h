@@ -37,13 +37,19 @@ struct Circle {
 
 // The largest box of `text` (already marked) that fits inside `region` (a
 // piece of the panel, inside `outline`), clear of `outline`, of `holes` and
-// of `taken`, reading along `angle`,
-// its centre tried at `candidates` in turn for each height. Nothing if none
-// fits at kSmallestLabel.
-std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text, double angle,
+// of `taken`, reading along the first of `angles` at which any box fits
+// (the reading the layout prefers first; the others are for a strip too
+// short for the text along it), its centre tried at `candidates` in turn
+// for each height, no taller than `largest`. Nothing if none fits at
+// kSmallestLabel.
+std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text, const std::vector<double>& angles,
                                const std::vector<Point2>& region, const std::vector<Point2>& outline,
                                const std::vector<Circle>& holes, const std::vector<TextBox>& taken,
-                               const std::vector<Point2>& candidates);
+                               const std::vector<Point2>& candidates, double largest = kLargestLabel);
+
+// A strip's readings: along `angle` first, else across it, the text's top
+// toward `angle` (read from the strip's root, where the builder stands).
+std::vector<double> alongThenAcross(double angle);
 
 // The warning for labels that fit nowhere, even at kSmallestLabel (one
 // list per panel, built in parallel): "N labels are not etched, too large

@@ -34,8 +34,8 @@ std::optional<PanelLabel> pieceName(const WovenPanel& w, const RowSpan& span, co
       if (row >= span.first && row <= span.last) rows.push_back(row);
     }
   }
-  const auto box = fitText(font, piece.name, angleAtRow(w, middle), piece.outline, piece.outline, circles, taken,
-                           labelCandidates(w, rows));
+  const auto box = fitText(font, piece.name, alongThenAcross(angleAtRow(w, middle)), piece.outline, piece.outline,
+                           circles, taken, labelCandidates(w, rows));
   if (!box) return std::nullopt;
   return PanelLabel{piece.name, 0, LabelRole::Piece, *box,
                     font.strokes(piece.name, box->origin, box->height, box->angle)};

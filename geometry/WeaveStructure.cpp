@@ -309,8 +309,8 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
                          const std::vector<Point2>& candidates) {
     const std::vector<Point2> region = w.outlineOfRows(std::max(first, 0), std::min(last, w.rows() - 1));
     const std::string text = labelText(label);
-    const auto box =
-        fitText(layout.font, text, weaving::angleAtRow(w, row), region, panel.outline, circles, taken, candidates);
+    const auto box = fitText(layout.font, text, alongThenAcross(weaving::angleAtRow(w, row)), region, panel.outline,
+                             circles, taken, candidates);
     if (!box) {
       unfitted.push_back(fmt::format("{} {} on panel {}", roleName(role), label, panel.id));
       return;

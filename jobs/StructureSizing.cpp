@@ -55,8 +55,8 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
 constexpr double kMostGrowth = 1.10;
 // Rounds of mends (each mends each band without room once), at most, and
 // rounds in a row that leave no fewer bands without room before make stops.
-constexpr int kMendRounds = 40;
-constexpr int kStalledRounds = 3;
+constexpr int kMendRounds = 60;
+constexpr int kStalledRounds = 5;
 // Mends are made only where at most this share of the bands have no room.
 constexpr double kMostMendedShare = 0.4;
 // --size is kept within this share.
@@ -91,7 +91,8 @@ bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHol
     mesh = std::move(before);
     return false;
   }
-  for (const auto& [sum, add] : {std::pair{&mends.collapsed, &made.collapsed}, {&mends.merged, &made.merged}}) {
+  for (const auto& [sum, add] :
+       {std::pair{&mends.collapsed, &made.collapsed}, {&mends.flipped, &made.flipped}, {&mends.merged, &made.merged}}) {
     if (sum->count == 0) sum->first = add->first;
     sum->count += add->count;
     sum->moved = std::max(sum->moved, add->moved);
@@ -102,7 +103,7 @@ bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHol
 // The mends, among the repairs of the mesh as built, said, and its counts as built.
 void recordMends(const geometry::Mends& mends, geometry::PolygonMesh& mesh, BuiltMesh& built, const std::string& name,
                  const core::WorkContext& context) {
-  for (const geometry::MeshRepair* made : {&mends.collapsed, &mends.merged}) {
+  for (const geometry::MeshRepair* made : {&mends.collapsed, &mends.flipped, &mends.merged}) {
     if (made->count == 0) continue;
     context.note(fmt::format("{}: repaired: {}", name, made->line()));
     built.repairs.push_back(*made);
@@ -122,33 +123,53 @@ double innerEdges(const geometry::PolygonMesh& mesh) {
 
 // What make says when bands have no room and no mend gives it: the size,
 // and the fastener at this size, at which every band of `mesh` (as drawn,
-// before any mend) has room, found by building it (every length of the
-// structure scales with it); the fastener alone where that size's panels
-// miss the bed.
+// before any mend) has room for its holes and its number, each found by
+// building it; where that size's panels miss the bed, the fastener alone.
+// (A smaller fastener is what a larger size is for the holes, every length
+// scaling with the structure, but not for the numbers, which keep their
+// smallest height: so it is built too.) `labels`: the bands lack room for
+// their numbers, which glue does not give.
 std::string triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh,
-                        const geometry::BandOptions& band, const core::WorkContext& context) {
+                        const geometry::BandOptions& band, bool labels, const core::WorkContext& context) {
   const auto& names = request.names;
+  const auto buildsWith = [&](double fastener) {
+    if (!(fastener > 0)) return false;
+    geometry::BandOptions smaller = band;
+    smaller.fastener = fastener;
+    try {
+      geometry::buildBandStructure(mesh, smaller, context);
+      return true;
+    } catch (const geometry::NoRoomForHoleError&) {
+      return false;
+    }
+  };
+  const std::string glue = labels ? std::string() : fmt::format("; {} glues them", names(Parameter::GlueNarrow));
   geometry::PolygonMesh larger = mesh;
   try {
     const geometry::GrownStructure grown = geometry::buildBandStructureWithRoom(larger, band, context);
     const double smaller = std::floor(band.fastener / grown.grown * 1000) / 1000;
     const double side = std::ceil(builtSize(grown.structure).maxCoeff());
     const std::string size = fmt::format("{} {:.0f}in", names(Parameter::Size), side);
-    const std::string glue = fmt::format("{} glues them", names(Parameter::GlueNarrow));
     const double kerf = request.kerf.value_or(request.material.kerf);
+    const bool fastenerBuilds = buildsWith(smaller);
     if (roomOnTheBed(structureParts(grown.structure), request.machine, kerf) < 1) {
-      // (Every length scales with the structure: the same at this size with a fastener that much smaller.)
-      return smaller > 0
+      return fastenerBuilds
                  ? fmt::format(
-                       "{} {:.3f}in or smaller builds it at this size (tried at {:.0f} in with this "
-                       "fastener, where a panel is larger than the bed); {}",
+                       "{} {:.3f}in or smaller builds it at this size (tried; at {:.0f} in with this "
+                       "fastener a panel is larger than the bed){}",
                        names(Parameter::Fastener), smaller, side, glue)
-                 : fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed; {}", side, glue);
+                 : fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed{}", side, glue);
     }
-    return smaller > 0 ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size; {}", size,
-                                     names(Parameter::Fastener), smaller, glue)
-                       : fmt::format("{} or larger builds it as drawn (tried); {}", size, glue);
+    return fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size{}", size,
+                                        names(Parameter::Fastener), smaller, glue)
+                          : fmt::format("{} or larger builds it as drawn (tried){}", size, glue);
   } catch (const geometry::NoRoomForHoleError& error) {
+    if (error.labels) {
+      return fmt::format(
+          "no size up to {:.1f} times this one gave every number room (tried); a smaller {} makes "
+          "larger panels",
+          std::pow(geometry::kLabelGrowth, geometry::kMostGrowAttempts), names(Parameter::Panels));
+    }
     return roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true);
   }
 }
@@ -233,14 +254,20 @@ class MendingBuild {
     if (request_.keepFaces || mendsStopped_ || ++rounds_ > kMendRounds) return false;
     // Where most bands have no room, the fastener is too large for the
     // design: mending them all would make another shape.
-    if (!error.estimate && error.bands > kMostMendedShare * innerEdges(mesh_)) return false;
+    const bool counted = !error.estimate || error.labels;
+    if (counted && error.bands > kMostMendedShare * innerEdges(mesh_)) return false;
     // Rounds go on while they leave fewer bands without room (a tab's
-    // error, which names one band and stops the build there, does not count).
-    if (!error.estimate) {
-      if (error.bands < fewest_) {
-        fewest_ = error.bands;
-        stalled_ = 0;
-      } else if (++stalled_ >= kStalledRounds) {
+    // error, which names one band and stops the build there, does not
+    // count). Bands whose numbers have no room are found only once every
+    // hole has room, and their mends may leave new bands without room for a
+    // hole: each kind is counted apart, and the holes afresh after each
+    // round of numbers.
+    if (counted) {
+      Progress& progress = error.labels ? labelsProgress_ : holesProgress_;
+      if (error.labels) holesProgress_ = {};
+      if (error.bands < progress.fewest) {
+        progress = {error.bands, 0};
+      } else if (++progress.stalled >= kStalledRounds) {
         return false;
       }
     }
@@ -290,7 +317,7 @@ class MendingBuild {
                               : request_.keepFaces ? fmt::format(" ({} keeps every face)", names(Parameter::KeepFaces))
                                                    : std::string();
     throw core::UserError(fmt::format("{}: {}{}; {}", name_, error.bandsWithoutRoom, after,
-                                      triedAdvice(request_, asDrawn_, band_, context_)));
+                                      triedAdvice(request_, asDrawn_, band_, error.labels, context_)));
   }
 
   const MakeRequest& request_;
@@ -305,7 +332,12 @@ class MendingBuild {
   std::optional<Unmended> unmended_;
   std::optional<geometry::NoRoomForHoleError> lastError_;
   bool resized_ = false, mendsStopped_ = false, merges_ = true;
-  int rounds_ = 0, stalled_ = 0, fewest_ = std::numeric_limits<int>::max();
+  // The fewest bands without room a round has left, and the rounds since.
+  struct Progress {
+    int fewest = std::numeric_limits<int>::max(), stalled = 0;
+  };
+  Progress holesProgress_, labelsProgress_;
+  int rounds_ = 0;
 };
 
 }  // namespace

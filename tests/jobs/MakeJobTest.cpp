@@ -98,7 +98,8 @@ TEST(MakeJob, ErrorsNameTheMeshAndTheOptionAsTheCallerNamesIt) {
     const std::string what = error.what();
     EXPECT_EQ(what.rfind(request.mesh.string() + ": ", 0), 0u) << what;
     EXPECT_NE(what.find("; size "), std::string::npos) << what;
-    EXPECT_NE(what.find(" or larger builds it as drawn (tried), or fastener 0."), std::string::npos) << what;
+    // (No smaller fastener is offered: at 12 in the bunny's numbers have no room at any.)
+    EXPECT_NE(what.find(" or larger builds it as drawn (tried); other glues them"), std::string::npos) << what;
   }
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
 }
