@@ -165,10 +165,8 @@ std::string triedAdvice(const MakeRequest& request, const geometry::PolygonMesh&
                           : fmt::format("{} or larger builds it as drawn (tried){}", size, glue);
   } catch (const geometry::NoRoomForHoleError& error) {
     if (error.labels) {
-      return fmt::format(
-          "no size up to {:.1f} times this one gave every number room (tried); a smaller {} makes "
-          "larger panels",
-          std::pow(geometry::kLabelGrowth, geometry::kMostGrowAttempts), names(Parameter::Panels));
+      return fmt::format("at no larger size tried did every number have room; a smaller {} makes larger panels",
+                         names(Parameter::Panels));
     }
     return roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true);
   }
