@@ -78,6 +78,18 @@ Panel panelWithBands(const BandBuild& b, const std::vector<BandHoles>& holes, in
   return panel;
 }
 
+// A piece's name etched in `box`, or, where none fitted, counted among the
+// labels left out (the piece is fastened by band `edge`).
+void namePiece(PanelPiece& piece, int edge, const HersheyFont& font, const std::optional<TextBox>& box,
+               std::vector<Unetched>& unfitted) {
+  if (!box) {
+    unfitted.push_back({fmt::format("piece {}", piece.name), edge});
+    return;
+  }
+  piece.labels.push_back(
+      {piece.name, 0, LabelRole::Piece, *box, font.strokes(piece.name, box->origin, box->height, box->angle)});
+}
+
 // A detached band's piece named on its tab, along the side it is fastened to.
 void namePieceOnItsTab(const FlatBand& copy, PanelPiece& piece, const HersheyFont& font,
                        const std::vector<Circle>& circles, const std::vector<TextBox>& taken,
@@ -91,13 +103,10 @@ void namePieceOnItsTab(const FlatBand& copy, PanelPiece& piece, const HersheyFon
     for (double v = 0.2; v <= 0.801; v += 0.3) onTab.push_back((1 - v) * ((1 - u) * t[0] + u * t[1]) + v * middle);
   }
   const Point2 side = copy.tabOutline[1] - copy.tabOutline[0];
-  if (const auto box = fitText(font, piece.name, alongThenAcross(std::atan2(side.y(), side.x())), copy.tabOutline,
-                               copy.pieceOutline, circles, taken, onTab)) {
-    piece.labels.push_back(
-        {piece.name, 0, LabelRole::Piece, *box, font.strokes(piece.name, box->origin, box->height, box->angle)});
-  } else {
-    unfitted.push_back({fmt::format("piece {}", piece.name), copy.edge});
-  }
+  namePiece(piece, copy.edge, font,
+            fitText(font, piece.name, alongThenAcross(std::atan2(side.y(), side.x())), copy.tabOutline,
+                    copy.pieceOutline, circles, taken, onTab),
+            unfitted);
 }
 
 // A band cut across: the far half's name on it, reading out along the
@@ -113,14 +122,10 @@ void nameFarHalf(const FlatBand& copy, double near, double far, PanelPiece& half
   std::stable_sort(onHalf.begin(), onHalf.end(), [&](const Point2& a, const Point2& b) {
     return (a - middle).squaredNorm() < (b - middle).squaredNorm();
   });
-  std::vector<TextBox> halfTaken;
-  if (const auto box = fitText(font, half.name, alongThenAcross(std::atan2(out.y(), out.x())), copy.pieceOutline,
-                               copy.pieceOutline, circles, halfTaken, onHalf)) {
-    half.labels.push_back(
-        {half.name, 0, LabelRole::Piece, *box, font.strokes(half.name, box->origin, box->height, box->angle)});
-  } else {
-    unfitted.push_back({fmt::format("piece {}", half.name), copy.edge});
-  }
+  namePiece(half, copy.edge, font,
+            fitText(font, half.name, alongThenAcross(std::atan2(out.y(), out.x())), copy.pieceOutline,
+                    copy.pieceOutline, circles, {}, onHalf),
+            unfitted);
 }
 
 // Each band's edge number near its holes, reading out from the vertex band

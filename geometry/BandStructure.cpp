@@ -5,8 +5,6 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <numbers>
-#include <set>
 #include <stdexcept>
 
 #include "geometry/BandBuild.h"

@@ -10,6 +10,8 @@
 #include <optional>
 #include <set>
 
+#include "geometry/SurfaceProjection.h"
+
 namespace rotafab::geometry {
 namespace {
 
@@ -351,9 +353,7 @@ class Collapser {
     double nearest = std::numeric_limits<double>::max();
     for (int i = 0; i <= 64; ++i) {
       const Point3 p = a + (b - a) * (i / 64.0);
-      const Point3 cd = d - c;
-      const double t = cd.squaredNorm() > 0 ? std::clamp((p - c).dot(cd) / cd.squaredNorm(), 0.0, 1.0) : 0.0;
-      nearest = std::min(nearest, (c + t * cd - p).norm());
+      nearest = std::min(nearest, (projection::closestOnSegment(p, c, d) - p).norm());
     }
     return nearest;
   }
@@ -402,6 +402,15 @@ bool flippedNear(Collapser& collapser, const PolygonMesh& mesh, int u, int v, Me
 }
 
 }  // namespace
+
+void Mends::add(const Mends& later) {
+  for (const auto& [sum, more] :
+       {std::pair{&collapsed, &later.collapsed}, {&flipped, &later.flipped}, {&merged, &later.merged}}) {
+    if (sum->count == 0) sum->first = more->first;
+    sum->count += more->count;
+    sum->moved = std::max(sum->moved, more->moved);
+  }
+}
 
 MeshRepair collapseDegenerateFaces(PolygonMesh& mesh) {
   MeshRepair repair{"collapse-degenerate-face", 0, ""};

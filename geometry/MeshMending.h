@@ -32,7 +32,11 @@ struct Mends {
   MeshRepair collapsed{"collapse-short-edge", 0, ""};
   MeshRepair flipped{"flip-narrow-band", 0, ""};
   MeshRepair merged{"merge-narrow-band", 0, ""};
+  // Each kind, in the order made (collapses before flips before merges).
+  [[nodiscard]] std::array<const MeshRepair*, 3> kinds() const { return {&collapsed, &flipped, &merged}; }
   [[nodiscard]] int count() const { return collapsed.count + flipped.count + merged.count; }
+  // Those of a later round added: counts summed, the first kept, the farthest move kept.
+  void add(const Mends& later);
 };
 
 // `--repair auto`'s last repair: each face of zero area (its corners

@@ -9,9 +9,8 @@
 #include <numeric>
 #include <unordered_map>
 
-#include "geometry/MeshMending.h"
-
 #include "geometry/EdgeUses.h"
+#include "geometry/MeshMending.h"
 #include "geometry/io/MeshImport.h"
 
 namespace rotafab::geometry {

@@ -91,19 +91,14 @@ bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHol
     mesh = std::move(before);
     return false;
   }
-  for (const auto& [sum, add] :
-       {std::pair{&mends.collapsed, &made.collapsed}, {&mends.flipped, &made.flipped}, {&mends.merged, &made.merged}}) {
-    if (sum->count == 0) sum->first = add->first;
-    sum->count += add->count;
-    sum->moved = std::max(sum->moved, add->moved);
-  }
+  mends.add(made);
   return true;
 }
 
 // The mends, among the repairs of the mesh as built, said, and its counts as built.
 void recordMends(const geometry::Mends& mends, geometry::PolygonMesh& mesh, BuiltMesh& built, const std::string& name,
                  const core::WorkContext& context) {
-  for (const geometry::MeshRepair* made : {&mends.collapsed, &mends.flipped, &mends.merged}) {
+  for (const geometry::MeshRepair* made : mends.kinds()) {
     if (made->count == 0) continue;
     context.note(fmt::format("{}: repaired: {}", name, made->line()));
     built.repairs.push_back(*made);

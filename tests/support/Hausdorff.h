@@ -1,6 +1,6 @@
 #pragma once
 // The Hausdorff distance between two surfaces, for the tests of
-// simplification: the largest distance from a point of either surface to the
+// remeshing: the largest distance from a point of either surface to the
 // other, measured from a dense set of points on each (every corner, and a
 // barycentric grid on every triangle of a fan triangulation of each face) to
 // the nearest point of the other's triangles. Written for the tests, apart
