@@ -54,8 +54,12 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const
   if (const auto& count = job.mesh.panelCount) {
     const geometry::Remeshing& remeshing = count->remeshing;
     if (remeshing.remeshed) {
-      fmt::print("  panels asked: {}; the mesh remeshed from {} faces to {} even triangles\n", count->asked,
-                 remeshing.facesBefore, remeshing.facesAfter);
+      // (Mends of narrow bands collapse or merge faces; a panel that would overlap itself is split in two.)
+      const bool changed =
+          job.structure.kind == geometry::StructureKind::Band && static_cast<int>(panels) != remeshing.facesAfter;
+      fmt::print("  panels asked: {}; the mesh remeshed from {} faces to {} even triangles{}\n", count->asked,
+                 remeshing.facesBefore, remeshing.facesAfter,
+                 changed ? fmt::format(", {} panels as built (after the mends and splits above)", panels) : "");
     } else {
       fmt::print("  panels asked: {}; the mesh has {} faces, kept as drawn\n", count->asked, remeshing.facesAfter);
     }

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "geometry/MeshMending.h"
 #include "geometry/SurfaceProjection.h"
 #include "geometry/TriangleMeshes.h"
 
@@ -632,6 +633,10 @@ Remeshing remeshEvenly(PolygonMesh& mesh, int faces, const core::WorkContext& co
   for (const auto vertex : tri.vertices()) tri.property(source.vertex, vertex) = -1;
   measure(tri, source, input, reference, result);
   mesh = triangles::fromTriangleMesh(tri, source);
+  // A face whose corners slid into one line along a crease (no collapse or
+  // flip there kept the features) goes as the import's repair takes it away.
+  const MeshRepair collinear = collapseDegenerateFaces(mesh);
+  result.largestMove = std::max(result.largestMove, collinear.moved);
   mesh.sourceVertex.clear();
   result.remeshed = true;
   result.facesAfter = mesh.faceCount();

@@ -110,9 +110,18 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   context.check();
 
   Sizing sizing;
-  job.structure = request.structure == geometry::StructureKind::Weave
-                      ? builtWeave(request, mesh, sizing, context)
-                      : builtStructure(request, mesh, job.mesh, sizing, context);
+  if (request.structure == geometry::StructureKind::Weave) {
+    job.structure = builtWeave(request, mesh, sizing, context);
+  } else {
+    const double side = geometry::boundingBoxSize(mesh).maxCoeff();
+    try {
+      job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
+    } catch (const making::StructureRefused& refused) {
+      // A refusal offers a way out that was built, never a guess.
+      if (refused.tried) throw;
+      throw core::UserError(making::withTriedWayOut(request, refused, side, job.mesh.faces, context));
+    }
+  }
   for (const auto& note : job.structure.notes) context.note(fmt::format("{}: {}", name, note));
   for (const auto& warning : job.structure.warnings) {
     context.warn(fmt::format("{}: {}", name, warning));

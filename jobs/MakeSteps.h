@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "core/UserError.h"
 #include "core/WorkContext.h"
 #include "geometry/PolygonMesh.h"
 #include "geometry/Structure.h"
@@ -52,5 +53,28 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
 // builds as drawn. `built.start`: the flood fill's first face.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
+
+// builtStructure()'s refusal: the mesh and the place (`place`: "the edge
+// between vertices 14 and 12: its band ... has no room ..."), and the way out
+// it offers, which `tried` says was built (a size, a fastener) or only
+// estimated or not found.
+class StructureRefused : public core::UserError {
+ public:
+  StructureRefused(const std::string& mesh, std::string place, std::string advice, bool tried)
+      : core::UserError(mesh + ": " + place + (advice.empty() ? "" : "; " + advice)),
+        place(std::move(place)),
+        advice(std::move(advice)),
+        tried(tried) {}
+  std::string place, advice;
+  bool tried;
+};
+
+// A way out of `refused` that was tried: make run again, quietly, with a
+// larger size, fewer panels or both (each as the user would ask for it on
+// the command line), until one builds with every band fastened and every
+// label etched and every panel on the bed, within a bounded time. Returns
+// the refusal's line with that way out, or with what was tried in vain.
+std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& refused, double sideAsRefused,
+                            int facesAsRefused, const core::WorkContext& context);
 
 }  // namespace rotafab::jobs::making

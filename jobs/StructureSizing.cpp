@@ -124,8 +124,12 @@ double innerEdges(const geometry::PolygonMesh& mesh) {
 // scaling with the structure, but not for the numbers, which keep their
 // smallest height: so it is built too.) `labels`: the bands lack room for
 // their numbers, which glue does not give.
-std::string triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh,
-                        const geometry::BandOptions& band, bool labels, const core::WorkContext& context) {
+struct Advice {
+  std::string text;
+  bool tried = false;  // built, not estimated
+};
+Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, const geometry::BandOptions& band,
+                   bool labels, const core::WorkContext& context) {
   const auto& names = request.names;
   const auto buildsWith = [&](double fastener) {
     if (!(fastener > 0)) return false;
@@ -148,22 +152,21 @@ std::string triedAdvice(const MakeRequest& request, const geometry::PolygonMesh&
     const double kerf = request.kerf.value_or(request.material.kerf);
     const bool fastenerBuilds = buildsWith(smaller);
     if (roomOnTheBed(structureParts(grown.structure), request.machine, kerf) < 1) {
-      return fastenerBuilds
-                 ? fmt::format(
-                       "{} {:.3f}in or smaller builds it at this size (tried; at {:.0f} in with this "
-                       "fastener a panel is larger than the bed){}",
-                       names(Parameter::Fastener), smaller, side, glue)
-                 : fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed{}", side, glue);
+      if (fastenerBuilds) {
+        return {fmt::format("{} {:.3f}in or smaller builds it at this size (tried; at {:.0f} in with this "
+                            "fastener a panel is larger than the bed){}",
+                            names(Parameter::Fastener), smaller, side, glue),
+                true};
+      }
+      return {fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed{}", side, glue)};
     }
-    return fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size{}", size,
-                                        names(Parameter::Fastener), smaller, glue)
-                          : fmt::format("{} or larger builds it as drawn (tried){}", size, glue);
+    return {fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size{}", size,
+                                         names(Parameter::Fastener), smaller, glue)
+                           : fmt::format("{} or larger builds it as drawn (tried){}", size, glue),
+            true};
   } catch (const geometry::NoRoomForHoleError& error) {
-    if (error.labels) {
-      return fmt::format("at no larger size tried did every number have room; a smaller {} makes larger panels",
-                         names(Parameter::Panels));
-    }
-    return roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true);
+    if (error.labels) return {"at no larger size tried did every number have room"};
+    return {roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true)};
   }
 }
 
@@ -309,8 +312,8 @@ class MendingBuild {
                                                                mends_.count() == 1 ? " was" : "s were")
                               : request_.keepFaces ? fmt::format(" ({} keeps every face)", names(Parameter::KeepFaces))
                                                    : std::string();
-    throw core::UserError(fmt::format("{}: {}{}; {}", name_, error.bandsWithoutRoom, after,
-                                      triedAdvice(request_, asDrawn_, band_, error.labels, context_)));
+    const Advice advice = triedAdvice(request_, asDrawn_, band_, error.labels, context_);
+    throw StructureRefused(name_, error.bandsWithoutRoom + after, advice.text, advice.tried);
   }
 
   const MakeRequest& request_;
@@ -458,12 +461,12 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   } catch (const geometry::NoRoomForHoleError& error) {
     // (The measuring build of --size glues; a tab's estimate may still be thrown.)
     const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
-    throw core::UserError(fmt::format("{}: {}; {}", request.mesh.string(), error.bandsWithoutRoom,
-                                      roomAdvice(request, mesh, fastener, error.scaleNeeded, "band", error.estimate)));
+    throw StructureRefused(request.mesh.string(), error.bandsWithoutRoom,
+                           roomAdvice(request, mesh, fastener, error.scaleNeeded, "band", error.estimate), false);
   } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{}: {}", request.mesh.string(), error.what()));
+    throw StructureRefused(request.mesh.string(), error.what(), "", false);
   } catch (const geometry::InvalidMeshError& error) {
-    throw core::UserError(fmt::format("{}: {}", request.mesh.string(), error.what()));
+    throw StructureRefused(request.mesh.string(), error.what(), "", false);
   }
 }
 

@@ -290,8 +290,8 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 // L-shaped prism (a panel that overlaps itself at a reflex corner). Each is built at the default size, grown by at most
 // 10%, its narrow places mended where they are (repairs in manifest.json), no band glued. Those no mend gives room
 // (CGAL's pig, triple torus, "mpi" (polygons far from planar) and anchor (slivers everywhere: too many to mend); the
-// npm teapot) are refused with a size, or a fastener, that was tried, and that builds them as drawn (or, where at the
-// size every band has room a panel misses the bed and no fastener leaves room for the numbers, glue). The layout in
+// npm teapot) are refused with a size, or a fastener, that was tried, and that builds them as drawn (or, where at that
+// size a panel misses the bed, the size or panel count with which make's own tries built it, mended). The layout in
 // rows, at once: how fast nesting is does not matter here.
 TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
   std::vector<std::string> meshes = {"/usr/share/openscad/testdata/scad/3D/features/import.stl",
@@ -314,15 +314,15 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
     ASSERT_TRUE(std::regex_search(made.err, advice,
                                   std::regex(R"((--size \d+in) or larger builds it as drawn \(tried\))"
                                              R"(|(--fastener \S+) or smaller builds it at this size \(tried)"
-                                             R"(|a panel is larger than the bed; (--glue-narrow) glues them)")))
+                                             R"(|; ((--panels \d+ ?)?(--size \d+in)?) builds it \(tried: )")))
         << made.err;
     EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
-    // As drawn: with --keep-faces too.
-    const std::string option = advice[1].matched   ? advice[1].str()
-                               : advice[2].matched ? advice[2].str()
+    // As drawn (with --keep-faces too), or as make's own tries built it (with mends).
+    const std::string option = advice[1].matched   ? advice[1].str() + " --keep-faces"
+                               : advice[2].matched ? advice[2].str() + " --keep-faces"
                                                    : advice[3].str();
     const CommandResult followed = run(kCli + " make " + mesh + " --structure band --layout rows " + option +
-                                       " --keep-faces --out " + quoted(dir.path() / "followed"));
+                                       " --out " + quoted(dir.path() / "followed"));
     EXPECT_EQ(followed.status, 0) << option << ": " << followed.err;
   }
   for (const std::string& where : meshes) {
@@ -359,8 +359,10 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
 // OpenSCAD's test STLs whose faces of zero area (collinear corners, as CAD
 // programs write them) were refused for them: --repair auto collapses
 // them, says so, and names the first by the file's facet; --repair none
-// still refuses them. (Their CAD slivers then leave most bands without
-// room: refused with a way out, not for the zero area.)
+// still refuses them. Their CAD slivers (fans across each flat side) leave
+// most bands without room at the default size, and a thin wing's panel
+// overlaps itself: refused with a panel count and a size that were tried,
+// and that build them, at that size, through every invariant.
 TEST(MakeCli, CadStlsFacesOfZeroAreaAreRepaired) {
   for (const char* where : {"/usr/share/openscad/testdata/stl/adns2610_dev_circuit_inv.stl",
                             "/usr/share/openscad/testdata/scad/misc/bad-stl-wing.stl"}) {
@@ -376,6 +378,29 @@ TEST(MakeCli, CadStlsFacesOfZeroAreaAreRepaired) {
                                       " --structure band --repair none --out " + quoted(dir.path() / "none"));
     EXPECT_EQ(refused.status, 1) << refused.err;
     EXPECT_NE(refused.err.find("has zero area"), std::string::npos) << refused.err;
+    const CommandResult asDrawn = run(kCli + " make " + quoted(publicMesh(where)) +
+                                      " --structure band --layout rows --out " + quoted(dir.path() / "default"));
+    EXPECT_EQ(asDrawn.status, 1) << asDrawn.err;
+    std::smatch wayOut;
+    ASSERT_TRUE(std::regex_search(asDrawn.err, wayOut,
+                                  std::regex(R"(; ((--panels \d+ )?--size (\d+)in) builds it \(tried: (\d+) panels)")))
+        << asDrawn.err;
+    const CommandResult followed =
+        run(kCli + " make " + quoted(publicMesh(where)) + " --structure band --layout rows " + wayOut[1].str() +
+            " --out " + quoted(dir.path() / "followed"));
+    ASSERT_EQ(followed.status, 0) << wayOut[1].str() << ": " << followed.err;
+    EXPECT_EQ(followed.err.find(" glued"), std::string::npos) << followed.err;
+    EXPECT_EQ(followed.err.find("not etched"), std::string::npos) << followed.err;
+    const auto m = nlohmann::json::parse(readFile(dir.path() / "followed/manifest.json"));
+    EXPECT_EQ(m.at("panels").size(), std::stoul(wayOut[4].str()));
+    double side = 0;
+    for (const auto& length : m.at("size")) side = std::max(side, length.get<double>());
+    EXPECT_NEAR(side, std::stod(wayOut[3].str()), 0.01 * std::stod(wayOut[3].str()));
+    // (Remeshed, a panel's source face is the input's face under its centre: several panels may share one.)
+    std::set<int> sources;
+    for (const auto& panel : m.at("panels")) sources.insert(panel.at("source").at("face").get<int>());
+    expectSpecPanels(m, static_cast<int>(sources.size()), -1, 0,
+                     static_cast<int>(m.at("panels").size() - sources.size()));
   }
 }
 

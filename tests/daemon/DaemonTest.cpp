@@ -569,14 +569,15 @@ const fs::path& oneSheet() {
   return made;
 }
 
-// One host of a fab lab: its name, the shared store and spool, a short
-// lease, and one simulated GRBL of its own.
+// One host of a fab lab: its name, the shared store and spool, a lease
+// (short, 3 s, where a test waits for one to lapse), and one simulated GRBL
+// of its own.
 std::string hostConfig(const test::TestDatabase& database, const fs::path& spool, const std::string& host,
-                       const std::string& simulator, bool autoStart) {
+                       const std::string& simulator, bool autoStart, int leaseSeconds = 3) {
   return fmt::format(
-      "store: {}\nhost: {}\nspool: {}\nlease: 3\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
+      "store: {}\nhost: {}\nspool: {}\nlease: {}\ndevices: [{{name: laser-{}, machine: grbl-diode-400, uri: "
       "\"{}\", auto_start: {}}}]\n",
-      database.uri(), host, spool.string(), host, simulator, autoStart);
+      database.uri(), host, spool.string(), leaseSeconds, host, simulator, autoStart);
 }
 
 std::vector<std::string> statesOf(const json& job) {
@@ -591,8 +592,10 @@ std::vector<std::string> statesOf(const json& job) {
 TEST(Daemon, TwoHostsOnOneStoreCutEachOfTwoHundredConcurrentSubmissionsExactlyOnce) {
   test::TestDatabase database;
   TempDir shared, rootA, rootB;
-  Daemon a(rootA.path(), hostConfig(database, shared.path(), "a", "sim:grbl?speed=10000", true));
-  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=10000", true));
+  // (No lease lapses here: one long enough that 200 submissions on two busy cores do not stall its renewal.)
+  constexpr int kLeaseSeconds = 15;
+  Daemon a(rootA.path(), hostConfig(database, shared.path(), "a", "sim:grbl?speed=10000", true, kLeaseSeconds));
+  Daemon b(rootB.path(), hostConfig(database, shared.path(), "b", "sim:grbl?speed=10000", true, kLeaseSeconds));
   a.start();
   b.start();
   constexpr int kClients = 8, kEach = 25;
