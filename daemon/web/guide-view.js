@@ -113,8 +113,9 @@ export class Guide {
   }
 
   load(structure, manifest) {
-    // Assembly order: the manifest's `order`, else the panels' own.
-    this.panels = [...manifest.panels].sort((a, b) => (a.order || a.id) - (b.order || b.id));
+    // Assembly order, as manifest.txt's steps: a panel's id is its step
+    // (the flood fill's order; `order` is where it comes in the cutting).
+    this.panels = [...manifest.panels].sort((a, b) => a.id - b.id);
     this.byId = new Map(manifest.panels.map((panel) => [panel.id, panel]));
     this.step = 0;
     if (!this.renderer) {
@@ -225,7 +226,7 @@ export class Guide {
     $('guide-steps').textContent = String(this.panels.length);
     $('guide-panel-number').textContent = String(panel.id);
     $('guide-panel-sheet').textContent = panel.sheet ? String(panel.sheet) : '–';
-    const placedBefore = (other) => (other.order || other.id) < (panel.order || panel.id);
+    const placedBefore = (other) => other.id < panel.id;
     const neighbours = (panel.neighbors || []).map((id) => this.byId.get(id)).filter(Boolean);
     $('guide-panel-neighbours').textContent = neighbours.length
       ? neighbours.map((other) => `${other.id}${placedBefore(other) ? ' (placed)' : ''}`).join(', ')

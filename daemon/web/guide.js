@@ -25,14 +25,16 @@ export async function openGuide(jobId) {
   steps.replaceChildren();
   const job = state.jobs.find((known) => known.id === jobId);
   $('guide-print-title').textContent = `Assembly of job ${jobId}${job ? `, ${job.source}` : ''}: ${manifest.panels.length} panels in order`;
+  // The steps of manifest.txt: each panel in assembly order, its sheet, and the placed panels it joins.
   for (const panel of state.guide.panels) {
     const neighbours = (panel.neighbors || []).map((id) => state.guide.byId.get(id)).filter(Boolean);
     const joins = neighbours
-      .filter((other) => (other.order || other.id) < (panel.order || panel.id))
+      .filter((other) => other.id < panel.id)
       .map((other) => `${other.id} (${sharedHoles(panel, other).map((s) => `edge ${s.edge}`).join(', ') || 'no holes'})`);
     const first = panel === state.guide.panels[0];
-    steps.append(element('li', {}, `Panel ${panel.id}, sheet ${panel.sheet}` + (joins.length ? `: joins ${joins.join('; ')}`
-      : first ? ': the first' : ': joins no panel placed yet (a new piece, joined to the rest later)')));
+    steps.append(element('li', { 'data-panel': String(panel.id), 'data-sheet': String(panel.sheet) },
+      `Step ${panel.id}: panel ${panel.id} (sheet ${panel.sheet})` + (joins.length ? `: joins ${joins.join('; ')}`
+        : first ? ': the first' : ': joins no panel placed yet (a new piece, joined to the rest later)')));
   }
   window.rotafabGuide = {
     job: jobId,

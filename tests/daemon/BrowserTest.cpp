@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <pwd.h>
+#include <regex>
 
 #include <algorithm>
 
@@ -144,7 +145,20 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
     if (panel["id"] == 3) three = panel;
   }
   ASSERT_TRUE(three.is_object());
-  EXPECT_EQ(three["order"], step);
+  EXPECT_EQ(step, 3) << "the guide steps in assembly order (a panel's id), not in cutting order";
+  // The guide's steps are manifest.txt's: each panel in assembly order, on its sheet.
+  const CommandResult text = daemon.client("manifest 1");
+  ASSERT_EQ(text.status, 0) << text.err;
+  json stepsOfText = json::array();
+  const std::regex stepLine(R"(step +(\d+): panel (\d+) \(sheet (\d+)\))");
+  for (auto line = std::sregex_iterator(text.out.begin(), text.out.end(), stepLine); line != std::sregex_iterator();
+       ++line) {
+    stepsOfText.push_back({std::stoi((*line)[2].str()), std::stoi((*line)[3].str())});
+  }
+  EXPECT_EQ(stepsOfText.size(), manifest["panels"].size()) << text.out;
+  EXPECT_EQ(browser.evaluate("[...document.querySelectorAll('#guide-print-steps li')].map((li) => "
+                             "[Number(li.dataset.panel), Number(li.dataset.sheet)])"),
+            stepsOfText);
   // Its sheet and neighbours as the manifest says.
   EXPECT_EQ(browser.evaluate("document.getElementById('guide-panel-sheet').textContent"),
             std::to_string(three["sheet"].get<int>()));
