@@ -17,6 +17,16 @@
 namespace rotafab::cli {
 namespace {
 
+// Why the nesting stopped, as the summary says it (NestingResult::stopped).
+std::string nestingStopped(const std::string& stopped) {
+  if (stopped == "area bound") return " (done: as few sheets as the parts' area allows)";
+  if (stopped == "no better layout") return " (done: no better layout in many tries)";
+  if (stopped == "time budget") return " (the whole --time)";
+  if (stopped == "layout cap") return " (the --evaluations cap)";
+  if (stopped == "nothing to search") return " (the first layout: nothing to search in this order)";
+  return "";
+}
+
 // "stands: ..." or "tips over: ... hang it from ...", with the mass when the material gives it.
 std::string stabilityLine(const geometry::Stability& stability) {
   const std::string mass = stability.massKg ? fmt::format("; mass {:.3g} kg", *stability.massKg) : "";
@@ -67,8 +77,8 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const
   fmt::print("  built, {:.1f} x {:.1f} x {:.1f} in; {}\n", job.size.x(), job.size.y(), job.size.z(),
              stabilityLine(job.stability));
   fmt::print("  it takes {}\n", jobs::costLine(job.cost));
-  fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s, estimate {:.2f} s, writing {:.2f} s\n", s.import,
-             s.geometry, s.nesting, s.estimate, s.writing);
+  fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s{}, estimate {:.2f} s, writing {:.2f} s\n",
+             s.import, s.geometry, s.nesting, nestingStopped(job.sheets.stopped), s.estimate, s.writing);
   fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", job.folder.string(), job.folder.string());
 }
 

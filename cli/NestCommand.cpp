@@ -125,9 +125,12 @@ void addNestCommand(CLI::App& app, int& status) {
                    "--strip or --evaluations: the first layout is then always finished)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 86400.0));
-  command->add_option("--order", options->order, "strict, window or free: how far parts may move from their order")
+  command
+      ->add_option("--order", options->order,
+                   "kits, strict, window or free: how far parts may move from their order (kits: each sheet a run of "
+                   "it)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"strict", "window", "free"}));
+      ->check(CLI::IsMember({"kits", "strict", "window", "free"}));
   command->add_option("--window", options->window, "With --order window: at most this many places")
       ->capture_default_str();
   command->add_option("--seed", options->seed, "Seed of the improvement search")->capture_default_str();

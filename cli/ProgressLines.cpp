@@ -61,7 +61,7 @@ void ProgressLines::operator()(const core::Progress& p) {
       const double left = p.budget - p.elapsed;
       step = fmt::format("{} sheet{}, last sheet {:.2f} in long, in {:.1f} s; {}", p.sheets, plural(p.sheets), p.length,
                          p.elapsed,
-                         left >= 0.5 ? fmt::format("improving it for up to {:.0f} s more", left)
+                         left >= 0.5 ? fmt::format("improving it for up to {:.0f} s more, while that helps", left)
                                      : std::string("no time left in --time to improve it"));
       nextCount_ = std::chrono::steady_clock::now() + kCountEvery;
     } else if (p.step == "improving" || p.step == "compacting" || p.step == "searching") {

@@ -28,6 +28,18 @@ using nlohmann::json;
 
 namespace {
 
+// " (its kit: steps 174-352; once cut, steps 1-352 can be done)" for sheet
+// `sheet` of a job whose summary gives its kits, else nothing.
+std::string kitOf(const json& job, int sheet) {
+  const json* kits = job.contains("summary") && job["summary"].is_object() && job["summary"].contains("kits")
+                         ? &job["summary"]["kits"]
+                         : nullptr;
+  if (!kits || !kits->is_array() || sheet < 1 || static_cast<size_t>(sheet) > kits->size()) return "";
+  const json& kit = (*kits)[static_cast<size_t>(sheet) - 1];
+  return kit.is_string() && !kit.get<std::string>().empty() ? fmt::format(" (its kit: {})", kit.get<std::string>())
+                                                            : "";
+}
+
 struct ClientOptions {
   std::string server, token;
   bool json = false;
@@ -172,7 +184,8 @@ void printStatus(const json& job) {
   }
   if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
   if (job.value("waiting_for_next", false)) {
-    fmt::print("  waiting: load sheet {} and run `rotafab next {}`\n", job.value("sheet", 0) + 1, job.value("id", 0));
+    const int next = job.value("sheet", 0) + 1;
+    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, kitOf(job, next), job.value("id", 0));
   }
   fmt::print("  {}\n", job.value("message", ""));
   if (job.contains("transitions")) {
@@ -249,7 +262,8 @@ int follow(const DaemonClient& client, long long id) {
         endBar();
         askedFor = next;
         if (askHere) {
-          fmt::print(stderr, "job {}: load sheet {} and press Enter (or run `rotafab next {}`)\n", id, next, id);
+          fmt::print(stderr, "job {}: load sheet {}{} and press Enter (or run `rotafab next {}`)\n", id, next,
+                     kitOf(data, next), id);
           if (asking.joinable()) asking.join();
           asking = std::thread([&client, id, &stopAsking] {
             if (!waitForEnter(stopAsking)) return;
@@ -260,7 +274,7 @@ int follow(const DaemonClient& client, long long id) {
             }
           });
         } else {
-          fmt::print(stderr, "job {}: load sheet {} and run `rotafab next {}`\n", id, next, id);
+          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, kitOf(data, next), id);
         }
       }
       if (settled(data)) {

@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <filesystem>
+#include <map>
 #include <memory>
 
 #include "cli/CommandContext.h"
@@ -11,6 +13,7 @@
 #include "cli/RunProgress.h"
 #include "devices/JobRun.h"
 #include "toolpath/JobSheets.h"
+#include "toolpath/ManifestFile.h"
 
 namespace rotafab::cli {
 namespace {
@@ -36,7 +39,7 @@ profiles::MachineProfile machineFor(const RunOptions& options, const profiles::P
   return machine;
 }
 
-int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command) {
+int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command, std::map<int, std::string> kits) {
   const auto& toolpaths = job.toolpaths();
   if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
     throw UserError(
@@ -47,7 +50,8 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   const auto started = std::chrono::steady_clock::now();
   devices::RunSummary done;
   try {
-    done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation()), command.cancellation());
+    done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(kits)),
+                   command.cancellation());
   } catch (const devices::DeviceFault& fault) {
     // Where the job stopped, so that the operator knows what is cut and can
     // go on from that sheet; and what is true of the laser.
@@ -118,7 +122,15 @@ int runRun(const RunOptions& options) {
       } catch (const std::invalid_argument& error) {
         throw UserError(error.what());
       }
-      if (!options.dryRun) return cut(options, *job, command);
+      if (!options.dryRun) {
+        // Each sheet's kit, said as it is loaded and cut, where the folder's manifest gives them.
+        std::map<int, std::string> kits;
+        if (const auto manifest = std::filesystem::path(options.target) / "manifest.json";
+            std::filesystem::is_directory(options.target) && std::filesystem::exists(manifest)) {
+          if (const auto read = jobs::readManifestSheets(manifest)) kits = read->kits;
+        }
+        return cut(options, *job, command, std::move(kits));
+      }
       if (job->toolpaths().size() > 1) {
         // One file of several sheets would be cut back to back, onto one sheet.
         throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,

@@ -3,6 +3,7 @@
 // minutes, and the question before each sheet after the first.
 
 #include <chrono>
+#include <map>
 #include <string>
 
 #include "core/Cancellation.h"
@@ -35,7 +36,9 @@ bool waitForEnter(const core::Cancellation& cancel);
 
 // The events of a run of `sheets` sheets shown on standard error: a line as
 // each sheet starts, its progress bar, the question before each sheet after
-// the first (answered at the terminal), the framing.
-devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel);
+// the first (answered at the terminal), the framing. `kits`: each sheet's
+// kit by its number, as the job's manifest says it (ManifestSheets::kits).
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel,
+                                     std::map<int, std::string> kits = {});
 
 }  // namespace rotafab::cli

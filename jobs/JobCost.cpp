@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
 #include "core/Duration.h"
@@ -10,6 +11,10 @@
 namespace rotafab::jobs {
 
 double JobCost::totalSeconds() const { return std::accumulate(cuttingSeconds.begin(), cuttingSeconds.end(), 0.0); }
+
+double JobCost::assemblySeconds() const {
+  return panels * kAssemblySecondsPerPanel + fasteners * kAssemblySecondsPerFastener;
+}
 
 nlohmann::ordered_json costJson(const JobCost& cost) {
   nlohmann::ordered_json json = {
@@ -21,6 +26,11 @@ nlohmann::ordered_json costJson(const JobCost& cost) {
        cost.cuttingSeconds.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(cost.totalSeconds())},
       {"sheet_cutting_seconds", cost.cuttingSeconds},
       {"motion", cost.motionGiven ? "profile" : "defaults"}};
+  // Extension: one person's time to assemble it, seconds (JobCost.h's rate).
+  if (cost.panels > 0) {
+    json["panels"] = cost.panels;
+    json["assembly_seconds"] = std::round(cost.assemblySeconds());
+  }
   return json;
 }
 
@@ -39,6 +49,8 @@ std::string costLine(const JobCost& cost) {
     }
     if (!cost.motionGiven) line += ", at GRBL's default speeds (the machine profile gives no motion)";
   }
+  if (cost.panels > 0)
+    line += fmt::format("; assembling about {} of one person's time", core::minutes(cost.assemblySeconds()));
   return line;
 }
 
@@ -52,6 +64,7 @@ JobCost costFromJson(const nlohmann::json& json) {
   cost.fastenerDiameter = json.at("fasteners").at("diameter").get<double>();
   cost.cuttingSeconds = json.at("sheet_cutting_seconds").get<std::vector<double>>();
   cost.motionGiven = json.at("motion").get<std::string>() == "profile";
+  cost.panels = json.value("panels", 0);
   return cost;
 }
 

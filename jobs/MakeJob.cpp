@@ -77,6 +77,7 @@ JobCost jobCost(const PlannedJob& job, const MakeRequest& request, const core::W
   cost.sheets = job.sheets.sheets.size();
   cost.sheetWidth = request.machine.bed.width, cost.sheetHeight = request.machine.bed.height;
   cost.fasteners = job.structure.fasteners;
+  cost.panels = static_cast<int>(job.structure.panels.size());
   cost.fastenerDiameter = request.fastener.value_or(request.material.fastenerDiameter);
   cost.motionGiven = request.machine.motion.has_value();
   const MotionLimits limits = profileMotion(request.machine);
@@ -137,7 +138,6 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   plan.evaluations = request.evaluations;
   plan.order = request.order;
   plan.window = request.window;
-  plan.freeOrderWhenItSavesSheets = request.freeOrderWhenItSavesSheets;
   plan.rows = request.rows;
   plan.title = job.title;
   context.report({"nesting", "", 0, job.structure.panels.size()});
@@ -160,12 +160,6 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.bed = request.machine.bed;
   job.formats = request.formats.value_or(defaultFormats(request.machine));
   job.seconds.nesting = lap();
-  if (job.sheets.windowSheets > 0) {
-    context.note(fmt::format(
-        "{}: cut in the free order: keeping each part within {} places of the assembly order took {} sheets, the "
-        "free order {} (manifest.json's `moved` says how far each part moved; --order window keeps the window)",
-        name, request.window, job.sheets.windowSheets, job.sheets.sheets.size()));
-  }
   if (!job.sheets.inRowsNote.empty()) context.note(fmt::format("{}: {}", name, job.sheets.inRowsNote));
   job.cost = jobCost(job, request, context);
   job.seconds.estimate = lap();
@@ -216,6 +210,7 @@ nlohmann::ordered_json summaryJson(const PlannedJob& job) {
                                       {"nesting", s.nesting},
                                       {"estimate", s.estimate},
                                       {"writing", s.writing}}}};
+  if (!job.sheets.stopped.empty()) summary["nesting_stopped"] = job.sheets.stopped;
   if (job.mesh.panelCount) summary["simplified"] = simplifiedJson(*job.mesh.panelCount);
   summary["size"] = {job.size.x(), job.size.y(), job.size.z()};
   summary["stability"] = stabilityJson(job.stability);

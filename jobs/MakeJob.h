@@ -72,9 +72,8 @@ struct MakeRequest {
   double seconds = kDefaultNestingSeconds;
   int evaluations = 0;                  // as NestingOptions'
   std::optional<SheetFormats> formats;  // unset: defaultFormats(machine)
-  OrderMode order = OrderMode::Window;
+  OrderMode order = OrderMode::Kits;
   int window = 8;
-  bool freeOrderWhenItSavesSheets = false;  // as PlanOptions'
   bool rows = false;
   // How messages name the options (the command line: by their flags).
   geometry::ParameterNames names = geometry::parameterInWords;

@@ -235,10 +235,10 @@ const std::vector<MakeOption>& makeOptionTable() {
                  &M::evaluations)
           .within(0, 1000000000),
       MakeOption("order", V::Choice,
-                 "Cutting order: strict, window or free (see `rotafab nest`); by default window, or free where\n"
-                 "keeping to the window would cost a sheet",
+                 "Cutting order: kits (each sheet a run of the assembly steps, nested freely within it; the\n"
+                 "default), strict, window or free (the fewest sheets, the steps anywhere; see `rotafab nest`)",
                  &M::order)
-          .among({"strict", "window", "free"})
+          .among({"kits", "strict", "window", "free"})
           .shown(),
       MakeOption("window", V::Whole, "With --order window: at most this many places from the assembly order",
                  &M::window)
@@ -424,7 +424,10 @@ std::string flagOf(geometry::Parameter parameter) {
 }
 
 OrderMode orderModeOf(const std::string& order) {
-  return order == "strict" ? OrderMode::Strict : order == "free" ? OrderMode::Free : OrderMode::Window;
+  return order == "strict"   ? OrderMode::Strict
+         : order == "free"   ? OrderMode::Free
+         : order == "window" ? OrderMode::Window
+                             : OrderMode::Kits;
 }
 
 MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalogue& catalogue) {
@@ -462,7 +465,6 @@ MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalog
   request.seconds = options.seconds;
   request.evaluations = options.evaluations;
   request.order = orderModeOf(options.order);
-  request.freeOrderWhenItSavesSheets = !options.given.contains("order");
   request.window = options.window;
   request.rows = options.layout == "rows";
   if (!options.formats.empty()) request.formats = formatsOf(options.formats);  // checked by whyNotAValue

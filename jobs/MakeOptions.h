@@ -23,7 +23,7 @@ namespace rotafab::jobs {
 
 struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
-  std::string size, fastener, kerf, holes, repair = "auto", up = "y", order = "window", layout = "nest";
+  std::string size, fastener, kerf, holes, repair = "auto", up = "y", order = "kits", layout = "nest";
   std::string offset, cycles = "all";  // the weave's
   std::optional<double> width, curve;  // the weave's: fractions, no unit
   std::string formats;                 // empty: the machine profile's (jobs::defaultFormats())

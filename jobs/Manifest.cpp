@@ -15,6 +15,7 @@
 #include "core/UserError.h"
 #include "geometry/WeaveStructure.h"
 #include "jobs/JobCost.h"
+#include "jobs/ManifestSteps.h"
 #include "jobs/SvgWriter.h"
 #include "toolpath/JsonErrors.h"
 
@@ -264,6 +265,13 @@ ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMes
   manifest["panels"] = nlohmann::ordered_json::array();
   for (size_t i = 0; i < structure.panels.size(); ++i) {
     manifest["panels"].push_back(panelEntry(structure, i, placements, false));
+  }
+  // Each sheet's kit (the steps it holds, and what can be done once it is cut).
+  const std::vector<SheetKit> kits = sheetKits(manifest);
+  for (size_t s = 0; s < kits.size(); ++s) {
+    auto& sheet = manifest["sheets"][s];
+    if (kits[s].run && kits[s].first > 0) sheet["kit"] = {kits[s].first, kits[s].last};
+    sheet["completes"] = kits[s].completes;
   }
   for (const auto& [key, value] : more.items()) manifest[key] = value;
   ManifestFiles out;

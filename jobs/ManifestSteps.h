@@ -19,6 +19,20 @@ struct StepLine {
 
 // The steps in assembly order, whatever the structure.
 std::vector<StepLine> stepLines(const nlohmann::ordered_json& manifest);
+// A sheet's kit: the steps (panel ids, in assembly order) whose panels it
+// holds, from `first` to `last`, `run` when they are every step between;
+// `completes`: once it and the sheets before it are cut, steps 1 to
+// `completes` can all be done (their panels and pieces cut), 0 for none.
+struct SheetKit {
+  int first = 0, last = 0;
+  bool run = true;
+  int completes = 0;
+};
+// Each sheet's kit, in sheet order, from the panels' sheets (and their pieces').
+std::vector<SheetKit> sheetKits(const nlohmann::ordered_json& manifest);
+// "steps 1-176", "steps 3 to 3650 (not in one run)".
+std::string kitText(const SheetKit& kit);
+
 // What the steps mean, for the structure.
 std::string howToJoin(const nlohmann::ordered_json& manifest);
 // "band structure, 12 panels on 2 sheets, 30 fasteners".

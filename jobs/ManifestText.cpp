@@ -382,6 +382,48 @@ std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
   return notes;
 }
 
+std::vector<SheetKit> sheetKits(const nlohmann::ordered_json& manifest) {
+  const auto& panels = manifest.at("panels");
+  const size_t sheets = manifest.at("sheets").size();
+  std::vector<SheetKit> kits(sheets);
+  std::vector<int> held(sheets, 0);
+  // The last sheet each step needs, by its panel's id (its panel's and its pieces').
+  std::vector<int> needs(panels.size() + 1, 0);
+  for (const auto& panel : panels) {
+    const int id = panel.at("id").get<int>(), sheet = panel.at("sheet").get<int>();
+    if (id < 1 || static_cast<size_t>(id) > panels.size() || sheet < 1 || static_cast<size_t>(sheet) > sheets) {
+      throw std::invalid_argument(fmt::format("panel {}: no such panel or sheet", id));
+    }
+    int last = sheet;
+    if (panel.contains("pieces")) {
+      for (const auto& piece : panel.at("pieces")) last = std::max(last, piece.at("sheet").get<int>());
+    }
+    needs[static_cast<size_t>(id)] = last;
+    SheetKit& kit = kits[static_cast<size_t>(sheet) - 1];
+    kit.first = kit.first == 0 ? id : std::min(kit.first, id);
+    kit.last = std::max(kit.last, id);
+    ++held[static_cast<size_t>(sheet) - 1];
+  }
+  int done = 0;
+  for (size_t s = 0; s < sheets; ++s) {
+    SheetKit& kit = kits[s];
+    kit.run = held[s] == 0 || kit.last - kit.first + 1 == held[s];
+    while (static_cast<size_t>(done) + 1 < needs.size() &&
+           needs[static_cast<size_t>(done) + 1] <= static_cast<int>(s) + 1) {
+      ++done;
+    }
+    kit.completes = done;
+  }
+  return kits;
+}
+
+std::string kitText(const SheetKit& kit) {
+  if (kit.first == 0) return "no panel";
+  if (kit.first == kit.last) return fmt::format("step {}", kit.first);
+  return kit.run ? fmt::format("steps {}-{}", kit.first, kit.last)
+                 : fmt::format("panels of steps {} to {} (not in one run)", kit.first, kit.last);
+}
+
 std::string manifestText(const nlohmann::ordered_json& manifest) {
   try {
     std::string text =
@@ -390,6 +432,15 @@ std::string manifestText(const nlohmann::ordered_json& manifest) {
       for (const std::string& note : notes) text += note + "\n";
       text += "\n";
     }
+    // Each sheet's kit: what can be built once it is cut (the dissertation's
+    // V.5: builders join the panels in the order they are cut).
+    const std::vector<SheetKit> kits = sheetKits(manifest);
+    for (size_t s = 0; s < kits.size(); ++s) {
+      text += fmt::format("sheet {}: {}; once cut, {}\n", s + 1, kitText(kits[s]),
+                          kits[s].completes == 0 ? std::string("no step can be done yet")
+                                                 : fmt::format("steps 1-{} can be done", kits[s].completes));
+    }
+    text += "\n";
     int total = 0, thread = 0;
     for (const StepLine& step : stepLines(manifest)) {
       total += step.fasteners;

@@ -106,7 +106,8 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
   // the lowest seed's). Strict order has nothing to search, nor has the
   // window order on a job too large for the sequence search.
   const bool nothingToSearch =
-      options.order == OrderMode::Strict || (options.order == OrderMode::Window && !shapes.forNoFitPolygons());
+      options.order == OrderMode::Strict ||
+      ((options.order == OrderMode::Window || options.order == OrderMode::Kits) && !shapes.forNoFitPolygons());
   const unsigned searches = nothingToSearch || parts.size() < 2 ? 1u
                             : options.threads > 0               ? static_cast<unsigned>(options.threads)
                                                                 : context.executor().concurrency();
@@ -128,9 +129,29 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
     }
     best = std::move(results[winner]);
     best.evaluations = evaluations;
+    if (nothingToSearch || parts.size() < 2) best.stopped = "nothing to search";
   }
+  if (best.stopped.empty()) best.stopped = "time budget";
   for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));
   return best;
+}
+
+bool inKits(const std::vector<NestingPart>& parts, const NestingResult& result) {
+  const int n = static_cast<int>(parts.size()), sheets = result.sheets;
+  if (n == 0) return true;
+  std::vector<int> lowest(static_cast<size_t>(sheets) + 1, n), highest(static_cast<size_t>(sheets) + 1, -1);
+  for (const PartPlacement& placement : result.placements) {
+    const int order = parts[placement.part].order, sheet = placement.sheet;
+    // Step order + 1, due by its fair share's sheet, one sheet of slack.
+    const int share = static_cast<int>((static_cast<long long>(order + 1) * sheets + n - 1) / n);
+    if (sheet > share + 1 || (order == 0 && sheet != 1)) return false;
+    lowest[static_cast<size_t>(sheet)] = std::min(lowest[static_cast<size_t>(sheet)], order);
+    highest[static_cast<size_t>(sheet)] = std::max(highest[static_cast<size_t>(sheet)], order);
+  }
+  for (int k = 1; k < sheets; ++k) {
+    if (highest[static_cast<size_t>(k)] > lowest[static_cast<size_t>(k) + 1]) return false;
+  }
+  return true;
 }
 
 std::string inRowsNote(const NestingResult& result) {

@@ -45,9 +45,15 @@ struct NestingPart {
 
 // How far the layout may move parts from their assembly order.
 enum class OrderMode {
-  Strict,  // sheet k holds a contiguous run of the order
+  Strict,  // sheet k holds a contiguous run of the order, each sheet filled before the next
   Window,  // no part is cut more than `window` places before or after its order
   Free,
+  // Kits (the dissertation's V.5: builders join panels in the order they
+  // are cut): sheet k holds a contiguous run of the order, nested freely
+  // within the sheet, the runs' ends moving between neighbouring sheets;
+  // step i (1-based, of n on S sheets) on sheet ceil(i S / n) + 1 at the
+  // latest, and step 1 on sheet 1 (inKits()).
+  Kits,
 };
 
 struct NestingOptions {
@@ -90,6 +96,11 @@ struct NestingResult {
   double stripLength = 0;  // strip mode: the rightmost extent of any part
   double partArea = 0;     // sum of the outlines' areas
   int evaluations = 0;     // layouts tried (and compaction moves), all searches together
+  // Why the search stopped: "area bound" (as few sheets as the parts' area
+  // allows), "no better layout" (it found none in many tries), "time
+  // budget", "layout cap" (NestingOptions::evaluations); "nothing to
+  // search" (strict order, or the first layout was all the budget allowed).
+  std::string stopped;
   // Parts laid out in rows by their boxes (RowLayout.h), after the rest,
   // because the budget ran out before the first layout reached them.
   int inRows = 0;
@@ -103,6 +114,12 @@ struct NestingResult {
 // (each better layout, by sheets and length; in the strip, its length).
 NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& options,
                    const core::WorkContext& context);
+
+// Whether `result` keeps the kits of OrderMode::Kits: each sheet a
+// contiguous run of the parts' order (after sheet k, every step up to its
+// last can be done), no step later than one sheet beyond its fair share,
+// the first step on sheet 1.
+bool inKits(const std::vector<NestingPart>& parts, const NestingResult& result);
 
 // What a person needs to know of NestingResult::inRows, in one line, or
 // nothing when every part was nested.

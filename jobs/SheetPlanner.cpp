@@ -1,7 +1,6 @@
 #include "jobs/SheetPlanner.h"
 
 #include <cctype>
-#include <chrono>
 
 #include <fmt/format.h>
 
@@ -56,30 +55,12 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.width = bed.width - 2 * bed.margin;
   nesting.height = bed.height - 2 * bed.margin;
   nesting.spacing = options.spacing >= 0 ? options.spacing : 1.0 / 16 + options.kerf;
-  // One budget for the whole nesting: with the free order as a fallback,
-  // the window order has half of it to improve its first layout (which
-  // may take all of it) and the free order what is left.
-  const bool fallback = !options.rows && options.freeOrderWhenItSavesSheets && options.order == OrderMode::Window;
-  nesting.seconds = fallback ? options.seconds / 2 : options.seconds;
-  nesting.firstLayoutSeconds = options.seconds;
+  nesting.seconds = options.seconds;
   nesting.evaluations = options.evaluations;
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
-  const auto started = std::chrono::steady_clock::now();
   NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
-  int windowSheets = 0;
-  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  // Only with budget left: the free order's first layout is extra work.
-  if (fallback && nested.sheets > sheetsTheAreaNeeds(nestingParts, nesting) && took < options.seconds) {
-    NestingOptions free = nesting;
-    free.order = OrderMode::Free;
-    // What is left of the budget.
-    free.seconds = std::max(0.0, options.seconds - took);
-    free.firstLayoutSeconds = 0;
-    NestingResult loose = nest(nestingParts, free, context);
-    if (loose.sheets < nested.sheets) windowSheets = nested.sheets, nested = std::move(loose);
-  }
 
   SheetPlan plan;
   for (size_t i = 0; i < nested.placements.size(); ++i) {
@@ -87,7 +68,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
     plan.parts.push_back({p.part, p.sheet, p.x + bed.margin, p.y + bed.margin, p.rotation, static_cast<int>(i),
                           static_cast<int>(i) - parts[p.part].order});
   }
-  plan.windowSheets = windowSheets;
+  plan.stopped = nested.stopped;
   plan.inRowsNote = inRowsNote(nested);
   for (const Part& part : parts) plan.partArea += std::abs(polygonArea(part.outline));
   plan.utilization = plan.partArea / (nested.sheets * nesting.width * nesting.height);

@@ -23,13 +23,8 @@ struct PlanOptions {
   double spacing = -1.0;                    // between two cut paths; negative: 1/16 in of material plus the kerf
   double seconds = kDefaultNestingSeconds;  // the whole nesting's budget (NestingOptions::seconds)
   int evaluations = 0;                      // NestingOptions::evaluations
-  OrderMode order = OrderMode::Window;
+  OrderMode order = OrderMode::Kits;
   int window = 8;
-  // With the window: when the free order fits the parts on fewer sheets,
-  // take it (SheetPlan::windowSheets says so). The window order has half
-  // the budget to improve its layout (its first layout, all of it), the
-  // free order what is left, if any.
-  bool freeOrderWhenItSavesSheets = false;
   unsigned seed = 1;
   bool rows = false;  // rowLayout() instead of nest(): seconds for any size, more sheets
   std::string title;  // "bunny (band)"; the sheet number is appended
@@ -58,9 +53,8 @@ struct SheetPlan {
   std::vector<PlannedPart> parts;  // in cutting order
   double partArea = 0;             // of the design outlines, square inches
   double utilization = 0;          // part area / usable area of all sheets
-  // The window order would have taken this many sheets, the free order took
-  // fewer; 0: the order asked was kept.
-  int windowSheets = 0;
+  // Why the nesting's search stopped (NestingResult::stopped).
+  std::string stopped;
   // What the nesting had no time for (NestingResult::inRows, inRowsNote()), else empty.
   std::string inRowsNote;
 };

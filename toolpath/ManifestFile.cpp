@@ -75,6 +75,20 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
       if (file.get(name) != simdjson::SUCCESS || index < 1 || index > INT32_MAX) return std::nullopt;
       if (name.ends_with(".svg")) read.svgSheets.emplace_back(static_cast<int>(index), std::string(name));
     }
+    // (Optional keys: manifests before kits have neither.)
+    int64_t completes = 0;
+    simdjson::dom::array kit;
+    if (sheet["completes"].get(completes) == simdjson::SUCCESS) {
+      std::string steps;
+      if (int64_t first = 0, last = 0; sheet["kit"].get(kit) == simdjson::SUCCESS && kit.size() == 2 &&
+                                       kit.at(0).get(first) == simdjson::SUCCESS &&
+                                       kit.at(1).get(last) == simdjson::SUCCESS) {
+        steps = first == last ? fmt::format("step {}; ", first) : fmt::format("steps {}-{}; ", first, last);
+      }
+      read.kits[static_cast<int>(index)] =
+          steps + (completes > 0 ? fmt::format("once cut, steps 1-{} can be done", completes)
+                                 : std::string("no step can be done once it is cut"));
+    }
   }
   if (simdjson::dom::array panels; manifest["panels"].get(panels) == simdjson::SUCCESS) read.panels = panels.size();
   if (simdjson::dom::element cost; manifest["cost"].get(cost) == simdjson::SUCCESS) read.cost = simdjson::minify(cost);

@@ -4,6 +4,7 @@
 // that cut the sheets it lists.
 
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -25,6 +26,9 @@ struct ManifestSheets {
   std::vector<std::pair<int, std::string>> svgSheets;  // (sheet index, SVG file name)
   std::optional<size_t> panels;                        // the number of panels, when it lists them
   std::optional<std::string> cost;                     // the "cost" object, as JSON text
+  // Each sheet's kit, where the manifest says it (by sheet index): "steps
+  // 174-352; once cut, steps 1-352 can be done".
+  std::map<int, std::string> kits;
 };
 // std::nullopt when manifest.json is not as `make` writes it: readManifest
 // then says what is wrong, naming the file, the line and the column.

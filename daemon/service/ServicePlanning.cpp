@@ -183,6 +183,14 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
     planned = jobs::readJobSheets(folder, listed->svgSheets);
     if (listed->panels) summary["panels"] = *listed->panels;
     if (listed->cost) summary["cost"] = json::parse(*listed->cost);
+    // Each sheet's kit, for the operator ("kits"[s - 1] for sheet s; "" where the manifest gives none).
+    if (!listed->kits.empty()) {
+      summary["kits"] = json::array();
+      for (const auto& [sheet, svg] : listed->svgSheets) {
+        const auto kit = listed->kits.find(sheet);
+        summary["kits"].push_back(kit == listed->kits.end() ? "" : kit->second);
+      }
+    }
   } else {  // read again, to say what is wrong with it
     const auto manifest = jobs::readManifest(folder);
     planned = jobs::readJobSheets(folder, manifest);

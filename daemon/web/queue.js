@@ -8,6 +8,14 @@ import { state } from './state.js';
 import { fillJobChoices, showGuide, showSheets } from './tabs.js';
 import { sheetsDone, timeLeft } from './words.js';
 
+// " (its kit: steps 174-352; once cut, steps 1-352 can be done)" for a
+// sheet of a job whose plan gives its kits, else nothing.
+function kitOf(job, sheet) {
+  const kits = job.summary && Array.isArray(job.summary.kits) ? job.summary.kits : [];
+  const kit = kits[sheet - 1];
+  return kit ? ` (its kit: ${kit})` : '';
+}
+
 function actionsOf(job) {
   const buttons = [];
   const act = (label, action, body, extra = {}) =>
@@ -74,7 +82,7 @@ export function renderJobs() {
       element('td', {}, job.source || ''),
       element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
               element('span', { class: 'message' }, job.waiting_for_next
-                ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}, then press “Next sheet loaded”`
+                ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}${kitOf(job, job.sheet + 1)}, then press “Next sheet loaded”`
                 : job.message || ''),
               warningsOf(job)),
       element('td', {}, job.owner || ''),

@@ -17,6 +17,12 @@ namespace {
 // The share of the time budget (and of a cap on layouts) that the sequence
 // search has in free order; the compaction has the rest.
 constexpr double kSequenceShare = 0.15;
+// Without a cap on layouts, and with no compaction after it (the order
+// kept: kits, window), the sequence search stops after this many tries in a
+// row (at least, and per part) that found no better layout: the 6 panels
+// of a cube are done in a moment, not in the whole budget.
+constexpr int kLeastStalledTries = 200;
+constexpr int kStalledTriesPerPart = 20;
 
 }  // namespace
 
@@ -90,7 +96,9 @@ FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core
   // layouts (the same layout on every machine) and in the strip (whose
   // parts could go nowhere else).
   const bool timed = options.evaluations <= 0 && !options.strip;
-  first.result = placer.place(sequence, options.order == OrderMode::Window ? OrderMode::Strict : options.order,
+  // (The window and the kits begin from the assembly order, each sheet filled before the next.)
+  const bool fromStrict = options.order == OrderMode::Window || options.order == OrderMode::Kits;
+  first.result = placer.place(sequence, fromStrict ? OrderMode::Strict : options.order,
                               timed ? progress.deadlineAfter(std::max(options.seconds, options.firstLayoutSeconds))
                                     : std::chrono::steady_clock::time_point::max());
   first.layout = placer.layout();
@@ -111,12 +119,20 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
   // Window: start from the strict layout (nothing moves) and accept only
   // layouts in which no part is cut more than `window` places from its order.
   auto withinWindow = [&](const NestingResult& result) {
+    if (options.order == OrderMode::Kits) return inKits(parts, result);
     if (options.order != OrderMode::Window) return true;
     for (size_t i = 0; i < result.placements.size(); ++i) {
       if (std::abs(static_cast<int>(i) - parts[result.placements[i].part].order) > options.window) return false;
     }
     return true;
   };
+  // Kits: each sheet is packed in turn (the packer's strict policy) from a
+  // sequence whose parts move within a sheet's worth of places, so that a
+  // sheet's own parts, and those at its kit's ends, trade places freely.
+  const OrderMode packing = options.order == OrderMode::Kits ? OrderMode::Strict : options.order;
+  const long kitSpan = first.result.sheets > 0
+                           ? std::max<long>(options.window, static_cast<long>(parts.size()) / first.result.sheets)
+                           : options.window;
   std::vector<int> shapeOf(parts.size(), -1);  // forced rotations (index), -1: the best of all
   NestingResult best = first.result;
   std::vector<PlacedShape> bestLayout = first.layout;
@@ -126,6 +142,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
   // sheet, is not worth the user's wait).
   const int sheetBound = jobs::sheetsTheAreaNeeds(parts, options);
   const auto atBound = [&] { return !options.strip && bestCost.first <= sheetBound; };
+  bool stalled = false;
   int evaluations = 1;
   // Improvement: swap two parts of the sequence (within the window when the
   // order is bounded), or fix or free one part's rotation, and keep the
@@ -145,8 +162,17 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
                                     : start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
                                                   sequenceShare * (deadline - start));
     const int lastEvaluation = static_cast<int>(std::ceil(sequenceShare * options.evaluations));
+    // Tries in a row that found nothing better: the search has stopped helping.
+    int sinceBetter = 0;
+    const int mostSinceBetter = std::max(kLeastStalledTries, kStalledTriesPerPart * static_cast<int>(parts.size()));
     while (!atBound() && std::chrono::steady_clock::now() < searchDeadline &&
            (options.evaluations <= 0 || evaluations < lastEvaluation)) {
+      // (Not where the compaction follows: it has the rest of the budget, and the strip's density gains from it.)
+      if (!compaction && options.evaluations <= 0 && sinceBetter >= mostSinceBetter) {
+        stalled = true;
+        break;
+      }
+      ++sinceBetter;
       context.check();
       progress.stillSearching(search);
       std::vector<int> trial = sequence, trialShapes = shapeOf;
@@ -163,6 +189,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
         // Swap with a neighbour (small steps) or with any part.
         const long span = options.order == OrderMode::Window ? std::max(1, options.window)
                           : move < 6                         ? 3
+                          : options.order == OrderMode::Kits ? kitSpan
                                                              : static_cast<long>(trial.size());
         j = std::clamp<long>(static_cast<long>(i) + static_cast<long>(random() % (2 * span + 1)) - span, 0,
                              static_cast<long>(trial.size()) - 1);
@@ -171,7 +198,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
       }
       // The parts before the first changed one are placed as before.
       // Without a cap on layouts, a trial that would end past the deadline is given up.
-      auto packed = packer.pack(trial, options.order, std::min(i, j), trialShapes, searchDeadline);
+      auto packed = packer.pack(trial, packing, std::min(i, j), trialShapes, searchDeadline);
       if (!packed) break;
       NestingResult result = std::move(*packed);
       ++evaluations;
@@ -179,6 +206,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
       if (trialCost <= bestCost && withinWindow(result)) {
         if (trialCost < bestCost) {
           progress.improved(trialCost, {"nesting", "improving", 0, 0, trialCost.first, trialCost.second});
+          sinceBetter = 0;
         }
         best = std::move(result);
         bestCost = trialCost;
@@ -215,6 +243,10 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
     }
   }
   best.evaluations = evaluations;
+  best.stopped = atBound()                                                       ? "area bound"
+                 : stalled && !compaction                                        ? "no better layout"
+                 : options.evaluations > 0 && evaluations >= options.evaluations ? "layout cap"
+                                                                                 : "time budget";
   return best;
 }
 

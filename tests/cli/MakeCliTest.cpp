@@ -119,6 +119,47 @@ void expectHolesADiameterIn(const nlohmann::json& part, const std::string& name)
   }
 }
 
+// The kits of `make`'s default order (docs/sheets.md, "Nesting in make"):
+// each sheet holds a consecutive run of the steps (panel ids), step 1 on
+// sheet 1, step i of n on S sheets by sheet ceil(i S / n) + 1; each sheet's
+// "kit" and "completes" (a step is done once its panel and its pieces are cut).
+void expectKits(const nlohmann::json& manifest) {
+  const auto& panels = manifest.at("panels");
+  const int n = static_cast<int>(panels.size()), sheets = static_cast<int>(manifest.at("sheets").size());
+  std::vector<int> sheetOf(static_cast<size_t>(n) + 1), needs(static_cast<size_t>(n) + 1);
+  for (const auto& panel : panels) {
+    const int id = panel.at("id"), sheet = panel.at("sheet");
+    sheetOf[static_cast<size_t>(id)] = sheet;
+    needs[static_cast<size_t>(id)] = sheet;
+    if (panel.contains("pieces")) {
+      for (const auto& piece : panel.at("pieces")) {
+        needs[static_cast<size_t>(id)] = std::max(needs[static_cast<size_t>(id)], piece.at("sheet").get<int>());
+      }
+    }
+  }
+  EXPECT_EQ(sheetOf[1], 1) << "step 1 on sheet 1";
+  for (int i = 1; i <= n; ++i) {
+    if (i > 1) {
+      EXPECT_GE(sheetOf[static_cast<size_t>(i)], sheetOf[static_cast<size_t>(i) - 1]) << "step " << i;
+    }
+    EXPECT_LE(sheetOf[static_cast<size_t>(i)], (i * sheets + n - 1) / n + 1) << "step " << i << " of " << n;
+  }
+  int done = 0;
+  for (int s = 1; s <= sheets; ++s) {
+    const auto& sheet = manifest.at("sheets").at(static_cast<size_t>(s) - 1);
+    int first = n + 1, last = 0;
+    for (int i = 1; i <= n; ++i) {
+      if (sheetOf[static_cast<size_t>(i)] == s) first = std::min(first, i), last = std::max(last, i);
+    }
+    if (last > 0) {
+      EXPECT_EQ(sheet.at("kit"), nlohmann::json::array({first, last})) << "sheet " << s;
+    }
+    while (done < n && needs[static_cast<size_t>(done) + 1] <= s) ++done;
+    EXPECT_EQ(sheet.at("completes"), done) << "sheet " << s;
+  }
+  EXPECT_EQ(done, n);
+}
+
 // The manifest.json panels (docs/CONTRACT.md, "manifest.json (version 1)")
 // of a band structure of `faceCount` faces: numbered 1..n, one per face, each
 // on a sheet inside the bed's margins, outlines counter-clockwise with their
@@ -489,25 +530,42 @@ TEST(MakeCli, ManifestCommandPrintsTheSteps) {
       << missing.err;
 }
 
-// The default order keeps each part near its place in the assembly, but not
-// at the cost of a sheet: the soccer ball's 32 panels fit one sheet in the
-// free order, and that is taken, and said; --order window keeps the window.
-TEST(MakeCli, TheOrderDoesNotCostASheet) {
+// Kits by default (the dissertation's V.5: builders join the panels in the
+// order they are cut): each sheet a consecutive run of the assembly steps,
+// step 1 on sheet 1, no step later than one sheet beyond its fair share,
+// each sheet's kit in manifest.json and manifest.txt; for the band and the
+// weave. --order free takes the fewest sheets. A 6-panel cube's search
+// stops once it finds nothing better, not at the end of the budget.
+TEST(MakeCli, SheetsAreCutInKitsOfTheAssemblyOrder) {
   TempDir dir;
   const std::string ball = quoted(kSource / "examples/soccer-ball.obj");
-  const CommandResult free =
-      run(kCli + " make " + ball + " --structure band --time 16 --json --out " + quoted(dir.path() / "a"));
+  for (const char* structure : {"band", "weave"}) {
+    SCOPED_TRACE(structure);
+    const auto out = dir.path() / structure;
+    const CommandResult made =
+        run(kCli + " make " + ball + " --structure " + structure + " --time 6 --json --out " + quoted(out));
+    ASSERT_EQ(made.status, 0) << made.err;
+    const auto manifest = nlohmann::json::parse(readFile(out / "manifest.json"));
+    expectKits(manifest);
+    EXPECT_TRUE(nlohmann::json::parse(made.out).contains("nesting_stopped"));
+    const std::string text = readFile(out / "manifest.txt");
+    const auto& first = manifest.at("sheets").at(0);
+    EXPECT_NE(text.find(fmt::format("sheet 1: steps 1-{}; once cut, steps 1-{} can be done",
+                                    first.at("kit").at(1).get<int>(), first.at("completes").get<int>())),
+              std::string::npos)
+        << text;
+  }
+  const CommandResult free = run(kCli + " make " + ball + " --structure band --time 16 --order free --json --out " +
+                                 quoted(dir.path() / "free"));
   ASSERT_EQ(free.status, 0) << free.err;
   EXPECT_EQ(nlohmann::json::parse(free.out).at("sheets"), 1);
-  EXPECT_NE(free.err.find("cut in the free order: keeping each part within 8 places of the assembly order took 2 "
-                          "sheets, the free order 1"),
-            std::string::npos)
-      << free.err;
-  const CommandResult window = run(kCli + " make " + ball + " --structure band --time 6 --order window --json --out " +
-                                   quoted(dir.path() / "b"));
-  ASSERT_EQ(window.status, 0) << window.err;
-  EXPECT_EQ(nlohmann::json::parse(window.out).at("sheets"), 2);
-  EXPECT_EQ(window.err.find("free order"), std::string::npos);
+  const CommandResult cube = run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                                 " --structure band --size 10in --json --out " + quoted(dir.path() / "cube"));
+  ASSERT_EQ(cube.status, 0) << cube.err;
+  const auto summary = nlohmann::json::parse(cube.out);
+  EXPECT_NE(summary.at("nesting_stopped"), "time budget") << cube.out;
+  EXPECT_GT(summary.at("cost").at("assembly_seconds").get<double>(), 0);
+  expectKits(nlohmann::json::parse(readFile(dir.path() / "cube/manifest.json")));
 }
 
 // A cap on layouts gives the same sheets run after run; a budget spent
@@ -589,6 +647,7 @@ TEST(MakeCli, SplitPanelsComeWithTheirPieces) {
                                  " --structure band --scale 1 --time 0 --out " + quoted(dir.path() / "out"));
   ASSERT_EQ(made.status, 0) << made.err;
   const auto manifest = nlohmann::json::parse(readFile(dir.path() / "out/manifest.json"));
+  expectKits(manifest);
   std::set<std::string> pieces, onSheets;
   for (const auto& panel : manifest.at("panels")) {
     if (!panel.contains("pieces")) continue;

@@ -40,6 +40,8 @@ TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
       << r.err;
   EXPECT_NE(r.err.find("] 100%  stroke 108 of 108"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("1 sheet cut on sim:grbl?speed=200: 108 strokes"), std::string::npos) << r.out;
+  // The sheet's kit, as the operator loads it: what the builders can do once it is cut.
+  EXPECT_NE(r.err.find("(its kit: steps 1-6; once cut, steps 1-6 can be done)"), std::string::npos) << r.err;
   // The estimate and the bar count the simulator's time, 200 times the machine's: seconds, not minutes.
   std::smatch about;
   ASSERT_TRUE(std::regex_search(r.err, about, std::regex(R"(about (\d+)s \((\d+)m (\d+)s on the machine simulated\))")))

@@ -94,6 +94,10 @@ TEST(Daemon, EachSheetAfterTheFirstWaitsForNextAndACutCanBePausedAndResumed) {
     ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
     EXPECT_EQ(job["sheet"], sheet - 1);
     EXPECT_EQ(state(job), "running");
+    // The operator is told what to load, and what the builders can do once it is cut.
+    const CommandResult status = daemon.client(fmt::format("status {}", id));
+    EXPECT_NE(status.out.find(fmt::format("waiting: load sheet {} (its kit: steps ", sheet)), std::string::npos)
+        << status.out;
     // Nothing moves while it waits: a pause has nothing to hold.
     EXPECT_EQ(daemon.client(fmt::format("pause {}", id)).status, 1);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));

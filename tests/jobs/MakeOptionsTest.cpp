@@ -102,11 +102,11 @@ TEST(MakeOptions, TheRequestTakesTheLengthsInTheirUnitsAndKeepsAGivenOrder) {
   MakeRequest request = requestOf(options, catalogue);
   EXPECT_NEAR(*request.size, 30.0, 1e-9);
   EXPECT_NEAR(*request.fastener, 3 / 25.4, 1e-9);
-  EXPECT_TRUE(request.freeOrderWhenItSavesSheets);
+  EXPECT_EQ(request.order, OrderMode::Kits);
   options = submittedOptions(json{{"structure", "band"}, {"order", "window"}, {"kerf", "2furlongs"}});
   EXPECT_THROW(requestOf(options, catalogue), core::UserError);
   options.kerf.clear();
-  EXPECT_FALSE(requestOf(options, catalogue).freeOrderWhenItSavesSheets);
+  EXPECT_EQ(requestOf(options, catalogue).order, OrderMode::Window);
 }
 
 }  // namespace
