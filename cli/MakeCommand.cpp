@@ -24,6 +24,7 @@ std::string nestingStopped(const std::string& stopped) {
   if (stopped == "time budget") return " (the whole --time)";
   if (stopped == "layout cap") return " (the --evaluations cap)";
   if (stopped == "nothing to search") return " (the first layout: nothing to search in this order)";
+  if (stopped == "too many parts") return " (the first layout: too many parts to search in this order)";
   return "";
 }
 

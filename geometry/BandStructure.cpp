@@ -242,7 +242,7 @@ void OverlapMending::mendFace(int f) {
       // No tab at any size: the band across its middle; else the face itself in two.
       if (cutAcross(f, j) || (i >= 0 && cutAcross(f, i))) continue;
       if (splitLater(what + "; nor can it be cut across its middle")) break;
-      throw std::invalid_argument(fmt::format(
+      throw UnfoldOverlapError(fmt::format(
           "{}; nor can it be cut across its middle; split that face in the mesh, or simplify the mesh ({} N)", what,
           options.names(Parameter::Panels)));
     }

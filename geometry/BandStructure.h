@@ -29,10 +29,18 @@ struct BandOptions {
   ParameterNames names = parameterInWords;  // how messages name the parameters
 };
 
+// A panel that would overlap itself when unfolded, and whose band could be
+// neither cut off nor cut across (ch. V.4): another size or fewer, larger
+// panels may unfold it.
+class UnfoldOverlapError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
 // The mesh must be usable (analyzeMesh), already at construction size
 // (inches). Throws InvalidMeshError, std::invalid_argument (a
 // ParameterError for a parameter's value, NoRoomForHoleError when bands have
-// no room for a hole) with one line naming what cannot be built, and
+// no room for a hole, UnfoldOverlapError) with one line naming what cannot be built, and
 // core::Cancelled. Progress: phase "geometry", steps "band decomposition"
 // (of the faces), "panels split" (bands cut off, when there are any),
 // "fastener holes" (of the bands), "labels" (of the panels).

@@ -119,7 +119,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
       job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
     } catch (const making::StructureRefused& refused) {
       // A refusal offers a way out that was built, never a guess.
-      if (refused.tried) throw;
+      if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
       throw core::UserError(making::withTriedWayOut(request, refused, side, job.mesh.faces, context));
     }
   }

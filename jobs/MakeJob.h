@@ -62,6 +62,9 @@ struct MakeRequest {
   bool keepFaces = false;
   // A band without room even after mending is glued, not refused.
   bool glueNarrow = false;
+  // A refusal names a way out that was built (a size, a fastener, a panel
+  // count: MakeSteps.h); false for make's own tries of one, which need not.
+  bool adviseWayOut = true;
   // The plain weave's (geometry/WeaveStructure.h); `samples` too, per Bézier segment.
   std::optional<double> width;  // default: geometry::RibbonShape's, narrowed where ribbons would meet
   double curve = 0.6;

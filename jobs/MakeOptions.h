@@ -32,9 +32,8 @@ struct MakeOptions {
   int samples = 8, window = 8, evaluations = 0;
   double seconds = kDefaultNestingSeconds;
   bool json = false, scoreFolds = false, keepFaces = false, glueNarrow = false;
-  // The options given, by name ("order", "machine"): an --order given is
-  // kept even where the free order would save a sheet; a --machine given
-  // must be the device's.
+  // The options given, by name ("machine"): a --machine given must be the
+  // device's.
   std::set<std::string> given;
 };
 
@@ -138,7 +137,7 @@ std::vector<std::string> optionWords(const MakeOptions& options);
 // An option's flag, for messages: "--fastener".
 std::string flagOf(geometry::Parameter parameter);
 
-// --order strict|window|free.
+// --order kits|strict|window|free (anything else: kits).
 OrderMode orderModeOf(const std::string& order);
 
 // The request the options make; throws core::UserError on a bad length or an

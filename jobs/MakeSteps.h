@@ -57,23 +57,27 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
 // builtStructure()'s refusal: the mesh and the place (`place`: "the edge
 // between vertices 14 and 12: its band ... has no room ..."), and the way out
 // it offers, which `tried` says was built (a size, a fastener) or only
-// estimated or not found.
+// estimated or not found. `sizeMayHelp`: bands without room or a panel that
+// overlaps itself, which a size or a panel count may mend (not a bad
+// --start, nor a face far from planar).
 class StructureRefused : public core::UserError {
  public:
-  StructureRefused(const std::string& mesh, std::string place, std::string advice, bool tried)
+  StructureRefused(const std::string& mesh, std::string place, std::string advice, bool tried, bool sizeMayHelp = true)
       : core::UserError(mesh + ": " + place + (advice.empty() ? "" : "; " + advice)),
         place(std::move(place)),
         advice(std::move(advice)),
-        tried(tried) {}
+        tried(tried),
+        sizeMayHelp(sizeMayHelp) {}
   std::string place, advice;
-  bool tried;
+  bool tried, sizeMayHelp;
 };
 
 // A way out of `refused` that was tried: make run again, quietly, with a
 // larger size, fewer panels or both (each as the user would ask for it on
 // the command line), until one builds with every band fastened and every
-// label etched and every panel on the bed, within a bounded time. Returns
-// the refusal's line with that way out, or with what was tried in vain.
+// label etched and every panel on the bed; no try begins after
+// kWayOutSeconds. Returns the refusal's line with that way out, or with
+// what was tried in vain and for how long.
 std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& refused, double sideAsRefused,
                             int facesAsRefused, const core::WorkContext& context);
 

@@ -418,7 +418,7 @@ std::vector<SheetKit> sheetKits(const nlohmann::ordered_json& manifest) {
 }
 
 std::string kitText(const SheetKit& kit) {
-  if (kit.first == 0) return "no panel";
+  if (kit.first == 0) return "pieces of panels on other sheets only";
   if (kit.first == kit.last) return fmt::format("step {}", kit.first);
   return kit.run ? fmt::format("steps {}-{}", kit.first, kit.last)
                  : fmt::format("panels of steps {} to {} (not in one run)", kit.first, kit.last);

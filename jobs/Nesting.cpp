@@ -129,7 +129,9 @@ NestingResult nest(const std::vector<NestingPart>& parts, const NestingOptions& 
     }
     best = std::move(results[winner]);
     best.evaluations = evaluations;
-    if (nothingToSearch || parts.size() < 2) best.stopped = "nothing to search";
+    if (nothingToSearch || parts.size() < 2) {
+      best.stopped = options.order == OrderMode::Strict || parts.size() < 2 ? "nothing to search" : "too many parts";
+    }
   }
   if (best.stopped.empty()) best.stopped = "time budget";
   for (const auto& part : parts) best.partArea += std::abs(polygonArea(part.outline));

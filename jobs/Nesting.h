@@ -51,8 +51,11 @@ enum class OrderMode {
   // Kits (the dissertation's V.5: builders join panels in the order they
   // are cut): sheet k holds a contiguous run of the order, nested freely
   // within the sheet, the runs' ends moving between neighbouring sheets;
-  // step i (1-based, of n on S sheets) on sheet ceil(i S / n) + 1 at the
-  // latest, and step 1 on sheet 1 (inKits()).
+  // part i (1-based in the order, of n on S sheets; a panel's pieces are
+  // parts too) on sheet ceil(i S / n) + 1 at the latest, and the first on
+  // sheet 1 (inKits()). The first layout fills each sheet before the next
+  // (the strict order), and is kept as it is: where large parts come first
+  // it may leave a part later than its share, and no search undoes that.
   Kits,
 };
 
@@ -69,10 +72,6 @@ struct NestingOptions {
   // best layout it found. Not with a cap on layouts (`evaluations`), nor
   // in the strip: the first layout is then always finished.
   double seconds = kDefaultNestingSeconds;
-  // The first layout's own budget, from the call, when it is longer than
-  // `seconds` (0: `seconds`): `make` gives the window order half the
-  // budget to improve its layout, but its first layout the whole of it.
-  double firstLayoutSeconds = 0;
   int evaluations = 0;  // if positive, each search stops after this many layouts (and compaction moves)
   OrderMode order = OrderMode::Free;
   int window = 8;
@@ -99,7 +98,9 @@ struct NestingResult {
   // Why the search stopped: "area bound" (as few sheets as the parts' area
   // allows), "no better layout" (it found none in many tries), "time
   // budget", "layout cap" (NestingOptions::evaluations); "nothing to
-  // search" (strict order, or the first layout was all the budget allowed).
+  // search" (strict order, or one part); "too many parts" (the window or the
+  // kits, with more parts than kMostPartsForNoFitPolygons: the first layout
+  // is the layout).
   std::string stopped;
   // Parts laid out in rows by their boxes (RowLayout.h), after the rest,
   // because the budget ran out before the first layout reached them.

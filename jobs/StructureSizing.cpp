@@ -312,7 +312,9 @@ class MendingBuild {
                                                                mends_.count() == 1 ? " was" : "s were")
                               : request_.keepFaces ? fmt::format(" ({} keeps every face)", names(Parameter::KeepFaces))
                                                    : std::string();
-    const Advice advice = triedAdvice(request_, asDrawn_, band_, error.labels, context_);
+    // (make's own tries of a way out need only know that this one failed.)
+    const Advice advice =
+        request_.adviseWayOut ? triedAdvice(request_, asDrawn_, band_, error.labels, context_) : Advice{};
     throw StructureRefused(name_, error.bandsWithoutRoom + after, advice.text, advice.tried);
   }
 
@@ -463,10 +465,12 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
     const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
     throw StructureRefused(request.mesh.string(), error.bandsWithoutRoom,
                            roomAdvice(request, mesh, fastener, error.scaleNeeded, "band", error.estimate), false);
+  } catch (const geometry::UnfoldOverlapError& error) {
+    throw StructureRefused(request.mesh.string(), error.what(), "", false);
   } catch (const std::invalid_argument& error) {
-    throw StructureRefused(request.mesh.string(), error.what(), "", false);
+    throw StructureRefused(request.mesh.string(), error.what(), "", false, false);
   } catch (const geometry::InvalidMeshError& error) {
-    throw StructureRefused(request.mesh.string(), error.what(), "", false);
+    throw StructureRefused(request.mesh.string(), error.what(), "", false, false);
   }
 }
 

@@ -56,7 +56,7 @@ std::vector<Change> changesToTry(const MakeRequest& request, double side, int fa
   std::vector<Step> steps;
   for (size_t p = 0; p < kPanelShares.size(); ++p) {
     for (size_t s = 0; s < kSizeTimes.size(); ++s) {
-      if (p + s > 0 && std::lround(asked * kPanelShares[p]) >= kFewestPanels) steps.push_back({p, s});
+      if (p + s > 0 && (p == 0 || std::lround(asked * kPanelShares[p]) >= kFewestPanels)) steps.push_back({p, s});
     }
   }
   std::stable_sort(steps.begin(), steps.end(), [&](const Step& a, const Step& b) {
@@ -120,6 +120,7 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
   std::map<int, double> offTheBedAt;
   size_t started = 0;
   for (const Change& change : changes) {
+    context.check();
     const int panels = change.panels.value_or(0);
     if (change.size && offTheBedAt.count(panels) && *change.size >= offTheBedAt[panels]) continue;
     const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
@@ -129,6 +130,7 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
     }
     context.report({"geometry", "trying a way out: " + change.options(request), ++started, changes.size()});
     MakeRequest changed = request;
+    changed.adviseWayOut = false;
     changed.panels = change.panels;
     if (change.size) {
       changed.size = change.size;
@@ -151,8 +153,9 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
   std::vector<std::string> ranges;
   if (largestSize) ranges.push_back(fmt::format("sizes up to {:.0f} in", *largestSize));
   if (fewestPanels) ranges.push_back(fmt::format("down to {} panels", *fewestPanels));
-  return said + fmt::format("; nothing tried built it ({} tries{}: {})", tries,
-                            timedOut ? fmt::format(" in {:.0f} s", kWayOutSeconds) : "", fmt::join(ranges, ", "));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  return said + fmt::format("; nothing tried built it ({} tries in {:.0f} s{}: {})", tries, took,
+                            timedOut ? ", the time allowed" : "", fmt::join(ranges, ", "));
 }
 
 }  // namespace rotafab::jobs::making

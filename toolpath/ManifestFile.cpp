@@ -87,7 +87,7 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
       }
       read.kits[static_cast<int>(index)] =
           steps + (completes > 0 ? fmt::format("once cut, steps 1-{} can be done", completes)
-                                 : std::string("no step can be done once it is cut"));
+                                 : std::string("no step can be done yet"));
     }
   }
   if (simdjson::dom::array panels; manifest["panels"].get(panels) == simdjson::SUCCESS) read.panels = panels.size();

@@ -43,6 +43,17 @@ class JobNotesSink : public spdlog::sinks::base_sink<std::mutex> {
   std::shared_ptr<Said> said_;
 };
 
+// Each sheet's kit, for the operator: "kits"[s - 1] for sheet s ("" where
+// the manifest gives none; no "kits" for a manifest written before them).
+void addKits(const jobs::ManifestSheets& listed, json& summary) {
+  if (listed.kits.empty()) return;
+  summary["kits"] = json::array();
+  for (const auto& [sheet, svg] : listed.svgSheets) {
+    const auto kit = listed.kits.find(sheet);
+    summary["kits"].push_back(kit == listed.kits.end() ? "" : kit->second);
+  }
+}
+
 }  // namespace
 
 void Service::Impl::pump() {
@@ -183,14 +194,7 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
     planned = jobs::readJobSheets(folder, listed->svgSheets);
     if (listed->panels) summary["panels"] = *listed->panels;
     if (listed->cost) summary["cost"] = json::parse(*listed->cost);
-    // Each sheet's kit, for the operator ("kits"[s - 1] for sheet s; "" where the manifest gives none).
-    if (!listed->kits.empty()) {
-      summary["kits"] = json::array();
-      for (const auto& [sheet, svg] : listed->svgSheets) {
-        const auto kit = listed->kits.find(sheet);
-        summary["kits"].push_back(kit == listed->kits.end() ? "" : kit->second);
-      }
-    }
+    addKits(*listed, summary);
   } else {  // read again, to say what is wrong with it
     const auto manifest = jobs::readManifest(folder);
     planned = jobs::readJobSheets(folder, manifest);
@@ -304,6 +308,8 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
       summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
       summary["cost"] = jobs::costJson(planned.cost);
       summary["folder"] = plannedName;
+      if (const auto listed = jobs::readManifestSheets(folder / plannedName / "manifest.json"))
+        addKits(*listed, summary);
       // What the plan said on the way, for the people at the machine (the page shows them).
       summary["notes"] = said->notes;
       summary["warnings"] = said->warnings;

@@ -98,9 +98,9 @@ FirstLayout firstLayout(PartShapes& shapes, SharedProgress& progress, const core
   const bool timed = options.evaluations <= 0 && !options.strip;
   // (The window and the kits begin from the assembly order, each sheet filled before the next.)
   const bool fromStrict = options.order == OrderMode::Window || options.order == OrderMode::Kits;
-  first.result = placer.place(sequence, fromStrict ? OrderMode::Strict : options.order,
-                              timed ? progress.deadlineAfter(std::max(options.seconds, options.firstLayoutSeconds))
-                                    : std::chrono::steady_clock::time_point::max());
+  first.result =
+      placer.place(sequence, fromStrict ? OrderMode::Strict : options.order,
+                   timed ? progress.deadlineAfter(options.seconds) : std::chrono::steady_clock::time_point::max());
   first.layout = placer.layout();
   first.placed = first.result.placements.size();
   if (first.placed == parts.size()) {

@@ -147,18 +147,22 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
   ASSERT_TRUE(three.is_object());
   EXPECT_EQ(step, 3) << "the guide steps in assembly order (a panel's id), not in cutting order";
   // The guide's steps are manifest.txt's: each panel in assembly order, on its sheet.
-  const CommandResult text = daemon.client("manifest 1");
-  ASSERT_EQ(text.status, 0) << text.err;
-  json stepsOfText = json::array();
-  const std::regex stepLine(R"(step +(\d+): panel (\d+) \(sheet (\d+)\))");
-  for (auto line = std::sregex_iterator(text.out.begin(), text.out.end(), stepLine); line != std::sregex_iterator();
-       ++line) {
-    stepsOfText.push_back({std::stoi((*line)[2].str()), std::stoi((*line)[3].str())});
-  }
-  EXPECT_EQ(stepsOfText.size(), manifest["panels"].size()) << text.out;
-  EXPECT_EQ(browser.evaluate("[...document.querySelectorAll('#guide-print-steps li')].map((li) => "
-                             "[Number(li.dataset.panel), Number(li.dataset.sheet)])"),
-            stepsOfText);
+  const auto expectTheStepsOfTheText = [&](int job) {
+    const CommandResult text = daemon.client(fmt::format("manifest {}", job));
+    ASSERT_EQ(text.status, 0) << text.err;
+    json stepsOfText = json::array();
+    const std::regex stepLine(R"(step +(\d+): panel (\d+) \(sheet (\d+)\))");
+    for (auto line = std::sregex_iterator(text.out.begin(), text.out.end(), stepLine); line != std::sregex_iterator();
+         ++line) {
+      stepsOfText.push_back({std::stoi((*line)[2].str()), std::stoi((*line)[3].str())});
+    }
+    EXPECT_EQ(stepsOfText.size(), daemon.get(fmt::format("/api/jobs/{}/manifest", job)).body["panels"].size())
+        << text.out;
+    EXPECT_EQ(browser.evaluate("[...document.querySelectorAll('#guide-print-steps li')].map((li) => "
+                               "[Number(li.dataset.panel), Number(li.dataset.sheet)])"),
+              stepsOfText);
+  };
+  expectTheStepsOfTheText(1);
   // Its sheet and neighbours as the manifest says.
   EXPECT_EQ(browser.evaluate("document.getElementById('guide-panel-sheet').textContent"),
             std::to_string(three["sheet"].get<int>()));
@@ -173,6 +177,20 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
   ASSERT_TRUE(browser.waitFor("document.getElementById('guide-panel-number').textContent === '5'", 5s));
   EXPECT_EQ(browser.evaluate("window.rotafabGuide.highlighted()"), json::array({5}));
   browser.screenshot(artefacts() / "guide.png");
+  // A job cut in the free order, whose cutting order is not its assembly
+  // order (larger panels first): the guide still steps as manifest.txt does.
+  const CommandResult free = daemon.client("submit " + quoted(kSource / "examples/soccer-ball.obj") +
+                                           " --structure band --order free --time 2");
+  ASSERT_EQ(free.status, 0) << free.err;
+  ASSERT_EQ(daemon.waitForJob(2, [](const json& job) { return job["state"] == "ready"; })["state"], "ready");
+  const json freeManifest = daemon.get("/api/jobs/2/manifest").body;
+  ASSERT_TRUE(std::any_of(freeManifest["panels"].begin(), freeManifest["panels"].end(), [](const json& panel) {
+    return panel["order"] != panel["id"];
+  })) << "the free order cut the panels in their assembly order: this job tests nothing";
+  click(browser, "tr[data-job=\"2\"] button[data-action=\"guide\"]");
+  ASSERT_TRUE(browser.waitFor("window.rotafabGuide && window.rotafabGuide.job === 2", 20s));
+  EXPECT_EQ(browser.evaluate("window.rotafabGuide.panel()"), 1) << "step 1 is panel 1, the base";
+  expectTheStepsOfTheText(2);
   expectNoErrors(browser);
 }
 
