@@ -18,6 +18,7 @@
 #include "jobs/JobCost.h"
 #include "jobs/SvgWriter.h"
 #include "toolpath/JsonErrors.h"
+#include "toolpath/ManifestFile.h"
 
 namespace rotafab::jobs {
 
@@ -436,9 +437,11 @@ std::string manifestText(const nlohmann::ordered_json& manifest) {
     // V.5: builders join the panels in the order they are cut).
     const std::vector<SheetKit> kits = sheetKits(manifest);
     for (size_t s = 0; s < kits.size(); ++s) {
-      text += fmt::format("sheet {}: {}; once cut, {}\n", s + 1, kitText(kits[s]),
-                          kits[s].completes == 0 ? std::string("no step can be done yet")
-                                                 : fmt::format("steps 1-{} can be done", kits[s].completes));
+      const SheetKit& kit = kits[s];
+      text += fmt::format("sheet {}: {}\n", s + 1,
+                          kit.run && kit.first > 0
+                              ? kitLine(std::pair{kit.first, kit.last}, kit.completes)
+                              : fmt::format("{}; {}", kitText(kit), kitLine(std::nullopt, kit.completes)));
     }
     text += "\n";
     int total = 0, thread = 0;

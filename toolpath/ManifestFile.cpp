@@ -44,6 +44,15 @@ nlohmann::ordered_json readManifest(const std::filesystem::path& folderOrFile) {
   }
 }
 
+std::string kitLine(std::optional<std::pair<int, int>> run, int completes) {
+  std::string steps;
+  if (run)
+    steps = run->first == run->second ? fmt::format("step {}; ", run->first)
+                                      : fmt::format("steps {}-{}; ", run->first, run->second);
+  return steps + (completes > 0 ? fmt::format("once cut, steps 1-{} can be done", completes)
+                                : std::string("no step can be done yet"));
+}
+
 std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& manifestFile) {
   simdjson::padded_string text;
   if (simdjson::padded_string::load(manifestFile.string()).get(text) != simdjson::SUCCESS) return std::nullopt;
@@ -79,15 +88,13 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
     int64_t completes = 0;
     simdjson::dom::array kit;
     if (sheet["completes"].get(completes) == simdjson::SUCCESS) {
-      std::string steps;
+      std::optional<std::pair<int, int>> run;
       if (int64_t first = 0, last = 0; sheet["kit"].get(kit) == simdjson::SUCCESS && kit.size() == 2 &&
                                        kit.at(0).get(first) == simdjson::SUCCESS &&
                                        kit.at(1).get(last) == simdjson::SUCCESS) {
-        steps = first == last ? fmt::format("step {}; ", first) : fmt::format("steps {}-{}; ", first, last);
+        run = {static_cast<int>(first), static_cast<int>(last)};
       }
-      read.kits[static_cast<int>(index)] =
-          steps + (completes > 0 ? fmt::format("once cut, steps 1-{} can be done", completes)
-                                 : std::string("no step can be done yet"));
+      read.kits[static_cast<int>(index)] = kitLine(run, static_cast<int>(completes));
     }
   }
   if (simdjson::dom::array panels; manifest["panels"].get(panels) == simdjson::SUCCESS) read.panels = panels.size();

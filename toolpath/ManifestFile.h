@@ -30,6 +30,11 @@ struct ManifestSheets {
   // 174-352; once cut, steps 1-352 can be done".
   std::map<int, std::string> kits;
 };
+// A sheet's kit as the operator and the builders read it: "steps 174-352;
+// once cut, steps 1-352 can be done" (`run`: its first and last step, when
+// they are one run; `completes`: the steps done once it is cut).
+std::string kitLine(std::optional<std::pair<int, int>> run, int completes);
+
 // std::nullopt when manifest.json is not as `make` writes it: readManifest
 // then says what is wrong, naming the file, the line and the column.
 std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& manifestFile);
