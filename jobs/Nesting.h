@@ -76,6 +76,12 @@ struct NestingOptions {
   OrderMode order = OrderMode::Free;
   int window = 8;
   unsigned seed = 1;
+  // The parts may be cut at any angle, not only at their `rotations` (panels
+  // of board or paper, which has no grain to keep). Star-shaped panels
+  // interlock at angles other than quarter turns: on jobs too large for
+  // no-fit polygons, each part is tried at anyAngleTurns() even turns
+  // (docs/PERFORMANCE.md, "Turns other than quarter turns").
+  bool anyAngle = false;
   // Searches run side by side on the executor, with seeds seed, seed + 1,
   // ...; the best layout wins. 0: one per thread of the executor. With a cap
   // on layouts, the result is the same on every machine for the same number.
@@ -145,6 +151,14 @@ double polygonArea(const Polygon2& polygon);
 // The fewest sheets the parts' area fills (their outlines' area over the
 // usable area's, rounded up): no layout on beds has fewer.
 int sheetsTheAreaNeeds(const std::vector<NestingPart>& parts, const NestingOptions& options);
+
+// The even turns (a multiple of 4, so that quarter turns are among them;
+// 4 to 24) tried for parts that may be cut at any angle
+// (NestingOptions::anyAngle) on a job of `parts` parts: as many as keep the
+// first layout's work (parts times turns) within what 2 cores place in
+// about 15 s, and quarter turns alone on jobs small enough for no-fit
+// polygons, whose cost grows with the square of the turns.
+int anyAngleTurns(size_t parts);
 
 // How many quarter turns (0-3) `degrees` is, or -1 when it is no whole number of them.
 int quarterTurns(double degrees);

@@ -60,6 +60,7 @@ SheetPlan planSheets(const std::vector<Part>& parts, const profiles::MachineProf
   nesting.order = options.order;
   nesting.window = options.window;
   nesting.seed = options.seed;
+  nesting.anyAngle = true;
   NestingResult nested = options.rows ? rowLayout(nestingParts, nesting) : nest(nestingParts, nesting, context);
 
   SheetPlan plan;

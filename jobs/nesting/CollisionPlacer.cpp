@@ -109,9 +109,13 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
   const NestingOptions& options = shapes_.options();
   const bool timed = deadline != std::chrono::steady_clock::time_point::max();
   size_t aheadTo = 0;  // beforeParts has been called for the sequence up to here
+  const auto started = std::chrono::steady_clock::now();
+  quarterTurnsOnly_ = false;
   for (size_t index = 0; index < sequence.size(); ++index) {
     if (cancellation_) cancellation_->check();
     if (timed && std::chrono::steady_clock::now() >= deadline) break;
+    if (timed && index >= kHurryCheckEvery && index % kHurryCheckEvery == 0)
+      quarterTurnsOnly_ = hurried(started, deadline, index, sequence.size());
     if (beforeParts && index == aheadTo) {
       aheadTo = std::min(sequence.size(), index + kPartsAhead);
       beforeParts(std::span<const int>(sequence).subspan(index, aheadTo - index));
@@ -173,8 +177,11 @@ NestingResult CollisionPlacer::place(const std::vector<int>& sequence, OrderMode
 std::optional<PlacedShape> CollisionPlacer::bestSpot(int part, Sheet& sheet) {
   std::optional<PlacedShape> best;
   std::pair<cInt, cInt> bestRank{std::numeric_limits<cInt>::max(), std::numeric_limits<cInt>::max()};
+  // (A part with no quarter turn among its rotations keeps all of them.)
+  const bool quartersOnly = quarterTurnsOnly_ && shapes_.firstQuarter(part) < 4;
   for (int k = 0; k < static_cast<int>(shapes_.of(part).size()); ++k) {
     if (cancellation_) cancellation_->check();
+    if (quartersOnly && shapes_.quarterOf(part, k) < 0) continue;
     const Shape& shape = shapes_.at(part, k);
     auto spot = leftmostFor(part, k, sheet, bestRank.first);
     if (!spot) continue;
@@ -182,6 +189,18 @@ std::optional<PlacedShape> CollisionPlacer::bestSpot(int part, Sheet& sheet) {
     if (rank < bestRank) best = spot, bestRank = rank;
   }
   return best;
+}
+
+bool CollisionPlacer::hurried(std::chrono::steady_clock::time_point started,
+                              std::chrono::steady_clock::time_point deadline, size_t placed, size_t of) {
+  // The rest at the pace so far, against most of the time left: on a
+  // slower or busier machine than the turns were chosen on, the parts
+  // still get placed, at fewer turns, instead of in rows.
+  constexpr double kShareOfTimeLeft = 0.8;
+  const auto now = std::chrono::steady_clock::now();
+  const double spent = std::chrono::duration<double>(now - started).count();
+  const double left = std::chrono::duration<double>(deadline - now).count();
+  return spent / static_cast<double>(placed) * static_cast<double>(of - placed) > kShareOfTimeLeft * left;
 }
 
 // The first free place, column by column from the left, for shape k of

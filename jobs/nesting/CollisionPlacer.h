@@ -45,7 +45,9 @@ class CollisionPlacer {
 
   // Lays out the parts in `sequence`; returns placements in cutting order.
   // `policy` Strict fills only the last sheet; otherwise first fit over all
-  // sheets (within the order window for Window). At `deadline` it stops:
+  // sheets (within the order window for Window). Where the pace so far
+  // would not finish by `deadline`, parts are tried at their quarter turns
+  // only (hurried()). At `deadline` it stops:
   // the result then holds the parts of the sequence placed so far, a
   // leading run of it. Throws std::invalid_argument naming a part that
   // fits no empty sheet (or the strip), core::Cancelled.
@@ -75,6 +77,11 @@ class CollisionPlacer {
   };
 
   Sheet newSheet() const;
+  // Whether, at the pace of the first `placed` parts, the rest of `of`
+  // would take most of the time left to `deadline`: the placer then tries
+  // each part at its quarter turns only (PartShapes::quarterOf()).
+  static bool hurried(std::chrono::steady_clock::time_point started, std::chrono::steady_clock::time_point deadline,
+                      size_t placed, size_t of);
   std::optional<PlacedShape> bestSpot(int part, Sheet& sheet);
   std::optional<PlacedShape> leftmostFor(int part, int k, Sheet& sheet, cInt beyond);
   [[nodiscard]] bool free(const Sheet& sheet, const Shape& shape, IntPoint at);
@@ -88,7 +95,9 @@ class CollisionPlacer {
 
   const PartShapes& shapes_;
   const core::Cancellation* cancellation_;
-  cInt cell_ = 1;  // the raster's cell side
+  bool quarterTurnsOnly_ = false;                 // hurried(): see place()
+  static constexpr size_t kHurryCheckEvery = 32;  // parts placed between checks of the pace
+  cInt cell_ = 1;                                 // the raster's cell side
   int columns_ = 0, rows_ = 0;
   static constexpr int kBlock = 16;  // raster cells per block side: the scan skips blocks without room
   // Sheets still open to first fit: trying every sheet for every part made

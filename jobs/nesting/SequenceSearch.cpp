@@ -234,6 +234,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
             ? OverlapCompaction(shapes).compact(bestLayout, random, goOn, evaluations, shorter)
             : SheetEmptying(shapes).empty(bestLayout, sheetBound, random, goOn, evaluations, shorter);
     context.check();
+    stalled = compacted.stopped == "no better layout";
     // The compaction lets grown shapes reach into each other by a few grid
     // units; the layout is kept only if the true outlines keep the spacing
     // (within layoutProblems' tolerance).
@@ -244,7 +245,7 @@ NestingResult searchLayout(const PartShapes& shapes, const FirstLayout& first, u
   }
   best.evaluations = evaluations;
   best.stopped = atBound()                                                       ? "area bound"
-                 : stalled && !compaction                                        ? "no better layout"
+                 : stalled                                                       ? "no better layout"
                  : options.evaluations > 0 && evaluations >= options.evaluations ? "layout cap"
                                                                                  : "time budget";
   return best;

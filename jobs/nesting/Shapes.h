@@ -124,7 +124,8 @@ std::vector<Shape::Pole> polesOf(const Path& polygon, size_t most);
 // for a quarter turn from a quarter turn, the whole shape is turned on the
 // grid, exactly; otherwise its poles and discs are turned instead of
 // searched again (their radii less twice kSimplifyTolerance, what the two
-// grown outlines may differ by).
+// grown outlines may differ by), and without `forNoFitPolygons` its grown
+// path and core too, their corners rounded to the grid (no offsets).
 Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
                 const Shape* turnedFrom = nullptr);
 

@@ -34,12 +34,16 @@ NestingResult SheetEmptying::empty(const std::vector<PlacedShape>& layout, int f
   std::erase_if(beds, [](const auto& bed) { return bed.empty(); });
   // Beds that kept every part through a whole pass since the beds last changed.
   std::vector<char> stuck(beds.size(), 0);
+  bool everyBedStuck = false;
   while (static_cast<int>(beds.size()) > fewest && goOn()) {
     size_t least = beds.size();
     for (size_t b = 0; b < beds.size(); ++b) {
       if (!stuck[b] && (least == beds.size() || partArea(beds[b]) < partArea(beds[least]))) least = b;
     }
-    if (least == beds.size()) break;
+    if (least == beds.size()) {
+      everyBedStuck = true;
+      break;
+    }
     // Each part that finds room elsewhere leaves at once (the layout is
     // valid after every move), the largest first; one that does not stays
     // for the next pass.
@@ -80,7 +84,9 @@ NestingResult SheetEmptying::empty(const std::vector<PlacedShape>& layout, int f
   for (size_t b = 0; b < beds.size(); ++b) {
     for (const PlacedShape& p : beds[b]) placed.emplace_back(static_cast<int>(b), p);
   }
-  return shapes_.resultOf(placed, static_cast<int>(beds.size()));
+  NestingResult result = shapes_.resultOf(placed, static_cast<int>(beds.size()));
+  if (everyBedStuck) result.stopped = "no better layout";
+  return result;
 }
 
 }  // namespace rotafab::jobs::nesting

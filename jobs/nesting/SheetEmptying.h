@@ -30,7 +30,9 @@ class SheetEmptying {
   // without overlaps. Works while `goOn` allows and more beds are used than
   // `fewest`; `moves` counts the moves; `fewer` hears of each bed closed
   // (beds, and the last bed's length in inches). Returns the layout, bed by
-  // bed in each bed's own coordinates, in cutting order.
+  // bed in each bed's own coordinates, in cutting order; its `stopped` is
+  // "no better layout" when it ended because no bed could be emptied (each
+  // kept a part through a whole pass), else empty.
   NestingResult empty(const std::vector<PlacedShape>& layout, int fewest, std::mt19937& random,
                       const std::function<bool()>& goOn, int& moves,
                       const std::function<void(int, double)>& fewer) const;

@@ -264,6 +264,42 @@ TEST(Nesting, StrictOrderPutsAContiguousRunOnEachSheet) {
   }
 }
 
+// Parts that may be cut at any angle, on a job too large for no-fit
+// polygons, are tried at even turns besides quarter turns (star-shaped
+// panels interlock at other angles); the turned shapes are the first's
+// turned and rounded to the grid, and the layout must still keep every
+// outline on the bed and the spacing between them, exactly.
+TEST(Nesting, PartsThatTurnFreelyKeepTheSpacingAtEveryTurn) {
+  EXPECT_EQ(anyAngleTurns(40), 4) << "no-fit polygons cost the square of the turns";
+  EXPECT_EQ(anyAngleTurns(3660), 24);
+  EXPECT_EQ(anyAngleTurns(5166), 16);
+  EXPECT_EQ(anyAngleTurns(75000), 4);
+  std::mt19937 random(11);
+  std::vector<NestingPart> parts;
+  for (int i = 0; i < 450; ++i) {
+    parts.push_back({"panel " + std::to_string(i + 1), star(random, 5 + i % 3, 0.6 + (i % 5) / 10.0)});
+    parts.back().order = i;
+  }
+  NestingOptions options;
+  options.order = OrderMode::Kits;
+  options.anyAngle = true;
+  options.evaluations = 1;  // the first layout only, on any machine
+  const NestingResult result = nest(parts, options, test::context());
+  expectValid(parts, result, options);
+  EXPECT_TRUE(inKits(parts, result));
+  const double step = 360.0 / anyAngleTurns(parts.size());
+  int unquartered = 0;
+  for (const PartPlacement& p : result.placements) {
+    EXPECT_NEAR(p.rotation / step, std::round(p.rotation / step), 1e-9) << p.rotation;
+    unquartered += quarterTurns(p.rotation) < 0;
+  }
+  EXPECT_GT(unquartered, 0) << "no part turned other than by quarter turns";
+  options.anyAngle = false;
+  for (const PartPlacement& p : nest(parts, options, test::context()).placements) {
+    EXPECT_GE(quarterTurns(p.rotation), 0) << p.rotation;
+  }
+}
+
 TEST(Nesting, WindowOrderMovesNoPartFartherThanTheWindow) {
   const auto parts = randomParts(6, 20);
   NestingOptions options;
