@@ -1,10 +1,13 @@
 #include "cli/RunCommand.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
+#include <iostream>
 #include <map>
 #include <memory>
 
@@ -19,24 +22,56 @@ namespace rotafab::cli {
 namespace {
 
 struct RunOptions {
-  std::string target, device, out, machine, material = "posterboard";
+  std::string target, device, out, machine, material;
   std::optional<int> sheet;
-  bool frame = false, dryRun = false;
+  bool frame = false, dryRun = false, force = false;
 };
 
-// The machine profile: the one named, or the first the URI's driver drives.
-profiles::MachineProfile machineFor(const RunOptions& options, const profiles::ProfileCatalogue& catalogue,
-                                    std::string_view driver) {
-  if (options.machine.empty()) {
-    if (auto machine = profiles::firstMachineFor(catalogue, driver)) return *machine;
-    throw UserError(fmt::format("no machine profile for the {} driver; give --machine", driver));
+// The device to cut on: the one given, else the connection of the machine
+// profile the job is cut on (the one given, else the job's own).
+std::string deviceFor(const RunOptions& options, const profiles::ProfileCatalogue& catalogue,
+                      const jobs::JobProfileNames& madeFor) {
+  if (!options.device.empty()) return options.device;
+  const std::string machine = !options.machine.empty() ? options.machine : madeFor.machine.value_or("");
+  if (machine.empty()) {
+    throw UserError(
+        fmt::format("{}: its manifest names no machine whose connection to use; give --device URI", options.target));
   }
-  profiles::MachineProfile machine = profiles::findMachine(catalogue, options.machine);
-  if (machine.driver != driver) {
-    throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver", machine.name,
-                                machine.driver, options.device, driver));
+  const profiles::MachineProfile profile = profiles::findMachine(catalogue, machine);
+  if (profile.connection.empty()) {
+    throw UserError(fmt::format("the machine profile {} ({}) names no connection; give --device URI", profile.name,
+                                profile.source.string()));
   }
-  return machine;
+  return profile.connection;
+}
+
+// A job cut with other settings than it was made for (another machine or
+// material, or the driver's machine where the job's is another's): said,
+// then asked on a terminal, or refused without --force.
+void confirmChanges(const RunOptions& options, const jobs::JobProfileNames& madeFor,
+                    const jobs::CuttingProfiles& cutting) {
+  if (cutting.changes.empty()) return;
+  const std::string made =
+      fmt::format("{} was made for {} with {}", options.target, madeFor.machine.value_or(cutting.machine.name),
+                  madeFor.material.value_or(cutting.material.name));
+  const std::string changes = fmt::format("{}", fmt::join(cutting.changes, "; "));
+  if (options.force) {
+    fmt::print(stderr, "run: {}; cut with --force: {}\n", made, changes);
+    return;
+  }
+  if (::isatty(STDIN_FILENO) == 0) {
+    throw UserError(
+        fmt::format("{}; cutting it on {} with {} changes {}; add --force to cut it so, or leave out "
+                    "--machine and --material to cut it as it was made",
+                    made, cutting.machine.name, cutting.material.name, changes));
+  }
+  fmt::print(stderr, "run: {}; cutting it on {} with {} changes {}.\nCut it with these settings? [y/N] ", made,
+             cutting.machine.name, cutting.material.name, changes);
+  std::fflush(stderr);
+  std::string answer;
+  if (!std::getline(std::cin, answer) || (answer != "y" && answer != "Y" && answer != "yes")) {
+    throw UserError("not cut: the settings were not confirmed");
+  }
 }
 
 int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command, std::map<int, std::string> kits) {
@@ -93,23 +128,33 @@ int runRun(const RunOptions& options) {
     CommandContext command({}, 0, CommandContext::SecondSignal::Waits);
     try {
       devices::JobRunSetup setup;
-      try {
-        setup.device = devices::parseDeviceUri(options.device);
-      } catch (const std::invalid_argument& error) {
-        throw UserError(fmt::format("--device {}", error.what()));
-      }
       if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
       const std::vector<jobs::JobSheet> sheets = jobs::readJobSheets(options.target, options.sheet);
       const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
-      setup.machine = machineFor(options, catalogue, setup.device.driver->name());
-      setup.material = profiles::findMaterial(catalogue, options.material);
-      jobs::checkSheetsFitBed(sheets, setup.machine);
+      const jobs::JobProfileNames madeFor = jobs::jobProfileNames(options.target);
+      const std::string device = deviceFor(options, catalogue, madeFor);
+      try {
+        setup.device = devices::parseDeviceUri(device);
+      } catch (const std::invalid_argument& error) {
+        throw UserError(fmt::format("--device {}", error.what()));
+      }
+      const std::string_view driverName = setup.device.driver->name();
+      jobs::CuttingProfiles cutting =
+          jobs::cuttingProfiles(catalogue, madeFor, options.machine, options.material, driverName);
+      if (cutting.machine.driver != driverName) {
+        throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver",
+                                    cutting.machine.name, cutting.machine.driver, device, driverName));
+      }
+      jobs::checkSheetsFitBed(sheets, cutting.machine);
+      confirmChanges(options, madeFor, cutting);
+      RunOptions resolved = options;
+      resolved.device = device;
+      setup.machine = std::move(cutting.machine);
+      setup.material = std::move(cutting.material);
       for (const jobs::JobSheet& sheet : sheets) setup.sheets.push_back(sheet.drawing);
       setup.dryRun = options.dryRun;
       setup.cancellation = &command.cancellation();
-      setup.connected = [&](const std::string& identity) {
-        fmt::print(stderr, "run: {}: {}\n", options.device, identity);
-      };
+      setup.connected = [&](const std::string& identity) { fmt::print(stderr, "run: {}: {}\n", device, identity); };
       const auto& driver = *setup.device.driver;
       if (options.dryRun && !driver.connectsForDryRun(*setup.device.address)) {
         if (const std::string note = driver.dryRunNote(*setup.device.address); !note.empty()) {
@@ -129,7 +174,7 @@ int runRun(const RunOptions& options) {
             std::filesystem::is_directory(options.target) && std::filesystem::exists(manifest)) {
           if (const auto read = jobs::readManifestSheets(manifest)) kits = read->kits;
         }
-        return cut(options, *job, command, std::move(kits));
+        return cut(resolved, *job, command, std::move(kits));
       }
       if (job->toolpaths().size() > 1) {
         // One file of several sheets would be cut back to back, onto one sheet.
@@ -161,25 +206,34 @@ void addRunCommand(CLI::App& app, int& status) {
   CLI::App* run = app.add_subcommand("run", "Drive a cutter directly: cut the sheets of a `make` output");
   run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
   run->add_option("--device", options->device,
-                  "Device URI: grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
+                  "Device URI (default: the connection of the job's machine profile): grbl:///dev/ttyUSB0?baud=115200, "
+                  "grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
                   "sim:grbl?speed=50 moves 50 times faster), m2nano://usb/1a86:5512 (a K40's M2 Nano board), "
-                  "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)")
-      ->required();
+                  "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
   run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
   run->add_option("--out", options->out,
                   "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool)");
-  run->add_option("--machine", options->machine, "Machine profile (default: the first whose driver the URI names)");
-  run->add_option("--material", options->material, "Material profile: power and speed overrides")
-      ->capture_default_str();
+  run->add_option("--machine", options->machine,
+                  "Machine profile (default: the job's, from its manifest; where --device's driver drives another, "
+                  "the first that driver drives)");
+  run->add_option("--material", options->material,
+                  "Material profile: its power, speed and passes for the machine (default: the job's, from its "
+                  "manifest, else posterboard)");
+  run->add_flag("--force", options->force,
+                "Cut with another machine or material than the job was made for without asking (it says what "
+                "changes; without a terminal, run refuses such a cut unless --force)");
   run->footer(
-      "Cuts etch, then score, then inner cuts, then outer cuts, each with the machine profile's power, speed and\n"
-      "passes. Ctrl-C stops the job and leaves the laser off (GRBL: feed hold, reset, M5; M2 Nano: \"I\", which\n"
+      "Cuts etch, then score, then inner cuts, then outer cuts, each with the power, speed and passes of the\n"
+      "machine and material the job was made for (its manifest names them); another --machine or --material\n"
+      "says what changes and asks first (or needs --force). Ctrl-C stops the job and leaves the laser off (GRBL: feed "
+      "hold, reset, M5; M2 Nano: \"I\", which\n"
       "drops the board's queue, then a home). Exit status 3 on a device fault.\n\n"
       "Examples:\n"
       "  rotafab make examples/cube.obj --structure band --machine grbl-diode-400 --out cube/\n"
       "  rotafab run cube/ --device sim:grbl\n"
+      "  rotafab run cube/ --sheet 1   (on the machine profile's connection, grbl:///dev/ttyUSB0)\n"
       "  rotafab run cube/ --sheet 1 --device grbl:///dev/ttyUSB0 --frame\n"
       "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode\n"
       "  rotafab make examples/cube.obj --structure band --machine k40-m2nano --out k40/\n"

@@ -158,6 +158,8 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   }
   job.meshFile = request.mesh;
   job.bed = request.machine.bed;
+  job.machine = request.machine.name;
+  job.material = request.material.name;
   job.formats = request.formats.value_or(defaultFormats(request.machine));
   job.seconds.nesting = lap();
   if (!job.sheets.inRowsNote.empty()) context.note(fmt::format("{}: {}", name, job.sheets.inRowsNote));
@@ -180,7 +182,10 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
         kSheetDecimals);
   });
   {
-    nlohmann::ordered_json more = {{"size", {job.size.x(), job.size.y(), job.size.z()}},
+    // The machine and material it was planned for: what `run` and the daemon cut it with.
+    nlohmann::ordered_json more = {{"machine", job.machine},
+                                   {"material", job.material},
+                                   {"size", {job.size.x(), job.size.y(), job.size.z()}},
                                    {"stability", stabilityJson(job.stability)},
                                    {"cost", costJson(job.cost)}};
     if (!job.warnings.empty()) more["warnings"] = job.warnings;

@@ -92,6 +92,7 @@ struct PlannedJob {
   std::string title;               // "bunny (band)"
   BuiltMesh mesh;                  // of the mesh as built (after --holes fill)
   profiles::Bed bed;               // the machine's
+  std::string machine, material;   // the profiles' names: manifest.json's "machine" and "material"
   geometry::Structure structure;
   geometry::Stability stability;                     // of the structure as built, standing on the request's up axis
   geometry::Point3 size = geometry::Point3::Zero();  // the mesh's box as built, inches ("size", docs/CONTRACT.md)

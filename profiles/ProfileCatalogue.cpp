@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "core/ProgramFolders.h"
+#include "profiles/Length.h"
 #include "profiles/Profiles.h"
 
 namespace rotafab::profiles {
@@ -102,6 +103,41 @@ MaterialProfile findMaterial(const ProfileCatalogue& catalogue, const std::strin
     if (material.name == name) return material;
   throw ProfileError(fmt::format("no material profile named '{}' (there are: {}; `rotafab profiles` lists them)", name,
                                  namesOf(catalogue.materials)));
+}
+
+OperationSettings operationSettings(const MachineProfile& machine, const MaterialProfile& material,
+                                    Operation operation) {
+  const ColourSetting& row = machine.settingFor(operation);
+  OperationSettings settings{row.power, row.speed, row.passes};
+  if (const auto overrides = material.machines.find(machine.name); overrides != material.machines.end()) {
+    if (const auto it = overrides->second.find(operation); it != overrides->second.end()) {
+      settings.power = it->second.power.value_or(settings.power);
+      settings.speed = it->second.speed.value_or(settings.speed);
+      settings.passes = it->second.passes.value_or(settings.passes);
+    }
+  }
+  return settings;
+}
+
+std::vector<std::string> settingChanges(const MachineProfile& madeFor, const MaterialProfile& madeWith,
+                                        const MachineProfile& cutOn, const MaterialProfile& cutWith) {
+  std::vector<std::string> changes;
+  const auto said = [](const OperationSettings& s) {
+    return fmt::format("{:g}% power at {:g}% speed, {} pass{}", s.power, s.speed, s.passes, s.passes == 1 ? "" : "es");
+  };
+  if (madeFor.name != cutOn.name) changes.push_back(fmt::format("machine: {} instead of {}", cutOn.name, madeFor.name));
+  if (madeWith.name != cutWith.name) {
+    changes.push_back(fmt::format("material: {} ({}) instead of {} ({})", cutWith.name,
+                                  formatLength(cutWith.thickness, cutWith.units.thickness), madeWith.name,
+                                  formatLength(madeWith.thickness, madeWith.units.thickness)));
+  }
+  for (const Operation operation : {Operation::Cut, Operation::Score, Operation::Etch}) {
+    const OperationSettings before = operationSettings(madeFor, madeWith, operation);
+    const OperationSettings after = operationSettings(cutOn, cutWith, operation);
+    if (before == after) continue;
+    changes.push_back(fmt::format("{}: {} instead of {}", operationName(operation), said(after), said(before)));
+  }
+  return changes;
 }
 
 }  // namespace rotafab::profiles

@@ -45,6 +45,9 @@ struct MachineMotion {
   double junctionDeviation = 0;  // inches; 0: it stops at every corner (no look-ahead)
 };
 
+// The material of a job that names none.
+inline constexpr std::string_view kDefaultMaterial = "posterboard";
+
 struct MachineProfile {
   std::string name;
   std::string description;
@@ -88,6 +91,26 @@ struct MaterialProfile {
   std::map<std::string, std::map<Operation, PowerSpeed>> machines;  // machine name -> overrides
   std::filesystem::path source;
 };
+
+// What the laser does for one operation on one machine with one material:
+// the machine's colour table row, with the material's overrides for that
+// machine (`machines:` in the material profile).
+struct OperationSettings {
+  double power = 0;  // percent
+  double speed = 0;  // percent of the machine's maximum
+  int passes = 1;
+  friend bool operator==(const OperationSettings&, const OperationSettings&) = default;
+};
+OperationSettings operationSettings(const MachineProfile& machine, const MaterialProfile& material,
+                                    Operation operation);
+
+// What changes when a job made for (`madeFor`, `madeWith`) is cut on
+// (`cutOn`, `cutWith`), one phrase each, for people: "cut: 100% power at
+// 100% speed, 2 passes instead of 100% at 25%, 4 passes", "material:
+// posterboard (0.06 in) instead of plywood-3mm (0.118 in)". Empty when the
+// machine and the material are the job's own and their settings are too.
+std::vector<std::string> settingChanges(const MachineProfile& madeFor, const MaterialProfile& madeWith,
+                                        const MachineProfile& cutOn, const MaterialProfile& cutWith);
 
 // Thrown for an invalid profile: "FILE:LINE:COL: key: what is wrong".
 class ProfileError : public std::runtime_error {

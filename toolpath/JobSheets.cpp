@@ -101,6 +101,41 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
   return readSheets(sheets);
 }
 
+JobProfileNames jobProfileNames(const std::filesystem::path& target) {
+  std::error_code error;
+  const std::filesystem::path folder = std::filesystem::is_directory(target, error) ? target : target.parent_path();
+  const std::filesystem::path manifest = folder / "manifest.json";
+  if (!std::filesystem::exists(manifest, error)) return {};
+  const auto read = readManifestSheets(manifest);
+  if (!read) return {};
+  return {read->machine, read->material};
+}
+
+CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, const JobProfileNames& madeFor,
+                                const std::string& machine, const std::string& material,
+                                std::optional<std::string_view> driver) {
+  CuttingProfiles cutting;
+  if (!machine.empty()) {
+    cutting.machine = profiles::findMachine(catalogue, machine);
+  } else if (madeFor.machine && (!driver || profiles::findMachine(catalogue, *madeFor.machine).driver == *driver)) {
+    cutting.machine = profiles::findMachine(catalogue, *madeFor.machine);
+  } else if (auto first = driver ? profiles::firstMachineFor(catalogue, *driver) : std::nullopt) {
+    cutting.machine = *first;
+  } else {
+    throw core::UserError(fmt::format("no machine profile for the {} driver; give --machine", driver.value_or("")));
+  }
+  cutting.material = profiles::findMaterial(
+      catalogue, !material.empty() ? material : madeFor.material.value_or(std::string(profiles::kDefaultMaterial)));
+  if (madeFor.machine || madeFor.material) {
+    const profiles::MachineProfile madeOn =
+        madeFor.machine ? profiles::findMachine(catalogue, *madeFor.machine) : cutting.machine;
+    const profiles::MaterialProfile madeWith =
+        madeFor.material ? profiles::findMaterial(catalogue, *madeFor.material) : cutting.material;
+    cutting.changes = profiles::settingChanges(madeOn, madeWith, cutting.machine, cutting.material);
+  }
+  return cutting;
+}
+
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {
   for (const JobSheet& sheet : sheets) {
     if (sheet.drawing.width > machine.bed.width + 1e-6 || sheet.drawing.height > machine.bed.height + 1e-6) {

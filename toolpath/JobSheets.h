@@ -30,6 +30,31 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder, const n
 std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
                                     const std::vector<std::pair<int, std::string>>& svgSheets);
 
+// The machine and material profiles a job was planned for, by name, from
+// its folder's manifest.json (for one sheet's .svg, the manifest beside
+// it), where it says them: jobs made before the manifest named them, and
+// sheets with no manifest, have neither.
+struct JobProfileNames {
+  std::optional<std::string> machine, material;
+};
+JobProfileNames jobProfileNames(const std::filesystem::path& target);
+
+// The profiles a job is cut with: the ones asked for (`machine`,
+// `material`, empty for none), else the job's own, else the first machine
+// the device's driver drives and posterboard; `changes` says what differs
+// from the job's own settings (profiles::settingChanges), empty when it
+// is cut as it was made. `madeFor` the job's names. Throws
+// profiles::ProfileError for a name no profile has (the job's own
+// included), core::UserError when no machine is driven by `driver`.
+struct CuttingProfiles {
+  profiles::MachineProfile machine;
+  profiles::MaterialProfile material;
+  std::vector<std::string> changes;
+};
+CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, const JobProfileNames& madeFor,
+                                const std::string& machine, const std::string& material,
+                                std::optional<std::string_view> driver);
+
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);
 

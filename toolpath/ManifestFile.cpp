@@ -99,6 +99,9 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
   }
   if (simdjson::dom::array panels; manifest["panels"].get(panels) == simdjson::SUCCESS) read.panels = panels.size();
   if (simdjson::dom::element cost; manifest["cost"].get(cost) == simdjson::SUCCESS) read.cost = simdjson::minify(cost);
+  // (Manifests before these keys name neither.)
+  if (std::string_view name; manifest["machine"].get(name) == simdjson::SUCCESS) read.machine = std::string(name);
+  if (std::string_view name; manifest["material"].get(name) == simdjson::SUCCESS) read.material = std::string(name);
   return read;
 }
 

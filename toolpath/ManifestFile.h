@@ -29,6 +29,10 @@ struct ManifestSheets {
   // Each sheet's kit, where the manifest says it (by sheet index): "steps
   // 174-352; once cut, steps 1-352 can be done".
   std::map<int, std::string> kits;
+  // The machine and material profiles the job was planned for, by name,
+  // where the manifest says them: what it is cut with unless the operator
+  // says otherwise.
+  std::optional<std::string> machine, material;
 };
 // A sheet's kit as the operator and the builders read it: "steps 174-352;
 // once cut, steps 1-352 can be done" (`run`: its first and last step, when

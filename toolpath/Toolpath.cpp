@@ -242,17 +242,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
   for (auto& [stage, candidates] : stages) {
     const Operation operation = stage.rank == 0 ? Operation::Etch : stage.rank == 1 ? Operation::Score : Operation::Cut;
     const profiles::ColourSetting& setting = machine.settingFor(operation);
-    double power = setting.power, speed = setting.speed;
-    int passes = setting.passes;
-    const auto overrides = material.machines.find(machine.name);
-    if (overrides != material.machines.end()) {
-      const auto it = overrides->second.find(operation);
-      if (it != overrides->second.end()) {
-        power = it->second.power.value_or(power);
-        speed = it->second.speed.value_or(speed);
-        passes = it->second.passes.value_or(passes);
-      }
-    }
+    const auto [power, speed, passes] = profiles::operationSettings(machine, material, operation);
     if (!(speed > 0) || passes < 1) {
       throw std::invalid_argument(fmt::format("{}: the {} setting ({}) has speed {}% and {} passes; nothing to run",
                                               machine.name, profiles::operationName(operation), setting.name, speed,

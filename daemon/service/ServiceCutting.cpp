@@ -91,6 +91,13 @@ void Service::Impl::launchCut(const JobRecord& job, Device& on, int fromSheet) {
   deviceChanged(*device);
 }
 
+profiles::MaterialProfile Service::Impl::cuttingMaterial(const fs::path& folder,
+                                                         const profiles::MaterialProfile& device) const {
+  const jobs::JobProfileNames madeFor = jobs::jobProfileNames(folder);
+  if (!madeFor.material || *madeFor.material == device.name) return device;
+  return profiles::findMaterial(catalogue, *madeFor.material);
+}
+
 void Service::Impl::runCut(JobId id, const std::shared_ptr<RunControl>& control, const std::string& uri,
                            const profiles::MachineProfile& machine, const profiles::MaterialProfile& material,
                            const fs::path& folder, int fromSheet, int sheets) {
@@ -103,7 +110,7 @@ void Service::Impl::runCut(JobId id, const std::shared_ptr<RunControl>& control,
     devices::JobRunSetup setup;
     setup.device = devices::parseDeviceUri(uri);
     setup.machine = machine;
-    setup.material = material;
+    setup.material = cuttingMaterial(folder, material);
     for (const jobs::JobSheet& sheet : jobs::readJobSheets(folder, std::nullopt)) {
       if (sheet.index >= fromSheet) setup.sheets.push_back(sheet.drawing);
     }

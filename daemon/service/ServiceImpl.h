@@ -372,6 +372,13 @@ struct Service::Impl {
   // A job this host moved to running on `device`: its cut on a thread of its own.
   void launchCut(const JobRecord& job, Device& on, int fromSheet);
 
+  // The material a planned job is cut with: the one its manifest names (it
+  // was made for it: kerf, power, speed, passes), else the device's.
+  // Throws profiles::ProfileError when no profile here has the job's. Reads
+  // the catalogue only, which no thread changes after startup.
+  [[nodiscard]] profiles::MaterialProfile cuttingMaterial(const fs::path& folder,
+                                                          const profiles::MaterialProfile& device) const;
+
   // On the job's own thread: the driver's loop, its events posted to the strand.
   void runCut(JobId id, const std::shared_ptr<RunControl>& control, const std::string& uri,
               const profiles::MachineProfile& machine, const profiles::MaterialProfile& material,

@@ -211,11 +211,12 @@ void Service::sheet(JobId id, int sheet, ReplyHandler done) {
       std::string why;
       const std::optional<Impl::Target> device = impl_->deviceFor(job.device, "", why);
       if (!device) throw ApiError(409, fmt::format("job {} has no device to plan its strokes for", id));
-      work = [folder = impl_->plannedFolder(job), machine = device->machine, material = device->material, sheet, id] {
+      work = [impl = impl_.get(), folder = impl_->plannedFolder(job), machine = device->machine,
+              material = device->material, sheet, id] {
         const std::vector<jobs::JobSheet> drawn = jobs::readJobSheets(folder, std::optional<int>(sheet));
         if (drawn.empty()) throw ApiError(404, fmt::format("job {} has no sheet {}", id, sheet));
-        const jobs::Toolpath path =
-            jobs::planToolpath(drawn.front().drawing, machine, material, jobs::profileMotion(machine));
+        const jobs::Toolpath path = jobs::planToolpath(
+            drawn.front().drawing, machine, impl->cuttingMaterial(folder, material), jobs::profileMotion(machine));
         json answer = toolpathJson(path);
         // Each operation in its colour of the machine's table (fig. 65), as the sheet files draw it.
         json colours = json::object();

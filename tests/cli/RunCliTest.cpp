@@ -88,6 +88,53 @@ TEST(RunCli, FaultsOfTheControllerAsTheOperatorMeetsThem) {
       << typo.err;
 }
 
+// A job carries its machine and material to the cutter: run cuts it with
+// the power, speed and passes it was made for, on the machine profile's
+// connection when no --device is given; another material or machine says
+// what changes and, with no terminal to ask, needs --force.
+TEST(RunCli, AJobIsCutWithTheMachineAndMaterialItWasMadeFor) {
+  const auto job = madeCube("--machine grbl-diode-400 --material plywood-3mm");
+  const auto manifest = nlohmann::json::parse(readFile(job / "manifest.json"));
+  EXPECT_EQ(manifest.at("machine"), "grbl-diode-400");
+  EXPECT_EQ(manifest.at("material"), "plywood-3mm");
+  TempDir dir;
+  const auto dryRun = [&](const std::string& options, const std::string& file) {
+    return run(kCli + " run " + quoted(job) + " --sheet 1 " + options + " --dry-run --out " +
+               quoted(dir.path() / file));
+  };
+  const CommandResult own = dryRun("--device sim:grbl", "own.gcode");
+  ASSERT_EQ(own.status, 0) << own.err;
+  const CommandResult named = dryRun("--device sim:grbl --material plywood-3mm", "named.gcode");
+  ASSERT_EQ(named.status, 0) << named.err;
+  EXPECT_EQ(named.err.find("instead of"), std::string::npos) << "the job's own material changes nothing";
+  EXPECT_EQ(readFile(dir.path() / "own.gcode"), readFile(dir.path() / "named.gcode"));
+  // Plywood's settings: 4 passes of each cut (posterboard's: 2).
+  EXPECT_NE(own.out.find("(168 strokes)"), std::string::npos) << own.out;
+
+  const CommandResult other = dryRun("--device sim:grbl --material posterboard", "other.gcode");
+  EXPECT_EQ(other.status, 1);
+  EXPECT_NE(other.err.find("was made for grbl-diode-400 with plywood-3mm; cutting it on grbl-diode-400 with "
+                           "posterboard changes material: posterboard (0.8 mm) instead of plywood-3mm (3 mm); cut: "),
+            std::string::npos)
+      << other.err;
+  EXPECT_NE(other.err.find("add --force"), std::string::npos) << other.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "other.gcode"));
+  const CommandResult forced = dryRun("--device sim:grbl --material posterboard --force", "forced.gcode");
+  ASSERT_EQ(forced.status, 0) << forced.err;
+  EXPECT_NE(forced.err.find("cut with --force: material: posterboard"), std::string::npos) << forced.err;
+  EXPECT_NE(forced.out.find("(108 strokes)"), std::string::npos) << forced.out;
+
+  // No --device: the machine profile's connection (a dry run does not open it).
+  const CommandResult profiled = dryRun("", "profiled.gcode");
+  ASSERT_EQ(profiled.status, 0) << profiled.err;
+  EXPECT_NE(profiled.out.find("G-code for 1 sheet (168 strokes)"), std::string::npos) << profiled.out;
+  // A device another driver drives: another machine, said and refused.
+  const CommandResult onGrbl = run(kCli + " run " + quoted(k40Job()) + " --sheet 1 --device sim:grbl --dry-run --out " +
+                                   quoted(dir.path() / "k40.gcode"));
+  EXPECT_EQ(onGrbl.status, 1);
+  EXPECT_NE(onGrbl.err.find("machine: grbl-diode-400 instead of k40-m2nano"), std::string::npos) << onGrbl.err;
+}
+
 TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
   TempDir dir;
   const auto file = dir.path() / "cube.gcode";

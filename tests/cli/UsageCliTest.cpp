@@ -38,10 +38,10 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
               "--width is an option of the plain-woven structure (--structure weave), not of band",
               "rotafab make --help");
   // The parser's own errors point to the command's help, not the program's.
-  const CommandResult noDevice = run(kCli + " run " + quoted(kSource));
-  EXPECT_EQ(noDevice.status, 2);
-  EXPECT_NE(noDevice.err.find("--device is required\nRun `rotafab run --help` for usage.\n"), std::string::npos)
-      << noDevice.err;
+  const CommandResult noTarget = run(kCli + " run");
+  EXPECT_EQ(noTarget.status, 2);
+  EXPECT_NE(noTarget.err.find("TARGET is required\nRun `rotafab run --help` for usage.\n"), std::string::npos)
+      << noTarget.err;
 }
 
 }  // namespace

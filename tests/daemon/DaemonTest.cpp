@@ -816,5 +816,34 @@ TEST(Daemon, WithNoDaemonTheClientSaysSoAndHowToStartIt) {
                                daemon.socket().string()));
 }
 
+// A job made for a material is cut with that material's power, speed and
+// passes, not the device's: plywood on the GRBL machine cuts in 4 passes,
+// posterboard (the device's) in 2.
+TEST(Daemon, AJobIsCutWithTheMaterialItWasMadeFor) {
+  TempDir root;
+  Daemon daemon(root.path(),
+                "devices: [{name: laser1, machine: grbl-diode-400, material: posterboard, "
+                "uri: \"sim:grbl?speed=400\"}]\n");
+  daemon.start();
+  const CommandResult submitted = daemon.client("submit " + quoted(kSource / "examples/cube.obj") +
+                                                " --structure band --material plywood-3mm --evaluations 1 --json");
+  ASSERT_EQ(submitted.status, 0) << submitted.err;
+  const long long id = json::parse(submitted.out)["id"];
+  const json ready =
+      daemon.waitForJob(id, [](const json& job) { return job["state"] != "queued" && job["state"] != "planning"; });
+  ASSERT_EQ(ready["state"], "ready") << ready.dump();
+  const RawReply sheet = daemon.get(fmt::format("/api/jobs/{}/sheets/1", id));
+  ASSERT_EQ(sheet.status, 200) << sheet.text;
+  int cutPasses = 0;
+  for (const json& stroke : sheet.body["strokes"]) {
+    if (stroke["operation"] == "cut") cutPasses = std::max(cutPasses, stroke["pass"].get<int>());
+  }
+  EXPECT_EQ(cutPasses, 4) << "plywood-3mm's passes on grbl-diode-400";
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  const json done = daemon.waitForJob(id, [](const json& job) { return job["state"] == "done"; });
+  ASSERT_EQ(done["state"], "done") << done.dump();
+  EXPECT_EQ(done["strokes"].get<size_t>(), sheet.body["strokes"].size()) << "the strokes cut are plywood's";
+}
+
 }  // namespace
 }  // namespace rotafab::test
