@@ -30,14 +30,19 @@ namespace {
 
 // " (its kit: steps 174-352; once cut, steps 1-352 can be done)" for sheet
 // `sheet` of a job whose summary gives its kits, else nothing.
-std::string kitOf(const json& job, int sheet) {
-  const json* kits = job.contains("summary") && job["summary"].is_object() && job["summary"].contains("kits")
-                         ? &job["summary"]["kits"]
-                         : nullptr;
-  if (!kits || !kits->is_array() || sheet < 1 || static_cast<size_t>(sheet) > kits->size()) return "";
+// What to load for `sheet`, where the job's summary says it: ", posterboard
+// (0.8 mm), 32 x 18 in (its kit: steps 181-364; ...)".
+std::string whatToLoad(const json& job, int sheet) {
+  const json* summary = job.contains("summary") && job["summary"].is_object() ? &job["summary"] : nullptr;
+  std::string said;
+  if (summary && summary->contains("stock") && (*summary)["stock"].is_string()) {
+    said = ", " + (*summary)["stock"].get<std::string>();
+  }
+  const json* kits = summary && summary->contains("kits") ? &(*summary)["kits"] : nullptr;
+  if (!kits || !kits->is_array() || sheet < 1 || static_cast<size_t>(sheet) > kits->size()) return said;
   const json& kit = (*kits)[static_cast<size_t>(sheet) - 1];
-  return kit.is_string() && !kit.get<std::string>().empty() ? fmt::format(" (its kit: {})", kit.get<std::string>())
-                                                            : "";
+  if (kit.is_string() && !kit.get<std::string>().empty()) said += fmt::format(" (its kit: {})", kit.get<std::string>());
+  return said;
 }
 
 struct ClientOptions {
@@ -175,6 +180,9 @@ void printStatus(const json& job) {
       line += fmt::format(", about {} to cut", core::minutes(summary["cost"].value("cutting_seconds", 0.0)));
     }
     fmt::print("{}\n", line);
+    if (summary.contains("stock") && summary["stock"].is_string()) {
+      fmt::print("  sheets of {}, cut on {}\n", summary["stock"].get<std::string>(), summary.value("machine", ""));
+    }
     // What the plan warned of, as make says it: the builders should know.
     if (summary.contains("warnings") && summary["warnings"].is_array()) {
       for (const json& warning : summary["warnings"]) {
@@ -185,7 +193,7 @@ void printStatus(const json& job) {
   if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
   if (job.value("waiting_for_next", false)) {
     const int next = job.value("sheet", 0) + 1;
-    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, kitOf(job, next), job.value("id", 0));
+    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, whatToLoad(job, next), job.value("id", 0));
   }
   fmt::print("  {}\n", job.value("message", ""));
   if (job.contains("transitions")) {
@@ -263,7 +271,7 @@ int follow(const DaemonClient& client, long long id) {
         askedFor = next;
         if (askHere) {
           fmt::print(stderr, "job {}: load sheet {}{} and press Enter (or run `rotafab next {}`)\n", id, next,
-                     kitOf(data, next), id);
+                     whatToLoad(data, next), id);
           if (asking.joinable()) asking.join();
           asking = std::thread([&client, id, &stopAsking] {
             if (!waitForEnter(stopAsking)) return;
@@ -274,7 +282,7 @@ int follow(const DaemonClient& client, long long id) {
             }
           });
         } else {
-          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, kitOf(data, next), id);
+          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, whatToLoad(data, next), id);
         }
       }
       if (settled(data)) {

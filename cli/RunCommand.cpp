@@ -74,7 +74,8 @@ void confirmChanges(const RunOptions& options, const jobs::JobProfileNames& made
   }
 }
 
-int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command, std::map<int, std::string> kits) {
+int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command, std::string stock,
+        std::map<int, std::string> kits) {
   const auto& toolpaths = job.toolpaths();
   if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
     throw UserError(
@@ -85,7 +86,8 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   const auto started = std::chrono::steady_clock::now();
   devices::RunSummary done;
   try {
-    done = job.run(options.frame, terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(kits)),
+    done = job.run(options.frame,
+                   terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(stock), std::move(kits)),
                    command.cancellation());
   } catch (const devices::DeviceFault& fault) {
     // Where the job stopped, so that the operator knows what is cut and can
@@ -147,6 +149,7 @@ int runRun(const RunOptions& options) {
       }
       jobs::checkSheetsFitBed(sheets, cutting.machine);
       confirmChanges(options, madeFor, cutting);
+      std::string stock = jobs::stockOf(cutting.material, cutting.machine.bed);
       RunOptions resolved = options;
       resolved.device = device;
       setup.machine = std::move(cutting.machine);
@@ -174,7 +177,7 @@ int runRun(const RunOptions& options) {
             std::filesystem::is_directory(options.target) && std::filesystem::exists(manifest)) {
           if (const auto read = jobs::readManifestSheets(manifest)) kits = read->kits;
         }
-        return cut(resolved, *job, command, std::move(kits));
+        return cut(resolved, *job, command, std::move(stock), std::move(kits));
       }
       if (job->toolpaths().size() > 1) {
         // One file of several sheets would be cut back to back, onto one sheet.

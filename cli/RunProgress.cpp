@@ -42,7 +42,8 @@ bool waitForEnter(const core::Cancellation& cancel) {
   }
 }
 
-devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::map<int, std::string> kits) {
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
+                                     std::map<int, std::string> kits) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   auto bar = std::make_shared<ProgressBar>(terminal);
   // "; its kit: steps 174-352; once cut, ..." for a sheet the manifest gives a kit.
@@ -51,17 +52,19 @@ devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& ca
     return kit == kits->end() ? std::string() : fmt::format(" (its kit: {})", kit->second);
   };
   devices::RunEvents events;
-  events.beforeSheet = [&cancel, kitOf](const jobs::Toolpath& next) {
-    fmt::print(stderr, "run: load sheet {}{} and press Enter (Ctrl-C stops)\n", next.sheet, kitOf(next.sheet));
+  events.beforeSheet = [&cancel, kitOf, stock](const jobs::Toolpath& next) {
+    fmt::print(stderr, "run: load sheet {}, {}{}, and press Enter (Ctrl-C stops)\n", next.sheet, stock,
+               kitOf(next.sheet));
     return waitForEnter(cancel);  // Ctrl-C or the end of input: stop, do not cut blind
   };
-  events.sheetStarted = [bar, sheets, terminal, kitOf](size_t s, const jobs::Toolpath& toolpath, double seconds) {
+  events.sheetStarted = [bar, sheets, terminal, kitOf, stock](size_t s, const jobs::Toolpath& toolpath,
+                                                              double seconds) {
     // A simulator faster than real: its time, and the machine's it stands for.
     const std::string machineTime = std::abs(seconds - toolpath.seconds) > 0.5
                                         ? fmt::format(" ({} on the machine simulated)", minutes(toolpath.seconds))
                                         : "";
-    fmt::print(stderr, "run: sheet {} ({} of {}): {} strokes, {:.1f} in to burn, about {}{}{}\n", toolpath.sheet, s + 1,
-               sheets, toolpath.strokes.size(), toolpath.burnLength, minutes(seconds), machineTime,
+    fmt::print(stderr, "run: sheet {} ({} of {}), {}: {} strokes, {:.1f} in to burn, about {}{}{}\n", toolpath.sheet,
+               s + 1, sheets, stock, toolpath.strokes.size(), toolpath.burnLength, minutes(seconds), machineTime,
                kitOf(toolpath.sheet));
     *bar = ProgressBar(terminal);
   };

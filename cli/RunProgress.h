@@ -36,9 +36,11 @@ bool waitForEnter(const core::Cancellation& cancel);
 
 // The events of a run of `sheets` sheets shown on standard error: a line as
 // each sheet starts, its progress bar, the question before each sheet after
-// the first (answered at the terminal), the framing. `kits`: each sheet's
-// kit by its number, as the job's manifest says it (ManifestSheets::kits).
-devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel,
+// the first (answered at the terminal), the framing. `stock`: what each
+// sheet is (jobs::stockOf(), "posterboard (0.8 mm), 32 x 18 in"); `kits`:
+// each sheet's kit by its number, as the job's manifest says it
+// (ManifestSheets::kits).
+devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
                                      std::map<int, std::string> kits = {});
 
 }  // namespace rotafab::cli

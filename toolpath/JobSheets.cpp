@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/UserError.h"
+#include "profiles/Length.h"
 #include "toolpath/JsonErrors.h"
 #include "toolpath/ManifestFile.h"
 #include "toolpath/SheetReader.h"
@@ -134,6 +135,13 @@ CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, con
     cutting.changes = profiles::settingChanges(madeOn, madeWith, cutting.machine, cutting.material);
   }
   return cutting;
+}
+
+std::string stockOf(const profiles::MaterialProfile& material, const profiles::Bed& bed) {
+  const double perInch = profiles::unitsPerInch(bed.unit);
+  return fmt::format("{} ({}), {:.4g} x {:.4g} {}", material.name,
+                     profiles::formatLength(material.thickness, material.units.thickness), bed.width * perInch,
+                     bed.height * perInch, bed.unit);
 }
 
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {

@@ -55,6 +55,11 @@ CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, con
                                 const std::string& machine, const std::string& material,
                                 std::optional<std::string_view> driver);
 
+// What the operator loads for each sheet of a job, for people: the
+// material, its thickness and the sheet's size, "posterboard (0.8 mm), 32
+// x 18 in", each in the unit its profile gives it in.
+std::string stockOf(const profiles::MaterialProfile& material, const profiles::Bed& bed);
+
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);
 

@@ -340,7 +340,8 @@ struct Service::Impl {
 
   // A planned folder's plan: its sheets read and checked against the bed
   // they are to be cut on; the summary the queue shows, from its manifest.
-  static json planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine);
+  json planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine,
+                    const profiles::MaterialProfile& material) const;
 
   // A planned folder is planned while it is submitted (off the strand, in
   // the submission's worker): its job is added ready, its queued, planning

@@ -54,6 +54,15 @@ void addKits(const jobs::ManifestSheets& listed, json& summary) {
   }
 }
 
+// What the job is cut on and with, and what the operator loads for each
+// sheet ("posterboard (0.8 mm), 32 x 18 in"): the page and `rotafab
+// status` say it.
+void addStock(const profiles::MachineProfile& machine, const profiles::MaterialProfile& material, json& summary) {
+  summary["machine"] = machine.name;
+  summary["material"] = material.name;
+  summary["stock"] = jobs::stockOf(material, machine.bed);
+}
+
 }  // namespace
 
 void Service::Impl::pump() {
@@ -187,8 +196,10 @@ std::string Service::Impl::plannedReason(int sheets, JobId id) {
   return fmt::format("planned: {} sheet{}; start it with `rotafab start {}`", sheets, sheets == 1 ? "" : "s", id);
 }
 
-json Service::Impl::planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine) {
+json Service::Impl::planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine,
+                                 const profiles::MaterialProfile& material) const {
   json summary;
+  addStock(machine, cuttingMaterial(folder, material), summary);
   std::vector<jobs::JobSheet> planned;
   if (const auto listed = jobs::readManifestSheets(folder / "manifest.json")) {
     planned = jobs::readJobSheets(folder, listed->svgSheets);
@@ -213,8 +224,11 @@ void Service::Impl::planOnSubmission(NewJob& job, const fs::path& folder, const 
   if (!device) throw ApiError(409, why);
   json summary;
   try {
-    summary = planOfFolder(folder, device->machine);
+    summary = planOfFolder(folder, device->machine, device->material);
   } catch (const core::UserError& error) {
+    throw ApiError(400, inSubmittersWords(error.what(), folder, submitted));
+  } catch (const profiles::ProfileError& error) {
+    // A material its manifest names that no profile here has.
     throw ApiError(400, inSubmittersWords(error.what(), folder, submitted));
   }
   const int sheets = summary["sheets"].get<int>();
@@ -258,7 +272,7 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
   std::string plannedName;
   try {
     if (job.kind == JobKind::Planned) {
-      summary = planOfFolder(folder, machine);
+      summary = planOfFolder(folder, machine, material);
       sheets = summary["sheets"].get<int>();
     } else {
       std::optional<jobs::MakeOptions> stored = storedOptions(job.options);
@@ -308,6 +322,7 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
       summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
       summary["cost"] = jobs::costJson(planned.cost);
       summary["folder"] = plannedName;
+      addStock(machine, request.material, summary);
       if (const auto listed = jobs::readManifestSheets(folder / plannedName / "manifest.json"))
         addKits(*listed, summary);
       // What the plan said on the way, for the people at the machine (the page shows them).

@@ -8,12 +8,20 @@ import { state } from './state.js';
 import { fillJobChoices, showGuide, showSheets } from './tabs.js';
 import { sheetsDone, timeLeft } from './words.js';
 
-// " (its kit: steps 174-352; once cut, steps 1-352 can be done)" for a
-// sheet of a job whose plan gives its kits, else nothing.
-function kitOf(job, sheet) {
-  const kits = job.summary && Array.isArray(job.summary.kits) ? job.summary.kits : [];
+// What to load for a sheet, where the plan says it: ", posterboard (0.8 mm),
+// 32 x 18 in (its kit: steps 181-364; once cut, steps 1-364 can be done)".
+function whatToLoad(job, sheet) {
+  const summary = job.summary || {};
+  const kits = Array.isArray(summary.kits) ? summary.kits : [];
   const kit = kits[sheet - 1];
-  return kit ? ` (its kit: ${kit})` : '';
+  return (summary.stock ? `, ${summary.stock}` : '') + (kit ? ` (its kit: ${kit})` : '');
+}
+
+// The machine and material a job is cut on and with, under its source.
+function cutWith(job) {
+  const summary = job.summary || {};
+  if (!summary.material) return null;
+  return element('div', { class: 'cut-with' }, `${summary.material} on ${summary.machine}`);
 }
 
 function actionsOf(job) {
@@ -79,10 +87,10 @@ export function renderJobs() {
   for (const job of state.jobs) {
     const row = element('tr', { 'data-job': job.id, draggable: 'true', 'data-state': job.state },
       element('td', {}, String(job.id)),
-      element('td', {}, job.source || ''),
+      element('td', {}, job.source || '', cutWith(job)),
       element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
               element('span', { class: 'message' }, job.waiting_for_next
-                ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}${kitOf(job, job.sheet + 1)}, then press “Next sheet loaded”`
+                ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}${whatToLoad(job, job.sheet + 1)}, then press “Next sheet loaded”`
                 : job.message || ''),
               warningsOf(job)),
       element('td', {}, job.owner || ''),

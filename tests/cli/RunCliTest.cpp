@@ -124,6 +124,11 @@ TEST(RunCli, AJobIsCutWithTheMachineAndMaterialItWasMadeFor) {
   EXPECT_NE(forced.err.find("cut with --force: material: posterboard"), std::string::npos) << forced.err;
   EXPECT_NE(forced.out.find("(108 strokes)"), std::string::npos) << forced.out;
 
+  // Cut, it says what to load: the material, its thickness and the sheet's size.
+  const CommandResult cut = run(kCli + " run " + quoted(job) + " --sheet 1 --device 'sim:grbl?speed=2000'");
+  ASSERT_EQ(cut.status, 0) << cut.err;
+  EXPECT_NE(cut.err.find("run: sheet 1 (1 of 1), plywood-3mm (3 mm), 400 x 400 mm: 168 strokes"), std::string::npos)
+      << cut.err;
   // No --device: the machine profile's connection (a dry run does not open it).
   const CommandResult profiled = dryRun("", "profiled.gcode");
   ASSERT_EQ(profiled.status, 0) << profiled.err;

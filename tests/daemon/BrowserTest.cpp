@@ -285,6 +285,12 @@ TEST(Browser, TheQueueIsReorderedByDraggingItsRowsUpAndDown) {
   testing::Browser browser;
   browser.navigate(loginLink(daemon));
   ASSERT_TRUE(browser.waitFor("document.querySelectorAll('#jobs-body tr').length === 3", 20s));
+  // Each planned job's row says what it is cut with, and on what.
+  EXPECT_TRUE(
+      browser.waitFor("[...document.querySelectorAll('#jobs-body .cut-with')].map(e => e.textContent).join("
+                      "'|') === Array(3).fill('posterboard on grbl-diode-400').join('|')",
+                      20s))
+      << browser.evaluate("document.querySelector('#jobs-body').innerText").dump();
   // A drag as the browser delivers one: dragstart on a row, drop on another.
   const auto drag = [&](int job, int onto) {
     browser.evaluate(fmt::format(R"((() => {{

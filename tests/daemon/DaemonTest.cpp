@@ -94,9 +94,13 @@ TEST(Daemon, EachSheetAfterTheFirstWaitsForNextAndACutCanBePausedAndResumed) {
     ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
     EXPECT_EQ(job["sheet"], sheet - 1);
     EXPECT_EQ(state(job), "running");
-    // The operator is told what to load, and what the builders can do once it is cut.
+    // The operator is told what to load (the material, its thickness, the
+    // sheet's size), and what the builders can do once it is cut.
+    const std::string stock = job["summary"].value("stock", "");
+    EXPECT_TRUE(stock.starts_with("posterboard (0.8 mm), ")) << job.dump();
     const CommandResult status = daemon.client(fmt::format("status {}", id));
-    EXPECT_NE(status.out.find(fmt::format("waiting: load sheet {} (its kit: steps ", sheet)), std::string::npos)
+    EXPECT_NE(status.out.find(fmt::format("waiting: load sheet {}, {} (its kit: steps ", sheet, stock)),
+              std::string::npos)
         << status.out;
     // Nothing moves while it waits: a pause has nothing to hold.
     EXPECT_EQ(daemon.client(fmt::format("pause {}", id)).status, 1);
@@ -839,6 +843,11 @@ TEST(Daemon, AJobIsCutWithTheMaterialItWasMadeFor) {
     if (stroke["operation"] == "cut") cutPasses = std::max(cutPasses, stroke["pass"].get<int>());
   }
   EXPECT_EQ(cutPasses, 4) << "plywood-3mm's passes on grbl-diode-400";
+  EXPECT_EQ(ready["summary"]["material"], "plywood-3mm");
+  EXPECT_EQ(ready["summary"]["machine"], "grbl-diode-400");
+  const CommandResult status = daemon.client(fmt::format("status {}", id));
+  EXPECT_NE(status.out.find("  sheets of plywood-3mm (3 mm), 400 x 400 mm, cut on grbl-diode-400\n"), std::string::npos)
+      << status.out;
   ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
   const json done = daemon.waitForJob(id, [](const json& job) { return job["state"] == "done"; });
   ASSERT_EQ(done["state"], "done") << done.dump();
