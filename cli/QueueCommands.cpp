@@ -193,7 +193,8 @@ void printStatus(const json& job) {
   if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
   if (job.value("waiting_for_next", false)) {
     const int next = job.value("sheet", 0) + 1;
-    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, whatToLoad(job, next), job.value("id", 0));
+    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, whatToLoad(job, next),
+               job.value("id", 0));
   }
   fmt::print("  {}\n", job.value("message", ""));
   if (job.contains("transitions")) {
@@ -282,7 +283,8 @@ int follow(const DaemonClient& client, long long id) {
             }
           });
         } else {
-          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, whatToLoad(data, next), id);
+          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, whatToLoad(data, next),
+                     id);
         }
       }
       if (settled(data)) {
@@ -473,6 +475,7 @@ void addJobsCommand(CLI::App& app, int& status) {
   auto client = std::make_shared<ClientOptions>();
   CLI::App* jobs = app.add_subcommand("jobs", "List the daemon's jobs in queue order");
   addClientOptions(*jobs, *client);
+  jobs->footer("Examples:\n  rotafab jobs\n  rotafab jobs --json");
   jobs->callback([client, &status] {
     status = talking([&]() -> int {
       const json answer = clientOf(*client).get("/api/jobs");
@@ -495,6 +498,7 @@ void addStatusCommand(CLI::App& app, int& status) {
   statusVerb->add_flag("--follow", *follows,
                        "Show live progress until the job is done, fails, is cancelled or interrupted, or is planned");
   addClientOptions(*statusVerb, *client);
+  statusVerb->footer("Examples:\n  rotafab status 7\n  rotafab status 7 --follow");
   statusVerb->callback([client, job, follows, &status] {
     status = talking([&]() -> int {
       const long long id = jobNumber(*job);
@@ -518,6 +522,7 @@ void addJobActionCommand(CLI::App& app, int& status, const char* verb, const cha
   CLI::App* command = app.add_subcommand(verb, help);
   command->add_option("JOB", *job, "The job's number")->required();
   addClientOptions(*command, *client);
+  command->footer(fmt::format("Examples:\n  rotafab {} 7\n  rotafab {} 7 --json", verb, verb));
   const std::string name = verb;
   command->callback([client, job, name, &status] {
     status = talking([&]() -> int {
@@ -569,6 +574,7 @@ void addMoveCommand(CLI::App& app, int& status) {
   auto* beforeOption = move->add_option("--before", *before, "Put it just before this job (and at its priority)");
   move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
   addClientOptions(*move, *client);
+  move->footer("Examples:\n  rotafab move 9 --before 7\n  rotafab move 9 --priority 5");
   move->callback([client, job, before, priority, &status] {
     status = talking([&]() -> int {
       json body = json::object();

@@ -38,6 +38,34 @@ size_t editDistance(std::string_view a, std::string_view b) {
   return row[b.size()];
 }
 
+// The first option of `command` on the command line (after the command's
+// name) that it does not have, said with the nearest it has: "--panel is
+// not an option of make; did you mean --panels?". Empty when every option
+// is one of its own. Said before the parser, which would otherwise answer
+// "--structure is required" for "--sturcture band".
+std::string mistypedOption(const CLI::App& command, int argc, char** argv) {
+  std::vector<std::string> names;
+  for (const CLI::Option* option : command.get_options()) {
+    for (const std::string& name : option->get_lnames()) names.push_back("--" + name);
+  }
+  for (int i = 2; i < argc; ++i) {
+    const std::string_view word = argv[i];
+    if (word == "--") break;  // what follows is no option
+    if (!word.starts_with("--") || word.size() == 2) continue;
+    const std::string name(word.substr(0, word.find('=')));
+    if (std::find(names.begin(), names.end(), name) != names.end()) continue;
+    std::string nearest;
+    for (const std::string& candidate : names) {
+      if (nearest.empty() || editDistance(name, candidate) < editDistance(name, nearest)) nearest = candidate;
+    }
+    const std::string verb = command.get_name();
+    return !nearest.empty() && editDistance(name, nearest) <= 2
+               ? fmt::format("{} is not an option of {}; did you mean {}?", name, verb, nearest)
+               : fmt::format("{} is not an option of {} (`rotafab {} --help` lists them)", name, verb, verb);
+  }
+  return "";
+}
+
 // A usage error the parser would word as its own: one line, and where to read more.
 int usageError(const std::string& message, const std::string& help) {
   fmt::print(stderr, "error: {}\nRun `{}` for usage.\n", message, help);
@@ -53,9 +81,6 @@ int main(int argc, char** argv) {
   CLI::App app{"rotafab: turn a 3D mesh into numbered laser-cut panels (Xing 2011), and run the cutter"};
   app.set_version_flag("--version", "rotafab 0.1.0");
   app.require_subcommand(1);
-  app.footer(
-      "Run `rotafab COMMAND --help` for a command's options and examples.\n\nExample:\n  rotafab inspect "
-      "examples/bunny.obj");
   int status = kSuccess;
   addInspectCommand(app, status);
   addMakeCommand(app, status);
@@ -65,6 +90,10 @@ int main(int argc, char** argv) {
   addDevicesCommand(app, status);
   addRunCommand(app, status);
   addQueueCommands(app, status);
+  // (After the commands: a command made later would take this footer as its own.)
+  app.footer(
+      "Run `rotafab COMMAND --help` for a command's options and examples.\n\nExample:\n  rotafab inspect "
+      "examples/bunny.obj");
   // The command named, if it is one: usage errors point to its own --help.
   std::vector<std::string> verbs;
   for (const CLI::App* command : app.get_subcommands([](const CLI::App*) { return true; })) {
@@ -86,6 +115,11 @@ int main(int argc, char** argv) {
               ? fmt::format("{} is not a rotafab command; did you mean `rotafab {}`?", word, nearest)
               : fmt::format("{} is not a rotafab command (the commands: {})", word, fmt::join(verbs, ", ")),
           "rotafab --help");
+    }
+  }
+  if (!verb.empty()) {
+    if (const std::string typo = mistypedOption(*app.get_subcommand(verb), argc, argv); !typo.empty()) {
+      return usageError(typo, "rotafab " + verb + " --help");
     }
   }
   try {

@@ -137,9 +137,8 @@ Reply Service::Impl::resumeJob(const JobRecord& job, const json& arguments, cons
   }
   if (job.sheets == 0) refuse(job, "; it was never planned: submit it again");
   if (!arguments.contains("from_sheet") || !arguments["from_sheet"].is_number_integer()) {
-    throw ApiError(400, fmt::format("job {} stopped {}: say which sheet to go on from, with --from-sheet N "
-                                    "(from_sheet), once that sheet is loaded",
-                                    id, sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes)));
+    throw ApiError(400, fmt::format("job {} stopped {}: say which sheet to go on from, once that sheet is loaded", id,
+                                    sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes)));
   }
   const int from = arguments["from_sheet"].get<int>();
   startCut(job, from, fmt::format("resumed by {} from sheet {}", who, from));

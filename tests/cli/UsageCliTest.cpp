@@ -38,6 +38,15 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
               "--width is an option of the plain-woven structure (--structure weave), not of band",
               "rotafab make --help");
   // The parser's own errors point to the command's help, not the program's.
+  // A mistyped option: the nearest the command has, before anything the parser says.
+  expectUsage("make " + cube + " --panel 300", "--panel is not an option of make; did you mean --panels?",
+              "rotafab make --help");
+  expectUsage("make " + cube + " --sturcture band", "--sturcture is not an option of make; did you mean --structure?",
+              "rotafab make --help");
+  expectUsage("run x --devcie=sim:grbl", "--devcie is not an option of run; did you mean --device?",
+              "rotafab run --help");
+  expectUsage("status 3 --frobnicate", "--frobnicate is not an option of status (`rotafab status --help` lists them)",
+              "rotafab status --help");
   const CommandResult noTarget = run(kCli + " run");
   EXPECT_EQ(noTarget.status, 2);
   EXPECT_NE(noTarget.err.find("TARGET is required\nRun `rotafab run --help` for usage.\n"), std::string::npos)
@@ -45,4 +54,17 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
 }
 
 }  // namespace
+// Each command's --help ends with examples of that command, not of another.
+TEST(UsageCli, EachCommandsHelpShowsItsOwnExample) {
+  for (const char* verb : {"inspect", "make", "manifest", "nest", "profiles", "devices", "run", "submit", "jobs",
+                           "status", "cancel", "pause", "resume", "start", "next", "move", "dashboard"}) {
+    SCOPED_TRACE(verb);
+    const CommandResult help = run(kCli + " " + verb + " --help");
+    EXPECT_EQ(help.status, 0) << help.err;
+    const auto examples = help.out.rfind("Example");
+    ASSERT_NE(examples, std::string::npos) << help.out;
+    EXPECT_NE(help.out.find(std::string("rotafab ") + verb + " ", examples), std::string::npos) << help.out;
+  }
+}
+
 }  // namespace rotafab::test
