@@ -179,14 +179,21 @@ int runRun(const RunOptions& options) {
         }
         return cut(resolved, *job, command, std::move(stock), std::move(kits));
       }
-      if (job->toolpaths().size() > 1) {
-        // One file of several sheets would be cut back to back, onto one sheet.
-        throw UserError(fmt::format("{}: {} sheets: a dry run writes one sheet's job; give --sheet N", options.target,
-                                    job->toolpaths().size()));
-      }
       if (command.cancellation().cancelled()) {
         fmt::print(stderr, "run: stopped; nothing was written\n");
         return command.interruptedStatus();
+      }
+      if (job->toolpaths().size() > 1) {
+        // One file a sheet, cube.gcode -> cube-sheet-001.gcode, ...: one
+        // file of several sheets would be cut back to back, onto one sheet.
+        const std::filesystem::path out = options.out;
+        for (const std::string& written : job->writeDryRunOfEachSheet([&](int sheet) {
+               return out.parent_path() /
+                      fmt::format("{}-sheet-{:03}{}", out.stem().string(), sheet, out.extension().string());
+             })) {
+          fmt::print("{}\n", written);
+        }
+        return kSuccess;
       }
       fmt::print("{}: {}\n", options.out, job->writeDryRun(options.out));
       return kSuccess;
@@ -208,16 +215,19 @@ void addRunCommand(CLI::App& app, int& status) {
   auto options = std::make_shared<RunOptions>();
   CLI::App* run = app.add_subcommand("run", "Drive a cutter directly: cut the sheets of a `make` output");
   run->add_option("TARGET", options->target, "An output folder of `rotafab make`, or one sheet's .svg")->required();
-  run->add_option("--device", options->device,
-                  "Device URI (default: the connection of the job's machine profile): grbl:///dev/ttyUSB0?baud=115200, "
-                  "grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
-                  "sim:grbl?speed=50 moves 50 times faster), m2nano://usb/1a86:5512 (a K40's M2 Nano board), "
-                  "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
+  run->add_option(
+      "--device", options->device,
+      "Device URI (default: the connection of the job's machine profile): grbl:///dev/ttyUSB0?baud=115200, "
+      "grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
+      "50 times faster than the machine by default; ?speed=1 for real time), m2nano://usb/1a86:5512 (a K40's M2 "
+      "Nano board), "
+      "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
   run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
   run->add_option("--out", options->out,
-                  "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool)");
+                  "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool); "
+                  "of several sheets, one file each beside it: --out cube.gcode writes cube-sheet-001.gcode, ...");
   run->add_option("--machine", options->machine,
                   "Machine profile (default: the job's, from its manifest; where --device's driver drives another, "
                   "the first that driver drives)");

@@ -1,5 +1,7 @@
 #include "devices/JobRun.h"
 
+#include <fmt/format.h>
+
 #include "toolpath/AtomicFile.h"
 
 namespace rotafab::devices {
@@ -43,6 +45,18 @@ JobRun::~JobRun() {
 std::string JobRun::writeDryRun(const std::filesystem::path& file) const {
   jobs::writeFileAtomically(file, device_->program(toolpaths_));
   return device_->describeProgram(toolpaths_);
+}
+
+std::vector<std::string> JobRun::writeDryRunOfEachSheet(
+    const std::function<std::filesystem::path(int sheet)>& fileOf) const {
+  std::vector<std::string> written;
+  for (const jobs::Toolpath& toolpath : toolpaths_) {
+    const std::vector<jobs::Toolpath> one{toolpath};
+    const std::filesystem::path file = fileOf(toolpath.sheet);
+    jobs::writeFileAtomically(file, device_->program(one));
+    written.push_back(fmt::format("{}: {}", file.string(), device_->describeProgram(one)));
+  }
+  return written;
 }
 
 RunSummary JobRun::run(bool frame, const RunEvents& events, const core::Cancellation& cancel) {

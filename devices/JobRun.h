@@ -70,6 +70,10 @@ class JobRun {
   // Writes exactly the bytes the device would be sent, atomically; returns
   // what they are ("G-code for 1 sheet (108 strokes), as the driver would send it").
   std::string writeDryRun(const std::filesystem::path& file) const;
+  // The same, one file for each sheet (`fileOf(sheet number)`), each the
+  // program of that sheet alone: a file of several sheets would be cut back
+  // to back, onto one. Returns what each holds, in the sheets' order.
+  std::vector<std::string> writeDryRunOfEachSheet(const std::function<std::filesystem::path(int sheet)>& fileOf) const;
 
   // Runs every sheet, each framed first if asked. Throws DeviceFault: the
   // driver has stopped the machine and says whether the controller

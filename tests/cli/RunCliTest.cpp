@@ -140,6 +140,42 @@ TEST(RunCli, AJobIsCutWithTheMachineAndMaterialItWasMadeFor) {
   EXPECT_NE(onGrbl.err.find("machine: grbl-diode-400 instead of k40-m2nano"), std::string::npos) << onGrbl.err;
 }
 
+// A dry run of a folder of several sheets writes every sheet, one file
+// each (one file of several would be cut back to back, onto one sheet).
+TEST(RunCli, ADryRunOfSeveralSheetsWritesOneFileEach) {
+  TempDir dir;
+  const auto job = dir.path() / "ball";
+  const CommandResult made = run(kCli + " make " + quoted(kSource / "examples/soccer-ball.obj") +
+                                 " --structure band --machine grbl-diode-400 --time 0 --out " + quoted(job));
+  ASSERT_EQ(made.status, 0) << made.err;
+  const size_t sheets = nlohmann::json::parse(readFile(job / "manifest.json")).at("sheets").size();
+  ASSERT_GT(sheets, 1u);
+  const CommandResult r =
+      run(kCli + " run " + quoted(job) + " --device sim:grbl --dry-run --out " + quoted(dir.path() / "ball.gcode"));
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "ball.gcode"));
+  for (size_t s = 1; s <= sheets; ++s) {
+    const auto file = dir.path() / fmt::format("ball-sheet-{:03}.gcode", s);
+    EXPECT_NE(r.out.find(file.string() + ": G-code for 1 sheet ("), std::string::npos) << r.out;
+    const std::string gcode = readFile(file);
+    EXPECT_TRUE(gcode.starts_with("G21\n")) << file;
+    EXPECT_NE(gcode.find("\nM5 S0\n"), std::string::npos) << file << ": the laser off at its end";
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / fmt::format("ball-sheet-{:03}.gcode", sheets + 1)));
+}
+
+// A simulator runs fast unless asked for real time, and says the time the
+// machine it stands for would take.
+TEST(RunCli, TheSimulatorRunsFastByDefaultAndSaysTheMachinesTime) {
+  const CommandResult r = run(kCli + " run " + quoted(k40Job()) + " --sheet 1 --device sim:m2nano");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::smatch said;
+  ASSERT_TRUE(std::regex_search(r.err, said, std::regex(R"(about (\d+)s \((\d+)m (\d+)s on the machine simulated\))")))
+      << r.err;
+  const double machine = std::stoi(said[2].str()) * 60 + std::stoi(said[3].str());
+  EXPECT_NEAR(machine / 50, std::stoi(said[1].str()), 1.0) << "50 times faster than the machine (seconds rounded)";
+}
+
 TEST(RunCli, DryRunWritesTheGCodeTheDriverSends) {
   TempDir dir;
   const auto file = dir.path() / "cube.gcode";
@@ -222,8 +258,9 @@ void interruptMidJob(const std::filesystem::path& job, const std::string& device
 }
 
 TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
-  interruptMidJob(cubeJob(), "sim:grbl");
-  interruptMidJob(k40Job(), "sim:m2nano");
+  // (In real time: a fast simulator may have ended the sheet before the signal.)
+  interruptMidJob(cubeJob(), "'sim:grbl?speed=1'");
+  interruptMidJob(k40Job(), "'sim:m2nano?speed=1'");
 }
 
 TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {
