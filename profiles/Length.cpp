@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <string>
@@ -9,20 +10,31 @@
 #include "core/UserError.h"
 
 namespace rotafab::profiles {
+namespace {
+
+// The units a length may be written in, and how many of each make an inch
+// ("mm" before "m": the first whose name ends the text is its unit).
+constexpr std::array<std::pair<std::string_view, double>, 5> kUnits{
+    {{"mm", 25.4}, {"cm", 2.54}, {"in", 1.0}, {"ft", 1.0 / 12}, {"m", 0.0254}}};
+
+// The unit a length ends with, or empty.
+std::string_view unitOf(std::string_view text) {
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
+  for (const auto& [unit, perInch] : kUnits) {
+    if (text.size() > unit.size() && text.ends_with(unit)) return unit;
+  }
+  return {};
+}
+
+}  // namespace
 
 std::optional<double> parseLength(std::string_view text) {
   while (!text.empty() && text.front() == ' ') text.remove_prefix(1);
   while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
-  double inchesPerUnit = 1.0;
-  for (auto [suffix, factor] : {std::pair{"in", 1.0}, {"mm", 1.0 / 25.4}, {"cm", 1.0 / 2.54}}) {
-    const std::string_view unit(suffix);
-    if (text.size() > unit.size() && text.substr(text.size() - unit.size()) == unit) {
-      text.remove_suffix(unit.size());
-      while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
-      inchesPerUnit = factor;
-      break;
-    }
-  }
+  const std::string_view unit = unitOf(text);
+  const double inchesPerUnit = 1.0 / unitsPerInch(unit.empty() ? "in" : unit);
+  text.remove_suffix(unit.size());
+  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
   if (!text.empty() && text.front() == '+') text.remove_prefix(1);
   double value = 0;
   auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
@@ -35,31 +47,23 @@ std::optional<double> parseLength(std::string_view text) {
 double lengthOption(const std::string& text, std::string_view flag, bool positive) {
   const auto value = parseLength(text);
   if (!value || *value < 0 || (positive && !(*value > 0))) {
-    throw core::UserError(fmt::format("{} {}: expected a {}length such as 0.125in, 3.2mm or 0.32cm", flag, text,
-                                      positive ? "positive " : ""));
+    throw core::UserError(fmt::format("{} {}: expected a {}length such as 0.125in, 3.2mm, 0.32cm, 2ft or 1.2m", flag,
+                                      text, positive ? "positive " : ""));
   }
   return *value;
 }
-
-namespace {
-
-// The unit a length ends with ("in", "mm", "cm"), or empty.
-std::string_view unitOf(std::string_view text) {
-  while (!text.empty() && text.back() == ' ') text.remove_suffix(1);
-  for (std::string_view unit : {"in", "mm", "cm"}) {
-    if (text.size() > unit.size() && text.ends_with(unit)) return unit;
-  }
-  return {};
-}
-
-}  // namespace
 
 std::string_view writtenUnit(std::string_view text) {
   const std::string_view unit = unitOf(text);
   return unit.empty() ? "in" : unit;
 }
 
-double unitsPerInch(std::string_view unit) { return unit == "mm" ? 25.4 : unit == "cm" ? 2.54 : 1.0; }
+double unitsPerInch(std::string_view unit) {
+  for (const auto& [name, perInch] : kUnits) {
+    if (name == unit) return perInch;
+  }
+  return 1.0;
+}
 
 std::string formatLength(double inches, std::string_view unit) {
   return fmt::format("{:.4g} {}", inches * unitsPerInch(unit), unit);

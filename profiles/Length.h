@@ -16,16 +16,16 @@ std::optional<double> parseLength(std::string_view text);
 
 // A length option's value in inches (`flag`, "--kerf", names it in the
 // message); zero allowed unless `positive`. Throws core::UserError: "--kerf
-// 2furlongs: expected a length such as 0.125in, 3.2mm or 0.32cm".
+// 2furlongs: expected a length such as 0.125in, 3.2mm, 0.32cm, 2ft or 1.2m".
 double lengthOption(const std::string& text, std::string_view flag, bool positive = false);
 
-// The unit a length is written in: "in", "mm" or "cm" ("in" for a bare number).
+// The unit a length is written in: "in", "mm", "cm", "ft" or "m" ("in" for a bare number).
 std::string_view writtenUnit(std::string_view text);
 
 // `inches` in `unit` for people, to 4 significant digits: "400 mm", "0.125 in".
 std::string formatLength(double inches, std::string_view unit);
 
-// Millimetres or centimetres per inch, or 1 for inches.
+// The unit's count per inch (25.4 for "mm"), or 1 for inches or an unknown unit.
 double unitsPerInch(std::string_view unit);
 
 // A size WIDTHxHEIGHT (docs/CONTRACT.md, "Units and scale": a unit written once

@@ -23,7 +23,13 @@ TEST(Length, UnitsAndBareInches) {
   EXPECT_DOUBLE_EQ(*parseLength("0.25"), 0.25);
   EXPECT_DOUBLE_EQ(*parseLength(" 3 mm "), 3 / 25.4);
   EXPECT_DOUBLE_EQ(*parseLength("-1in"), -1.0);
-  for (const char* bad : {"", "in", "wide", "3ft", "1e999in", "nan", "3 in in", "0x10"}) {
+  EXPECT_DOUBLE_EQ(*parseLength("2ft"), 24.0);
+  EXPECT_DOUBLE_EQ(*parseLength("1.27m"), 50.0);
+  EXPECT_DOUBLE_EQ(*parseLength("0.5 m"), 0.5 / 0.0254);
+  EXPECT_EQ(writtenUnit("2ft"), "ft");
+  EXPECT_EQ(writtenUnit("3mm"), "mm");
+  EXPECT_EQ(formatLength(24.0, "ft"), "2 ft");
+  for (const char* bad : {"", "in", "m", "wide", "3furlongs", "3yd", "1e999in", "nan", "3 in in", "0x10", "3 mm m"}) {
     EXPECT_FALSE(parseLength(bad).has_value()) << bad;
   }
 }
@@ -43,7 +49,8 @@ TEST(Length, SizesTakeOneUnitForBothOrOneEach) {
   expectSize("32inx18in", 32, 18);
   expectSize("81.28cmx18in", 32, 18);
   expectSize("32x45.72cm", 32 / 2.54, 18);
-  for (const char* bad : {"", "32", "32x", "x18", "32x18x2", "32inx18", "32 by 18", "axb", "32x18ft"}) {
+  expectSize("2.5x1.5ft", 30, 18);
+  for (const char* bad : {"", "32", "32x", "x18", "32x18x2", "32inx18", "32 by 18", "axb", "32x18yd"}) {
     EXPECT_FALSE(parseSize(bad).has_value()) << bad;
   }
 }
