@@ -15,7 +15,7 @@ namespace {
 
 struct ProfilesOptions {
   bool json = false;
-  std::vector<std::string> files;
+  std::vector<std::string> files, checks;  // FILE..., --check FILE: the same
 };
 
 // A file given on the command line is checked as the kind it declares.
@@ -92,6 +92,7 @@ void addProfilesCommand(CLI::App& app, int& status) {
   auto options = std::make_shared<ProfilesOptions>();
   CLI::App* command = app.add_subcommand("profiles", "List the machine and material profiles, or check profile files");
   command->add_option("FILE", options->files, "Profile files to check instead of listing the search path");
+  command->add_option("--check", options->checks, "A profile file to check (as FILE); may be given more than once");
   command->add_flag("--json", options->json, "Print one JSON object: {\"machines\": [...], \"materials\": [...]}");
   command->footer(
       "Profiles are YAML files in machines/ and materials/ under each folder of the search path, first match wins:\n"
@@ -100,8 +101,12 @@ void addProfilesCommand(CLI::App& app, int& status) {
       "An invalid profile is reported as FILE:LINE:COL: key: what is wrong, and the exit status is 1.\n\n"
       "Examples:\n"
       "  rotafab profiles\n"
-      "  rotafab profiles ~/.config/rotafab/profiles/machines/my-laser.yaml");
-  command->callback([options, &status] { status = runProfiles(*options); });
+      "  rotafab profiles --check ~/.config/rotafab/profiles/machines/my-laser.yaml\n\n"
+      "Every key, its unit and its default: docs/profiles.md.");
+  command->callback([options, &status] {
+    options->files.insert(options->files.end(), options->checks.begin(), options->checks.end());
+    status = runProfiles(*options);
+  });
 }
 
 }  // namespace rotafab::cli

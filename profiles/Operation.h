@@ -20,6 +20,8 @@ inline constexpr std::array<Operation, 4> kAllOperations{Operation::Cut, Operati
 // "cut", "score", "etch", "outline".
 std::string_view operationName(Operation operation);
 std::optional<Operation> operationNamed(std::string_view name);
+// What the operation does, for people: "scores fold lines".
+std::string_view operationPurpose(Operation operation);
 
 struct Rgb {
   uint8_t r = 0, g = 0, b = 0;

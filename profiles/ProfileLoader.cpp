@@ -45,6 +45,10 @@ void checkConnection(const ProfileReader& reader, const YAML::Node& node, const 
       fmt::format("'{}' is not a {} device URI (expected {})", uri, driver, fmt::join(schemes.at(driver), " or ")));
 }
 
+// The largest bed side read as inches without a unit (a 2.5 m machine):
+// "bed: {width: 400}" is far more likely millimetres.
+constexpr double kMostBareBedInches = 100.0;
+
 }  // namespace
 
 const ColourSetting& MachineProfile::settingFor(Operation operation) const {
@@ -67,10 +71,10 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
 
   const YAML::Node bed = root["bed"];
   reader.keys(bed, "bed", {"width", "height", "margin"}, {"width", "height"});
-  machine.bed.width = reader.length(bed["width"], "bed.width", 0.0, false);
+  machine.bed.width = reader.length(bed["width"], "bed.width", 0.0, false, kMostBareBedInches);
   machine.bed.unit = writtenUnit(bed["width"].Scalar());
-  machine.bed.height = reader.length(bed["height"], "bed.height", 0.0, false);
-  if (bed["margin"]) machine.bed.margin = reader.length(bed["margin"], "bed.margin", 0.0, true);
+  machine.bed.height = reader.length(bed["height"], "bed.height", 0.0, false, kMostBareBedInches);
+  if (bed["margin"]) machine.bed.margin = reader.length(bed["margin"], "bed.margin", 0.0, true, 4.0);
   if (2 * machine.bed.margin >= std::min(machine.bed.width, machine.bed.height)) {
     reader.fail(bed, "bed",
                 fmt::format("margins of {}in on every side leave no usable area on a {} x {} in bed",
@@ -83,7 +87,7 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
     m.maxSpeed = reader.rate(motion["speed"], "motion.speed", 1);
     m.acceleration = reader.rate(motion["acceleration"], "motion.acceleration", 2);
     if (motion["junction_deviation"]) {
-      m.junctionDeviation = reader.length(motion["junction_deviation"], "motion.junction_deviation", 0.0, true);
+      m.junctionDeviation = reader.length(motion["junction_deviation"], "motion.junction_deviation", 0.0, true, 0.5);
     }
     machine.motion = m;
   }
@@ -149,8 +153,15 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
     const std::string colour = given ? reader.text(given, key) : defaults.at(operation);
     const YAML::Node at = given ? given : (operations ? operations : root);
     if (!hasColour(colour)) {
-      reader.fail(at, key,
-                  fmt::format("{}colour '{}' is not in the colour table", given ? "" : "the default ", colour));
+      std::vector<std::string> table;
+      for (const ColourSetting& c : machine.colours) table.push_back(c.name);
+      // (Not given: say the key that is missing, not a colour the user never wrote.)
+      reader.fail(
+          at, given ? key : "operations",
+          given ? fmt::format("colour '{}' is not in the colour table ({})", colour, fmt::join(table, ", "))
+                : fmt::format("{} is missing: give the colour of the table that {} ({}); its default, {}, is "
+                              "not in the table",
+                              operationName(operation), operationPurpose(operation), fmt::join(table, ", "), colour));
     }
     for (const auto& [other, otherColour] : machine.operationColour) {
       if (otherColour == colour) {
@@ -176,14 +187,14 @@ MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
   material.source = file;
   material.name = reader.text(root["name"], "name");
   if (root["description"]) material.description = reader.text(root["description"], "description");
-  material.thickness = reader.length(root["thickness"], "thickness", 0.0, false);
+  material.thickness = reader.length(root["thickness"], "thickness", 0.0, false, 2.0);
   material.units.thickness = writtenUnit(root["thickness"].Scalar());
-  material.kerf = reader.length(root["kerf"], "kerf", 0.0, true);
+  material.kerf = reader.length(root["kerf"], "kerf", 0.0, true, 0.25);
   if (material.kerf >= 0.25)
     reader.fail(root["kerf"], "kerf", "must be under 0.25in: a laser cut is a few thousandths wide");
   material.units.kerf = writtenUnit(root["kerf"].Scalar());
   if (root["fastener"]) {
-    material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false);
+    material.fastenerDiameter = reader.length(root["fastener"], "fastener", 0.0, false, 2.0);
     material.units.fastener = writtenUnit(root["fastener"].Scalar());
   }
   // Grams per square metre, as board and paper are sold (posterboard about

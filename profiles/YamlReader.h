@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
+#include <cctype>
 
 #include <algorithm>
 #include <cmath>
@@ -97,6 +98,12 @@ class YamlReader {
     return value;
   }
 
+  // Whether a length is written without its unit.
+  static bool isBareNumber(std::string text) {
+    while (!text.empty() && text.back() == ' ') text.pop_back();
+    return !text.empty() && (std::isdigit(static_cast<unsigned char>(text.back())) != 0 || text.back() == '.');
+  }
+
   bool boolean(const YAML::Node& node, const std::string& key) const {
     bool value = false;
     if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
@@ -106,13 +113,21 @@ class YamlReader {
     return value;
   }
 
-  // A length: 0.25in, 6.35mm, 0.635cm or a bare number of inches; must exceed `low`.
-  double length(const YAML::Node& node, const std::string& key, double low, bool inclusive) const {
+  // A length: 0.25in, 6.35mm, 0.635cm, 2ft, 1.2m or a bare number of
+  // inches; must exceed `low`. A bare number above `mostBareInches` is
+  // refused: more likely millimetres than inches ("bed.width: 400 without a
+  // unit").
+  double length(const YAML::Node& node, const std::string& key, double low, bool inclusive,
+                double mostBareInches) const {
     const auto value = node.IsScalar() ? parseLength(node.Scalar()) : std::nullopt;
     if (!value) {
       fail(node, key,
            fmt::format("expected a length such as 0.25in, 6.35mm or 0.635cm, found '{}'",
                        node.IsScalar() ? node.Scalar() : "a list or map"));
+    }
+    if (std::string text = node.Scalar(); *value > mostBareInches && isBareNumber(text)) {
+      fail(node, key,
+           fmt::format("{} without a unit, which would be {} inches; write {}mm or {}in", text, text, text, text));
     }
     if (inclusive ? *value < low : *value <= low) {
       fail(node, key, fmt::format("must be {} {}in, not {}", inclusive ? "at least" : "more than", low, node.Scalar()));

@@ -153,7 +153,13 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
       {"colour defined twice", replaced(good, "  red: {rgb: [255, 0, 0]}", "  blue: {rgb: [255, 0, 0]}"),
        "p.yaml:8:3: colours.blue: given twice"},
       {"unknown colour", replaced(good, "etch: yellow", "etch: purple"),
-       "p.yaml:11:43: operations.etch: colour 'purple' is not in the colour table"},
+       "p.yaml:11:43: operations.etch: colour 'purple' is not in the colour table (blue, red, yellow, green)"},
+      // Not given: the key that is missing, not a colour the user never wrote.
+      {"operation left out", replaced(replaced(good, ", outline: green", ""), "  green: {rgb: [0, 255, 0]}\n", ""),
+       "p.yaml:10:13: operations: outline is missing: give the colour of the table that draws the material's edge "
+       "(never burnt) (blue, red, yellow); its default, green, is not in the table"},
+      {"a bed in millimetres without the unit", replaced(good, "width: 32in, height: 18in", "width: 400, height: 430"),
+       "p.yaml:3:14: bed.width: 400 without a unit, which would be 400 inches; write 400mm or 400in"},
       {"rgb out of range", replaced(good, "rgb: [255, 0, 0]", "rgb: [256, 0, 0]"),
        "p.yaml:8:15: colours.red.rgb[0]: must be between 0 and 255, not 256"},
       {"missing bed", replaced(good, "bed: {width: 32in, height: 18in, margin: 0.25in}\n", ""),
@@ -198,6 +204,10 @@ TEST(Profiles, EveryInvalidMaterialIsRefusedWithItsPlace) {
             "p.yaml:4:7: kerf: must be at least 0in, not -0.1mm");
   EXPECT_EQ(refusal(replaced(good, "thickness: 1.5mm", "thickness: 0"), true),
             "p.yaml:3:12: thickness: must be more than 0in, not 0");
+  EXPECT_EQ(refusal(replaced(good, "thickness: 1.5mm", "thickness: 3"), true),
+            "p.yaml:3:12: thickness: 3 without a unit, which would be 3 inches; write 3mm or 3in");
+  EXPECT_EQ(refusal(replaced(good, "thickness: 1.5mm", "thickness: 0.125"), true), "(accepted)")
+      << "a bare number of inches that reads as one";
   EXPECT_EQ(refusal(replaced(good, "{cut: {power", "{slice: {power"), true),
             "p.yaml:6:20: machines.workshop-32x18.slice: unknown key (expected one of: cut, score, etch, outline)");
   EXPECT_EQ(refusal(replaced(good, "speed: 40", "speed: 0"), true),
