@@ -19,6 +19,14 @@ TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
                              ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
                              "connection, colours, operations, motion, formats)\n");
   EXPECT_EQ(refused.out, "") << "nothing on standard output before, or instead of, the error";
+  // --check FILE is the same; a bed in millimetres without its unit is named with the fix.
+  const auto metric =
+      dir.write("metric.yaml", replaced(kGoodMachine, "width: 32in, height: 18in", "width: 400, height: 430"));
+  const CommandResult unitless = run(std::string(ROTAFAB_CLI) + " profiles --check " + metric.string());
+  EXPECT_EQ(unitless.status, 1);
+  EXPECT_EQ(unitless.err,
+            "error: " + metric.string() +
+                ":3:14: bed.width: 400 without a unit, which would be 400 inches; write 400mm or 400in\n");
   const CommandResult accepted = run(std::string(ROTAFAB_CLI) + " profiles --json " + good.string());
   EXPECT_EQ(accepted.status, 0) << accepted.err;
   EXPECT_NE(accepted.out.find(R"("name":"test")"), std::string::npos) << accepted.out;
