@@ -162,6 +162,19 @@ std::string progressLine(const json& progress) {
   return line;
 }
 
+// A job's message with the command that goes on from it, for the command
+// line (the daemon's messages are in its own words, which the page shows
+// beside its buttons): "planned: 3 sheets; start it with
+// `rotafab start 7`".
+std::string withCommand(const json& job, long long id) {
+  const std::string message = job.value("message", ""), state = job.value("state", "");
+  if (state == "ready") return message + fmt::format("; start it with `rotafab start {}`", id);
+  if ((state == "interrupted" || state == "failed") && job.value("sheets", 0) > 0) {
+    return message + fmt::format(" (`rotafab resume {} --from-sheet {}`)", id, std::max(1, job.value("sheet", 0)));
+  }
+  return message;
+}
+
 void printStatus(const json& job) {
   const std::string device = job["device"].is_string() ? job["device"].get<std::string>() : "any device that fits";
   fmt::print("job {}: {} ({}), {}\n", job.value("id", 0), job.value("source", ""), job.value("kind", ""),
@@ -196,7 +209,7 @@ void printStatus(const json& job) {
     fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, whatToLoad(job, next),
                job.value("id", 0));
   }
-  fmt::print("  {}\n", job.value("message", ""));
+  fmt::print("  {}\n", withCommand(job, job.value("id", 0LL)));
   if (job.contains("transitions")) {
     fmt::print("  history:\n");
     for (const json& t : job["transitions"]) {
@@ -264,7 +277,7 @@ int follow(const DaemonClient& client, long long id) {
       const int next = data.value("sheet", 0) + 1;
       if (state != lastState) {
         endBar();
-        fmt::print(stderr, "job {}: {}: {}\n", id, state, data.value("message", ""));
+        fmt::print(stderr, "job {}: {}: {}\n", id, state, withCommand(data, id));
         lastState = state;
       }
       if (waiting && askedFor != next) {
@@ -335,7 +348,7 @@ void printAnswer(const json& answer, const std::string& action, bool asJson) {
     fmt::print("job {}: stopping (`rotafab status {}` says when it has)\n", answer.value("id", 0),
                answer.value("id", 0));
   } else {
-    fmt::print("job {}: {}: {}\n", answer.value("id", 0), state, answer.value("message", ""));
+    fmt::print("job {}: {}: {}\n", answer.value("id", 0), state, withCommand(answer, answer.value("id", 0LL)));
   }
 }
 
@@ -429,7 +442,8 @@ int submitJob(const ClientOptions& client, const MakeOptions& make, const std::s
   // A planned folder is checked as it is submitted: its job is ready at once.
   if (settled(job)) {
     if (!make.json)
-      fmt::print("job {}: {}: {}\n", job.value("id", 0), job.value("state", ""), job.value("message", ""));
+      fmt::print("job {}: {}: {}\n", job.value("id", 0), job.value("state", ""),
+                 withCommand(job, job.value("id", 0LL)));
     return kSuccess;
   }
   if (follows) return follow(daemon, job.value("id", 0LL));
@@ -556,9 +570,16 @@ void addResumeCommand(CLI::App& app, int& status) {
     status = talking([&]() -> int {
       json body = json::object();
       if (*fromSheet) body["from_sheet"] = **fromSheet;
-      printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
-                                                  kDeviceCheckPatience, saysWaiting),
-                  "resume", client->json);
+      try {
+        printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
+                                                    kDeviceCheckPatience, saysWaiting),
+                    "resume", client->json);
+      } catch (const DaemonRefused& refused) {
+        // The daemon asks for the sheet in its own words; here, the option that gives it.
+        if (*fromSheet || std::string_view(refused.what()).find("say which sheet to go on from") == std::string::npos)
+          throw;
+        throw UserError(fmt::format("{}: give it with --from-sheet N", refused.what()));
+      }
       return kSuccess;
     });
   });

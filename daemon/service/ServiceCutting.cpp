@@ -264,10 +264,10 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
       if (fault->kind == devices::FaultKind::Cancelled && cut->control->shutdown) {
         const std::string stopped = cut->stoppedBecause.empty() ? std::string("the daemon stopped")
                                                                 : cut->stoppedBecause + ": the daemon stopped the cut";
-        ended = record(
-            id, JobState::Interrupted,
-            fmt::format("{} {}; {}; go on with `rotafab resume {} --from-sheet {}`", stopped, where, laser, id, goOn),
-            change, true);
+        ended =
+            record(id, JobState::Interrupted,
+                   fmt::format("{} {}; {}; to go on, load sheet {} and resume from it", stopped, where, laser, goOn),
+                   change, true);
       } else if (fault->kind == devices::FaultKind::Cancelled) {
         ended = record(
             id, JobState::Cancelled,
@@ -276,11 +276,11 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
       } else {
         device.state = "fault";
         device.message = fault->what();
-        ended = record(
-            id, JobState::Failed,
-            fmt::format("{} ({}; stopped {}; {}); to go on once it is fixed: `rotafab resume {} --from-sheet {}`",
-                        fault->what(), devices::faultName(fault->kind), where, laser, id, goOn),
-            change, true);
+        ended =
+            record(id, JobState::Failed,
+                   fmt::format("{} ({}; stopped {}; {}); to go on once it is fixed, load sheet {} and resume from it",
+                               fault->what(), devices::faultName(fault->kind), where, laser, goOn),
+                   change, true);
       }
     }
     log->info("job {}: {}: {}", id, stateName(ended.state), ended.message);

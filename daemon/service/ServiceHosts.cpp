@@ -85,11 +85,9 @@ void Service::Impl::open() {
 
 std::pair<JobState, std::string> Service::Impl::released(const JobRecord& job, const std::string& who) {
   if (holdsDevice(job.state)) {
-    return {
-        JobState::Interrupted,
-        fmt::format("{} stopped while it cut, {}; check the machine and the sheet, then go on with `rotafab "
-                    "resume {} --from-sheet {}`",
-                    who, sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes), job.id, std::max(1, job.sheet))};
+    return {JobState::Interrupted,
+            fmt::format("{} stopped while it cut, {}; check the machine, then load sheet {} and resume from it", who,
+                        sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes), std::max(1, job.sheet))};
   }
   return {JobState::Queued, fmt::format("{} stopped while it planned; it is planned again", who)};
 }

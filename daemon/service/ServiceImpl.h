@@ -336,7 +336,7 @@ struct Service::Impl {
 
   static std::string planningReason(const Target& device);
 
-  static std::string plannedReason(int sheets, JobId id);
+  static std::string plannedReason(int sheets);
 
   // A planned folder's plan: its sheets read and checked against the bed
   // they are to be cut on; the summary the queue shows, from its manifest.

@@ -192,8 +192,9 @@ std::string Service::Impl::planningReason(const Target& device) {
   return fmt::format("planning against {} ({})", device.name, device.machine.name);
 }
 
-std::string Service::Impl::plannedReason(int sheets, JobId id) {
-  return fmt::format("planned: {} sheet{}; start it with `rotafab start {}`", sheets, sheets == 1 ? "" : "s", id);
+std::string Service::Impl::plannedReason(int sheets) {
+  // (In the daemon's own words: `rotafab status` adds the command, the page its Start button.)
+  return fmt::format("planned: {} sheet{}", sheets, sheets == 1 ? "" : "s");
 }
 
 json Service::Impl::planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine,
@@ -236,7 +237,7 @@ void Service::Impl::planOnSubmission(NewJob& job, const fs::path& folder, const 
   job.change.sheets = sheets;
   job.change.summary = summary.dump();
   job.then = {{JobState::Planning, [reason = planningReason(*device)](JobId) { return reason; }},
-              {JobState::Ready, [sheets](JobId id) { return plannedReason(sheets, id); }}};
+              {JobState::Ready, [sheets](JobId) { return plannedReason(sheets); }}};
 }
 
 void Service::Impl::startPlanning(const JobRecord& job, const Target& device) {
@@ -381,7 +382,7 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
         JobChange change;
         change.sheets = sheets;
         change.summary = summary.dump();
-        const JobRecord ready = record(id, JobState::Ready, plannedReason(sheets, id), change, true);
+        const JobRecord ready = record(id, JobState::Ready, plannedReason(sheets), change, true);
         log->info("job {}: planned, {} sheets", id, sheets);
         jobChanged(ready);
       }

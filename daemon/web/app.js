@@ -12,7 +12,7 @@ import { attempt, session, signedOut } from './api.js';
 import { listen } from './events.js';
 import './guide.js';
 import { refreshDevices } from './machines.js';
-import { refreshJobs } from './queue.js';
+import { refreshJobs, renderJobs } from './queue.js';
 import './sheets.js';
 import { state } from './state.js';
 import './submit.js';
@@ -25,6 +25,7 @@ if (!session()) {
 } else {
   attempt(async () => {
     await Promise.all([refreshDevices(), refreshJobs()]);
+    renderJobs();  // (with the devices known: no Start for one that cannot cut)
     listen();
     // What the other hosts do (their devices, the jobs they cut) comes with no event here: looked at again every few seconds.
     setInterval(() => {

@@ -71,5 +71,6 @@ export function listen() {
     if (known >= 0) state.devices[known] = device;
     else state.devices.push(device);
     renderDevices();
+    renderJobs();  // what a job's row offers depends on its device's state
   });
 }

@@ -36,9 +36,17 @@ function actionsOf(job) {
         await refreshJobs();
       }),
     }, label));
+  // A device that cannot cut now (offline, gone, in a fault): no Start, but why.
+  const device = state.devices.find((d) => d.name === job.device);
+  const unable = device && ['offline', 'gone', 'fault'].includes(device.state) ? device : null;
   switch (job.state) {
     case 'ready':
-      act('Start', 'start', {}, { class: 'primary' });
+      if (unable) {
+        buttons.push(element('span', { class: 'unable' },
+          `${unable.name} is ${unable.state}${unable.message ? `: ${unable.message}` : ''}`));
+      } else {
+        act('Start', 'start', {}, { class: 'primary' });
+      }
       break;
     case 'running':
       if (job.waiting_for_next) act('Next sheet loaded', 'next', {}, { class: 'primary' });

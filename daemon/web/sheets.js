@@ -37,20 +37,18 @@ async function drawSheet(jobId, sheet) {
   svg.setAttribute('data-job', jobId);
   svg.setAttribute('data-sheet', sheet);
   const bed = document.createElementNS(svgNS, 'rect');
-  Object.entries({ x: 0, y: 0, width: path.width, height: path.height, fill: '#fbfaf7', stroke: '#999', 'stroke-width': 0.02 })
+  Object.entries({ x: 0, y: 0, width: path.width, height: path.height, fill: kSheetColour, stroke: '#999', 'stroke-width': 0.02 })
     .forEach(([k, v]) => bed.setAttribute(k, v));
   svg.append(bed);
   // Sheet coordinates have y up.
   const flip = document.createElementNS(svgNS, 'g');
   flip.setAttribute('transform', `translate(0 ${path.height}) scale(1 -1)`);
-  // A group per operation (the strokes come operation by operation), so
-  // that a pale colour can be edged as a whole.
+  // A group per operation (the strokes come operation by operation).
   const groups = new Map();
   const groupOf = (operation) => {
     if (!groups.has(operation)) {
       const group = document.createElementNS(svgNS, 'g');
       group.setAttribute('data-operation', operation);
-      if (pale(path.colours[operation] || '#000')) group.setAttribute('class', 'pale');
       flip.append(group);
       groups.set(operation, group);
     }
@@ -60,7 +58,7 @@ async function drawSheet(jobId, sheet) {
     const line = document.createElementNS(svgNS, 'polyline');
     line.setAttribute('points', stroke.points.map((p) => `${p[0]},${p[1]}`).join(' '));
     line.setAttribute('fill', 'none');
-    line.setAttribute('stroke', path.colours[stroke.operation] || '#000');
+    line.setAttribute('stroke', readable(path.colours[stroke.operation] || '#000'));
     // Visible on a screen, unlike the cut file's hairlines: 1.5 px whatever the zoom.
     line.setAttribute('stroke-width', '1.5');
     line.setAttribute('vector-effect', 'non-scaling-stroke');
@@ -77,18 +75,35 @@ async function drawSheet(jobId, sheet) {
   legend.replaceChildren();
   for (const [operation, colour] of Object.entries(path.colours)) {
     if (!path.strokes.some((stroke) => stroke.operation === operation)) continue;
-    legend.append(element('span', {}, element('span', { class: 'swatch', style: `background:${colour}` }), ` ${operation}`));
+    legend.append(element('span', {}, element('span', { class: 'swatch', style: `background:${readable(colour)}` }), ` ${operation}`));
   }
   highlightStroke();
 }
 
-// Whether a colour "#rrggbb" is too light to see on the bed as it is.
-function pale(colour) {
+// The sheet's colour on the page.
+const kSheetColour = '#fbfaf7';
+
+// WCAG 2's relative luminance of "#rrggbb", and the contrast ratio of two.
+function luminance(colour) {
   const value = parseInt(colour.slice(1), 16);
-  const r = (value >> 16) & 255;
-  const g = (value >> 8) & 255;
-  const b = value & 255;
-  return 0.2126 * r + 0.7152 * g + 0.0722 * b > 160;
+  const linear = (c) => (c <= 0.03928 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4);
+  return 0.2126 * linear(((value >> 16) & 255) / 255) + 0.7152 * linear(((value >> 8) & 255) / 255) +
+    0.0722 * linear((value & 255) / 255);
+}
+export function contrast(a, b) {
+  const [light, dark] = [luminance(a), luminance(b)].sort((x, y) => y - x);
+  return (light + 0.05) / (dark + 0.05);
+}
+
+// The machine's colour for an operation, darkened (its hue kept) until it
+// stands out from the sheet by WCAG's 3:1 for graphics: the yellow of an
+// etch reads as a dark gold.
+function readable(colour) {
+  const value = parseInt(colour.slice(1), 16);
+  let [r, g, b] = [(value >> 16) & 255, (value >> 8) & 255, value & 255];
+  const hex = () => `#${[r, g, b].map((c) => Math.round(c).toString(16).padStart(2, '0')).join('')}`;
+  while (contrast(hex(), kSheetColour) < 3 && r + g + b > 0) [r, g, b] = [r * 0.9, g * 0.9, b * 0.9];
+  return hex();
 }
 
 // The stroke being cut (progress counts those finished), the ones before it faded.

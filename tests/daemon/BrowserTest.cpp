@@ -125,6 +125,26 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
   EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline').length"), job["strokes"]);
   EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline.done').length"), job["strokes"]);
   EXPECT_EQ(browser.evaluate("getComputedStyle(document.querySelector('#sheet-view polyline')).strokeWidth"), "1.5px");
+  // Every operation's strokes stand out from the sheet (WCAG 2's contrast
+  // for graphics, 3:1, computed here from the colours the browser draws):
+  // the machine's yellow etch would not (1.1:1).
+  const json contrasts = browser.evaluate(R"((() => {
+    const rgb = (text) => text.match(/\d+/g).slice(0, 3).map(Number);
+    const luminance = ([r, g, b]) => [r, g, b].map((c) => c / 255)
+      .map((c) => (c <= 0.03928 ? c / 12.92 : ((c + 0.055) / 1.055) ** 2.4))
+      .reduce((sum, c, i) => sum + c * [0.2126, 0.7152, 0.0722][i], 0);
+    const sheet = luminance(rgb(getComputedStyle(document.querySelector('#sheet-view rect')).fill));
+    const byOperation = {};
+    for (const line of document.querySelectorAll('#sheet-view polyline')) {
+      const stroke = luminance(rgb(getComputedStyle(line).stroke));
+      const ratio = (Math.max(stroke, sheet) + 0.05) / (Math.min(stroke, sheet) + 0.05);
+      const operation = line.dataset.operation;
+      byOperation[operation] = Math.min(byOperation[operation] ?? Infinity, ratio);
+    }
+    return byOperation;
+  })())");
+  ASSERT_TRUE(contrasts.contains("etch")) << contrasts.dump();
+  for (const auto& [operation, ratio] : contrasts.items()) EXPECT_GE(ratio.get<double>(), 3.0) << operation;
   browser.screenshot(artefacts() / "sheet.png");
 
   // The assembly guide, stepped to panel 3.
@@ -196,27 +216,34 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
 
 TEST(Browser, ARefusedActionShowsTheDaemonsOwnWords) {
   TempDir root;
-  // A cutter that is not plugged in: jobs are planned for it, and starting one is refused.
-  Daemon daemon(root.path(),
-                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"grbl:///dev/rotafab-no-such-port\"}]\n");
+  // A simulated cutter in real time, busy with job 1: starting job 2 is
+  // refused (the page offers Start, as the device can cut; it cannot yet).
+  Daemon daemon(root.path(), "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=1\"}]\n");
   daemon.start();
-  const CommandResult submitted =
-      daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --evaluations 1");
-  ASSERT_EQ(submitted.status, 0) << submitted.err;
-  ASSERT_EQ(daemon.waitForJob(1, [](const json& job) { return job["state"] == "ready"; })["state"], "ready");
+  for (int job = 1; job <= 2; ++job) {
+    const CommandResult submitted =
+        daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --evaluations 1");
+    ASSERT_EQ(submitted.status, 0) << submitted.err;
+    ASSERT_EQ(daemon.waitForJob(job, [](const json& j) { return j["state"] == "ready"; })["state"], "ready");
+  }
+  ASSERT_EQ(daemon.client("start 1").status, 0);
   testing::Browser browser;
   browser.navigate(loginLink(daemon));
-  ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"ready\"]')", 20s));
-  ASSERT_TRUE(browser.waitFor("document.querySelector('.device[data-state=\"offline\"]')", 20s))
-      << browser.evaluate("document.getElementById('devices').innerText");
+  ASSERT_TRUE(
+      browser.waitFor("document.querySelector('tr[data-job=\"2\"][data-state=\"ready\"] "
+                      "button[data-action=\"start\"]')",
+                      20s))
+      << browser.evaluate("document.getElementById('jobs-body').innerText");
   // What the API says to the same request.
-  const RawReply refused = daemon.post("/api/jobs/1/start", "{}");
+  const RawReply refused = daemon.post("/api/jobs/2/start", "{}");
   ASSERT_EQ(refused.status, 409) << refused.text;
   const std::string words = refused.body["error"];
-  click(browser, "tr[data-job=\"1\"] button[data-action=\"start\"]");
+  EXPECT_NE(words.find("busy with job 1"), std::string::npos) << words;
+  click(browser, "tr[data-job=\"2\"] button[data-action=\"start\"]");
   ASSERT_TRUE(browser.waitFor("!document.getElementById('error').hidden", 10s));
   EXPECT_EQ(browser.evaluate("document.getElementById('error-text').textContent"), words);
-  EXPECT_EQ(daemon.job(1)["state"], "ready");
+  EXPECT_EQ(daemon.job(2)["state"], "ready");
+  ASSERT_EQ(daemon.client("cancel 1").status, 0);
   browser.screenshot(artefacts() / "refused.png");
   // The browser logs the 409 of the request; nothing else went wrong.
   expectNoErrorsBut(browser, "status of 409");
@@ -291,6 +318,13 @@ TEST(Browser, TheQueueIsReorderedByDraggingItsRowsUpAndDown) {
                       "'|') === Array(3).fill('posterboard on grbl-diode-400').join('|')",
                       20s))
       << browser.evaluate("document.querySelector('#jobs-body').innerText").dump();
+  // Its device is not plugged in: no Start offered, but why.
+  EXPECT_TRUE(browser.waitFor("document.querySelectorAll('#jobs-body .unable').length === 3", 20s))
+      << browser.evaluate("document.querySelector('#jobs-body').innerText").dump();
+  EXPECT_EQ(browser.evaluate("document.querySelectorAll('#jobs-body button[data-action=start]').length"), 0);
+  EXPECT_TRUE(browser.evaluate("document.querySelector('#jobs-body .unable').textContent")
+                  .get<std::string>()
+                  .starts_with("laser1 is offline"));
   // A drag as the browser delivers one: dragstart on a row, drop on another.
   const auto drag = [&](int job, int onto) {
     browser.evaluate(fmt::format(R"((() => {{
