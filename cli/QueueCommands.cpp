@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <thread>
 
@@ -169,8 +170,10 @@ std::string progressLine(const json& progress) {
 std::string withCommand(const json& job, long long id) {
   const std::string message = job.value("message", ""), state = job.value("state", "");
   if (state == "ready") return message + fmt::format("; start it with `rotafab start {}`", id);
-  if ((state == "interrupted" || state == "failed") && job.value("sheets", 0) > 0) {
-    return message + fmt::format(" (`rotafab resume {} --from-sheet {}`)", id, std::max(1, job.value("sheet", 0)));
+  // The sheet the daemon says to go on from, where it says one (a stop or a device's fault).
+  static const std::regex goOn(R"(load sheet (\d+) and resume from it)");
+  if (std::smatch sheet; (state == "interrupted" || state == "failed") && std::regex_search(message, sheet, goOn)) {
+    return message + fmt::format(" (`rotafab resume {} --from-sheet {}`)", id, sheet[1].str());
   }
   return message;
 }

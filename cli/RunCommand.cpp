@@ -49,7 +49,7 @@ std::string deviceFor(const RunOptions& options, const profiles::ProfileCatalogu
 // material, or the driver's machine where the job's is another's): said,
 // then asked on a terminal, or refused without --force.
 void confirmChanges(const RunOptions& options, const jobs::JobProfileNames& madeFor,
-                    const jobs::CuttingProfiles& cutting) {
+                    const jobs::CuttingProfiles& cutting, const core::Cancellation& cancel) {
   if (cutting.changes.empty()) return;
   const std::string made =
       fmt::format("{} was made for {} with {}", options.target, madeFor.machine.value_or(cutting.machine.name),
@@ -68,8 +68,8 @@ void confirmChanges(const RunOptions& options, const jobs::JobProfileNames& made
   fmt::print(stderr, "run: {}; cutting it on {} with {} changes {}.\nCut it with these settings? [y/N] ", made,
              cutting.machine.name, cutting.material.name, changes);
   std::fflush(stderr);
-  std::string answer;
-  if (!std::getline(std::cin, answer) || (answer != "y" && answer != "Y" && answer != "yes")) {
+  const std::optional<std::string> answer = readLine(cancel);  // (Ctrl-C stops it at once)
+  if (!answer || (*answer != "y" && *answer != "Y" && *answer != "yes")) {
     throw UserError("not cut: the settings were not confirmed");
   }
 }
@@ -148,8 +148,10 @@ int runRun(const RunOptions& options) {
                                     cutting.machine.name, cutting.machine.driver, device, driverName));
       }
       jobs::checkSheetsFitBed(sheets, cutting.machine);
-      confirmChanges(options, madeFor, cutting);
-      std::string stock = jobs::stockOf(cutting.material, cutting.machine.bed);
+      confirmChanges(options, madeFor, cutting, command.cancellation());
+      // (The job's sheets' own size: a bed larger than theirs holds them as they are.)
+      std::string stock = jobs::stockOf(cutting.material, sheets.front().drawing.width, sheets.front().drawing.height,
+                                        cutting.machine.bed.unit);
       RunOptions resolved = options;
       resolved.device = device;
       setup.machine = std::move(cutting.machine);
@@ -187,6 +189,12 @@ int runRun(const RunOptions& options) {
         // One file a sheet, cube.gcode -> cube-sheet-001.gcode, ...: one
         // file of several sheets would be cut back to back, onto one sheet.
         const std::filesystem::path out = options.out;
+        if (out.stem().empty()) {
+          throw UserError(
+              fmt::format("--out {}: {} sheets are written as NAME-sheet-001{} and on: give a file "
+                          "name, such as cube.gcode",
+                          options.out, job->toolpaths().size(), out.extension().string()));
+        }
         for (const std::string& written : job->writeDryRunOfEachSheet([&](int sheet) {
                return out.parent_path() /
                       fmt::format("{}-sheet-{:03}{}", out.stem().string(), sheet, out.extension().string());

@@ -28,16 +28,20 @@ void ProgressBar::end() const {
   if (terminal_) fmt::print(stderr, "\n");
 }
 
-bool waitForEnter(const core::Cancellation& cancel) {
+bool waitForEnter(const core::Cancellation& cancel) { return readLine(cancel).has_value(); }
+
+std::optional<std::string> readLine(const core::Cancellation& cancel) {
+  std::string line;
   for (;;) {
-    if (cancel.cancelled()) return false;
+    if (cancel.cancelled()) return std::nullopt;
     pollfd input{STDIN_FILENO, POLLIN, 0};
     if (::poll(&input, 1, 200) > 0) {
       char byte = 0;
       while (::read(STDIN_FILENO, &byte, 1) == 1) {
-        if (byte == '\n') return true;
+        if (byte == '\n') return line;
+        line += byte;
       }
-      return false;
+      return std::nullopt;
     }
   }
 }

@@ -33,6 +33,9 @@ class ProgressBar {
 // Waits for a line on standard input while watching for a cancel (a read
 // restarted after a signal would not see it). False on a cancel or the end of input.
 bool waitForEnter(const core::Cancellation& cancel);
+// A line typed at the terminal, without its newline; nothing on a cancel
+// (Ctrl-C) or at the end of input.
+std::optional<std::string> readLine(const core::Cancellation& cancel);
 
 // The events of a run of `sheets` sheets shown on standard error: a line as
 // each sheet starts, its progress bar, the question before each sheet after

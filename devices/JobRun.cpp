@@ -51,6 +51,7 @@ std::vector<std::string> JobRun::writeDryRunOfEachSheet(
     const std::function<std::filesystem::path(int sheet)>& fileOf) const {
   std::vector<std::string> written;
   for (const jobs::Toolpath& toolpath : toolpaths_) {
+    throwIfCancelled(setup_.cancellation);
     const std::vector<jobs::Toolpath> one{toolpath};
     const std::filesystem::path file = fileOf(toolpath.sheet);
     jobs::writeFileAtomically(file, device_->program(one));

@@ -98,9 +98,9 @@ NestingResult withTheRestInRows(const std::vector<NestingPart>& parts, const Nes
 
 int anyAngleTurns(size_t parts) {
   // Measured on the bunny's 3,660 panels (the README's first command): 24
-  // turns, 88,000 part-turns, a first layout of 13 s and one sheet fewer
-  // than quarter turns; CGAL's elephant's 5,166 panels at 24 turns ran out
-  // of the 20-s budget.
+  // turns, 88,000 part-turns, a first layout of 4 s and one sheet fewer than
+  // quarter turns, and more turns no fewer sheets; the shapes of more part-turns
+  // take more memory (48 turns: 816 MB) for nothing.
   constexpr size_t kMostPartTurns = 90'000;
   constexpr size_t kMostTurns = 24;
   if (parts <= nesting::kMostPartsForNoFitPolygons) return 4;
@@ -114,6 +114,8 @@ NestingResult nest(const std::vector<NestingPart>& given, const NestingOptions& 
   if (const int turns = anyAngleTurns(given.size()); options.anyAngle && turns > 4) {
     turnedEvenly = given;
     for (NestingPart& part : turnedEvenly) {
+      // (A part allowed fewer than the four quarter turns keeps its own.)
+      if (part.rotations != std::vector<double>{0.0, 90.0, 180.0, 270.0}) continue;
       part.rotations.clear();
       for (int k = 0; k < turns; ++k) part.rotations.push_back(360.0 * k / turns);
     }

@@ -154,10 +154,11 @@ int sheetsTheAreaNeeds(const std::vector<NestingPart>& parts, const NestingOptio
 
 // The even turns (a multiple of 4, so that quarter turns are among them;
 // 4 to 24) tried for parts that may be cut at any angle
-// (NestingOptions::anyAngle) on a job of `parts` parts: as many as keep the
-// first layout's work (parts times turns) within what 2 cores place in
-// about 15 s, and quarter turns alone on jobs small enough for no-fit
-// polygons, whose cost grows with the square of the turns.
+// (NestingOptions::anyAngle) and allowed the four quarter turns, on a job
+// of `parts` parts: as many as keep parts times turns within 90,000 (the
+// bunny's first layout: 4 s on 2 cores), and quarter turns alone on jobs
+// small enough for no-fit polygons, whose cost grows with the square of
+// the turns.
 int anyAngleTurns(size_t parts);
 
 // How many quarter turns (0-3) `degrees` is, or -1 when it is no whole number of them.

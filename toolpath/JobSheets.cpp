@@ -109,39 +109,70 @@ JobProfileNames jobProfileNames(const std::filesystem::path& target) {
   if (!std::filesystem::exists(manifest, error)) return {};
   const auto read = readManifestSheets(manifest);
   if (!read) return {};
-  return {read->machine, read->material};
+  return {read->machine, read->material, manifest};
 }
 
 CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, const JobProfileNames& madeFor,
                                 const std::string& machine, const std::string& material,
                                 std::optional<std::string_view> driver) {
+  // The job's own profiles, where this computer has them.
+  std::optional<profiles::MachineProfile> madeOn;
+  std::optional<profiles::MaterialProfile> madeWith;
+  try {
+    if (madeFor.machine) madeOn = profiles::findMachine(catalogue, *madeFor.machine);
+  } catch (const profiles::ProfileError&) {
+  }
+  try {
+    if (madeFor.material) madeWith = profiles::findMaterial(catalogue, *madeFor.material);
+  } catch (const profiles::ProfileError&) {
+  }
+  const auto missing = [&](std::string_view kind, const std::string& name, std::string_view option) {
+    return core::UserError(
+        fmt::format("{}: names the {} {}, which no profile here has (`rotafab profiles` lists "
+                    "them); give {} to cut it with another",
+                    madeFor.manifest.string(), kind, name, option));
+  };
   CuttingProfiles cutting;
   if (!machine.empty()) {
     cutting.machine = profiles::findMachine(catalogue, machine);
-  } else if (madeFor.machine && (!driver || profiles::findMachine(catalogue, *madeFor.machine).driver == *driver)) {
-    cutting.machine = profiles::findMachine(catalogue, *madeFor.machine);
+  } else if (madeFor.machine && !madeOn) {
+    throw missing("machine", *madeFor.machine, "--machine NAME");
+  } else if (madeOn && (!driver || madeOn->driver == *driver)) {
+    cutting.machine = *madeOn;
   } else if (auto first = driver ? profiles::firstMachineFor(catalogue, *driver) : std::nullopt) {
     cutting.machine = *first;
   } else {
     throw core::UserError(fmt::format("no machine profile for the {} driver; give --machine", driver.value_or("")));
   }
-  cutting.material = profiles::findMaterial(
-      catalogue, !material.empty() ? material : madeFor.material.value_or(std::string(profiles::kDefaultMaterial)));
+  if (!material.empty()) {
+    cutting.material = profiles::findMaterial(catalogue, material);
+  } else if (madeFor.material && !madeWith) {
+    throw missing("material", *madeFor.material, "--material NAME");
+  } else {
+    cutting.material =
+        madeWith ? *madeWith : profiles::findMaterial(catalogue, std::string(profiles::kDefaultMaterial));
+  }
   if (madeFor.machine || madeFor.material) {
-    const profiles::MachineProfile madeOn =
-        madeFor.machine ? profiles::findMachine(catalogue, *madeFor.machine) : cutting.machine;
-    const profiles::MaterialProfile madeWith =
-        madeFor.material ? profiles::findMaterial(catalogue, *madeFor.material) : cutting.material;
-    cutting.changes = profiles::settingChanges(madeOn, madeWith, cutting.machine, cutting.material);
+    cutting.changes = profiles::settingChanges(madeOn.value_or(cutting.machine), madeWith.value_or(cutting.material),
+                                               cutting.machine, cutting.material);
+    // A profile of the job's that this computer lacks: what the job was made with is unknown, a change too.
+    if (madeFor.machine && !madeOn) {
+      cutting.changes.insert(cutting.changes.begin(), fmt::format("machine: {} instead of {} (no profile here)",
+                                                                  cutting.machine.name, *madeFor.machine));
+    }
+    if (madeFor.material && !madeWith) {
+      cutting.changes.insert(cutting.changes.begin(), fmt::format("material: {} instead of {} (no profile here)",
+                                                                  cutting.material.name, *madeFor.material));
+    }
   }
   return cutting;
 }
 
-std::string stockOf(const profiles::MaterialProfile& material, const profiles::Bed& bed) {
-  const double perInch = profiles::unitsPerInch(bed.unit);
+std::string stockOf(const profiles::MaterialProfile& material, double width, double height, std::string_view unit) {
+  const double perInch = profiles::unitsPerInch(unit);
   return fmt::format("{} ({}), {:.4g} x {:.4g} {}", material.name,
-                     profiles::formatLength(material.thickness, material.units.thickness), bed.width * perInch,
-                     bed.height * perInch, bed.unit);
+                     profiles::formatLength(material.thickness, material.units.thickness), width * perInch,
+                     height * perInch, unit);
 }
 
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {

@@ -36,6 +36,7 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
 // sheets with no manifest, have neither.
 struct JobProfileNames {
   std::optional<std::string> machine, material;
+  std::filesystem::path manifest;  // where they were read, for messages
 };
 JobProfileNames jobProfileNames(const std::filesystem::path& target);
 
@@ -43,9 +44,10 @@ JobProfileNames jobProfileNames(const std::filesystem::path& target);
 // `material`, empty for none), else the job's own, else the first machine
 // the device's driver drives and posterboard; `changes` says what differs
 // from the job's own settings (profiles::settingChanges), empty when it
-// is cut as it was made. `madeFor` the job's names. Throws
-// profiles::ProfileError for a name no profile has (the job's own
-// included), core::UserError when no machine is driven by `driver`.
+// is cut as it was made. `madeFor` the job's names: one no profile here
+// has is a change where another is asked for, else core::UserError naming
+// the manifest. Throws profiles::ProfileError for an asked name no profile
+// has, core::UserError when no machine is driven by `driver`.
 struct CuttingProfiles {
   profiles::MachineProfile machine;
   profiles::MaterialProfile material;
@@ -56,9 +58,10 @@ CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, con
                                 std::optional<std::string_view> driver);
 
 // What the operator loads for each sheet of a job, for people: the
-// material, its thickness and the sheet's size, "posterboard (0.8 mm), 32
-// x 18 in", each in the unit its profile gives it in.
-std::string stockOf(const profiles::MaterialProfile& material, const profiles::Bed& bed);
+// material, its thickness and the sheet's size (`width` x `height` inches,
+// shown in `unit`, the machine profile's), "posterboard (0.8 mm), 32 x 18
+// in".
+std::string stockOf(const profiles::MaterialProfile& material, double width, double height, std::string_view unit);
 
 // Throws core::UserError naming the first sheet larger than the machine's bed.
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);

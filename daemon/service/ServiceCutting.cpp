@@ -244,8 +244,7 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
                       summary.sheets, summary.sheets == 1 ? "" : "s", cut->firstSheet, summary.strokes, summary.burnt),
           change, true);
     } else if (failure) {
-      device.state = "fault";
-      device.message = *failure;
+      // (Not the device's fault: a sheet or a profile; the device stays idle.)
       ended = record(id, JobState::Failed, *failure, {}, true);
     } else {
       JobChange change;
@@ -260,7 +259,8 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
                                : sheetWhere(fault->sheet, job.sheets, static_cast<int64_t>(fault->strokesDone),
                                             static_cast<int64_t>(fault->strokes));
       const std::string laser = devices::laserStateAfter(*fault);
-      const int goOn = std::max(1, fault->sheet);
+      // The sheet it stopped at, or where this cut began when it stopped before any.
+      const int goOn = fault->sheet > 0 ? fault->sheet : std::max(1, cut->firstSheet);
       if (fault->kind == devices::FaultKind::Cancelled && cut->control->shutdown) {
         const std::string stopped = cut->stoppedBecause.empty() ? std::string("the daemon stopped")
                                                                 : cut->stoppedBecause + ": the daemon stopped the cut";

@@ -57,10 +57,11 @@ void addKits(const jobs::ManifestSheets& listed, json& summary) {
 // What the job is cut on and with, and what the operator loads for each
 // sheet ("posterboard (0.8 mm), 32 x 18 in"): the page and `rotafab
 // status` say it.
-void addStock(const profiles::MachineProfile& machine, const profiles::MaterialProfile& material, json& summary) {
+void addStock(const profiles::MachineProfile& machine, const profiles::MaterialProfile& material, double width,
+              double height, json& summary) {
   summary["machine"] = machine.name;
   summary["material"] = material.name;
-  summary["stock"] = jobs::stockOf(material, machine.bed);
+  summary["stock"] = jobs::stockOf(material, width, height, machine.bed.unit);
 }
 
 }  // namespace
@@ -200,7 +201,6 @@ std::string Service::Impl::plannedReason(int sheets) {
 json Service::Impl::planOfFolder(const fs::path& folder, const profiles::MachineProfile& machine,
                                  const profiles::MaterialProfile& material) const {
   json summary;
-  addStock(machine, cuttingMaterial(folder, material), summary);
   std::vector<jobs::JobSheet> planned;
   if (const auto listed = jobs::readManifestSheets(folder / "manifest.json")) {
     planned = jobs::readJobSheets(folder, listed->svgSheets);
@@ -216,6 +216,10 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
   }
   jobs::checkSheetsFitBed(planned, machine);
   summary["sheets"] = static_cast<int>(planned.size());
+  // (The sheets' own size: a folder made for a smaller bed is cut on sheets of its size.)
+  addStock(machine, cuttingMaterial(folder, material),
+           planned.empty() ? machine.bed.width : planned.front().drawing.width,
+           planned.empty() ? machine.bed.height : planned.front().drawing.height, summary);
   return summary;
 }
 
@@ -323,7 +327,7 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
       summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
       summary["cost"] = jobs::costJson(planned.cost);
       summary["folder"] = plannedName;
-      addStock(machine, request.material, summary);
+      addStock(machine, request.material, machine.bed.width, machine.bed.height, summary);
       if (const auto listed = jobs::readManifestSheets(folder / plannedName / "manifest.json"))
         addKits(*listed, summary);
       // What the plan said on the way, for the people at the machine (the page shows them).

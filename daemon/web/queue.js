@@ -36,9 +36,10 @@ function actionsOf(job) {
         await refreshJobs();
       }),
     }, label));
-  // A device that cannot cut now (offline, gone, in a fault): no Start, but why.
+  // A device that cannot cut now (offline, gone): no Start, but why. (One in
+  // a fault can: the daemon starts a cut on it, and the operator has cleared it.)
   const device = state.devices.find((d) => d.name === job.device);
-  const unable = device && ['offline', 'gone', 'fault'].includes(device.state) ? device : null;
+  const unable = device && ['offline', 'gone'].includes(device.state) ? device : null;
   switch (job.state) {
     case 'ready':
       if (unable) {

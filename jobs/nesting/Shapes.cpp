@@ -160,9 +160,9 @@ Shape turnedByRounding(const Shape& from, Shape shape) {
   shape.grown = turnPath(from.grown);
   for (const IntPoint& p : shape.grown) shape.negated.push_back({-p.X, -p.Y});
   std::tie(shape.grownMinX, shape.grownMinY, shape.grownMaxX, shape.grownMaxY) = std::tuple_cat(boxOf(shape.grown));
-  // One grid unit less for the rounding.
+  // Less by what the rounding may move a centre and a corner: each under a grid unit's diagonal.
   for (const Shape::Pole& pole : from.poles)
-    shape.poles.push_back({turned(pole.centre), std::max(1.0, pole.radius - 1)});
+    shape.poles.push_back({turned(pole.centre), std::max(1.0, pole.radius - 2)});
   shape.diameter = std::hypot(static_cast<double>(shape.grownMaxX - shape.grownMinX),
                               static_cast<double>(shape.grownMaxY - shape.grownMinY));
   shape.size = from.size;

@@ -133,6 +133,25 @@ TEST(RunCli, AJobIsCutWithTheMachineAndMaterialItWasMadeFor) {
   const CommandResult profiled = dryRun("", "profiled.gcode");
   ASSERT_EQ(profiled.status, 0) << profiled.err;
   EXPECT_NE(profiled.out.find("G-code for 1 sheet (168 strokes)"), std::string::npos) << profiled.out;
+  // A job made where a profile is that this computer lacks: named, and cut only with one asked for.
+  TempDir elsewhere;
+  std::filesystem::copy(job, elsewhere.path() / "job", std::filesystem::copy_options::recursive);
+  const auto copied = elsewhere.path() / "job";
+  std::string text = readFile(copied / "manifest.json");
+  text.replace(text.find("\"grbl-diode-400\""), 16, "\"their-laser\"");
+  { std::ofstream(copied / "manifest.json") << text; }
+  const CommandResult unknown =
+      run(kCli + " run " + quoted(copied) + " --sheet 1 --device sim:grbl --dry-run --out " + quoted(dir.path() / "u"));
+  EXPECT_EQ(unknown.status, 1);
+  EXPECT_NE(unknown.err.find("manifest.json: names the machine their-laser, which no profile here has"),
+            std::string::npos)
+      << unknown.err;
+  const CommandResult asked = run(kCli + " run " + quoted(copied) +
+                                  " --sheet 1 --device sim:grbl --machine grbl-diode-400 --force --dry-run --out " +
+                                  quoted(dir.path() / "n.gcode"));
+  EXPECT_EQ(asked.status, 0) << asked.err;
+  EXPECT_NE(asked.err.find("machine: grbl-diode-400 instead of their-laser (no profile here)"), std::string::npos)
+      << asked.err;
   // A device another driver drives: another machine, said and refused.
   const CommandResult onGrbl = run(kCli + " run " + quoted(k40Job()) + " --sheet 1 --device sim:grbl --dry-run --out " +
                                    quoted(dir.path() / "k40.gcode"));
