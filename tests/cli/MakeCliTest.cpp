@@ -1052,12 +1052,15 @@ TEST(MakeCli, InterruptStopsAtOnceAndWritesNothing) {
        {std::pair<std::string, std::string>{"INT", "nesting: first layout"}, {"TERM", "make: nesting [0-9]"}}) {
     TempDir dir;
     const auto out = dir.path() / "bunny", err = dir.path() / "err";
-    const CommandResult r =
-        run("(" + kCli + " make " + quoted(kSource / "examples/bunny.obj") + " --structure band --out " + quoted(out) +
-            " 2> " + quoted(err) + " & pid=$!; for i in $(seq 600); do grep -q '" + after + "' " + quoted(err) +
-            " && break; sleep 0.05; done; sleep 1; start=$(date +%s%N); kill -" + signal +
-            " $pid; wait $pid; status=$?; end=$(date +%s%N); cat " + quoted(err) +
-            " >&2; echo $(( (end - start) / 1000000 )); exit $status)");
+    // (Under AddressSanitizer, LeakSanitizer's scan of the heap at exit, 1.3 s
+    // of a 1.6-s stop for the bunny's turned shapes, is not the stop the user
+    // waits for; leaks are every other test's to find.)
+    const CommandResult r = run("(ASAN_OPTIONS=\"${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0\" " + kCli + " make " +
+                                quoted(kSource / "examples/bunny.obj") + " --structure band --out " + quoted(out) +
+                                " 2> " + quoted(err) + " & pid=$!; for i in $(seq 600); do grep -q '" + after + "' " +
+                                quoted(err) + " && break; sleep 0.05; done; sleep 1; start=$(date +%s%N); kill -" +
+                                signal + " $pid; wait $pid; status=$?; end=$(date +%s%N); cat " + quoted(err) +
+                                " >&2; echo $(( (end - start) / 1000000 )); exit $status)");
     EXPECT_EQ(r.status, signal == "INT" ? 130 : 143) << r.err;
     EXPECT_NE(r.err.find("make: stopped; nothing was written"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("error:"), std::string::npos) << r.err;
