@@ -107,12 +107,7 @@ bool openInBrowser(const std::string& url) {
 std::string sheetsOf(const json& job) {
   const int sheets = job.value("sheets", 0);
   if (sheets == 0) return "-";
-  const std::string state = job.value("state", "");
-  if (state == "done") return fmt::format("{}/{}", sheets, sheets);
-  if (state == "running" || state == "paused" || state == "interrupted" || state == "failed") {
-    return fmt::format("{}/{}", std::max(0, job.value("sheet", 0) - 1), sheets);
-  }
-  return fmt::format("0/{}", sheets);
+  return fmt::format("{}/{}", job.value("sheets_cut", 0), sheets);
 }
 
 std::string shortened(const std::string& text, size_t width) {
@@ -171,11 +166,22 @@ std::string withCommand(const json& job, long long id) {
   const std::string message = job.value("message", ""), state = job.value("state", "");
   if (state == "ready") return message + fmt::format("; start it with `rotafab start {}`", id);
   // The sheet the daemon says to go on from, where it says one (a stop or a device's fault).
-  static const std::regex goOn(R"(load sheet (\d+) and resume from it)");
+  static const std::regex goOn(R"((?:load|leave) sheet (\d+) (?:and|where it is and) resume from it)");
   if (std::smatch sheet; (state == "interrupted" || state == "failed") && std::regex_search(message, sheet, goOn)) {
     return message + fmt::format(" (`rotafab resume {} --from-sheet {}`)", id, sheet[1].str());
   }
   return message;
+}
+
+// What a job waiting for its operator waits for, with the commands that answer it.
+std::string waitingSaid(const json& job, long long id) {
+  const int sheet = job.value("waiting_sheet", job.value("sheet", 0) + 1);
+  if (job.value("waiting_for", "").find("framed") != std::string::npos) {
+    return fmt::format("{}: run `rotafab next {}` (`rotafab frame {}` frames it again)", job.value("waiting_for", ""),
+                       id, id);
+  }
+  return fmt::format("load sheet {}{} and run `rotafab next {}` (`rotafab frame {}` frames it first)", sheet,
+                     whatToLoad(job, sheet), id, id);
 }
 
 void printStatus(const json& job) {
@@ -207,12 +213,12 @@ void printStatus(const json& job) {
     }
   }
   if (job.contains("progress")) fmt::print("  {}\n", progressLine(job["progress"]));
-  if (job.value("waiting_for_next", false)) {
-    const int next = job.value("sheet", 0) + 1;
-    fmt::print("  waiting: load sheet {}{} and run `rotafab next {}`\n", next, whatToLoad(job, next),
-               job.value("id", 0));
-  }
+  if (job.value("waiting_for_next", false)) fmt::print("  waiting: {}\n", waitingSaid(job, job.value("id", 0LL)));
   fmt::print("  {}\n", withCommand(job, job.value("id", 0LL)));
+  if (job.contains("events") && job["events"].is_array() && !job["events"].empty()) {
+    const json& latest = job["events"].back();
+    fmt::print("  latest: {} ({})\n", latest.value("text", ""), latest.value("at", ""));
+  }
   if (job.contains("transitions")) {
     fmt::print("  history:\n");
     for (const json& t : job["transitions"]) {
@@ -277,18 +283,21 @@ int follow(const DaemonClient& client, long long id) {
       if (type != "job") return true;
       const std::string state = data.value("state", "");
       const bool waiting = data.value("waiting_for_next", false);
-      const int next = data.value("sheet", 0) + 1;
+      const int next = data.value("waiting_sheet", data.value("sheet", 0) + 1);
+      const bool framed = data.value("waiting_for", "").find("framed") != std::string::npos;
       if (state != lastState) {
         endBar();
         fmt::print(stderr, "job {}: {}: {}\n", id, state, withCommand(data, id));
         lastState = state;
       }
-      if (waiting && askedFor != next) {
+      if (waiting && askedFor != next * 2 + (framed ? 1 : 0)) {
         endBar();
-        askedFor = next;
+        askedFor = next * 2 + (framed ? 1 : 0);
         if (askHere) {
-          fmt::print(stderr, "job {}: load sheet {}{} and press Enter (or run `rotafab next {}`)\n", id, next,
-                     whatToLoad(data, next), id);
+          fmt::print(stderr, "job {}: {} press Enter (or run `rotafab next {}`; `rotafab frame {}` frames it)\n", id,
+                     framed ? fmt::format("sheet {} framed: once it is in place,", next)
+                            : fmt::format("load sheet {}{}, then", next, whatToLoad(data, next)),
+                     id, id);
           if (asking.joinable()) asking.join();
           asking = std::thread([&client, id, &stopAsking] {
             if (!waitForEnter(stopAsking)) return;
@@ -299,8 +308,7 @@ int follow(const DaemonClient& client, long long id) {
             }
           });
         } else {
-          fmt::print(stderr, "job {}: load sheet {}{} and run `rotafab next {}`\n", id, next, whatToLoad(data, next),
-                     id);
+          fmt::print(stderr, "job {}: {}\n", id, waitingSaid(data, id));
         }
       }
       if (settled(data)) {
@@ -347,6 +355,9 @@ void printAnswer(const json& answer, const std::string& action, bool asJson) {
   } else if (answer.contains("asked_host")) {
     fmt::print("job {}: {} on host {}: asked it to {} it (`rotafab status {}` says when it has)\n",
                answer.value("id", 0), state, answer.value("asked_host", ""), action, answer.value("id", 0));
+  } else if (action == "frame") {
+    fmt::print("job {}: framing sheet {} (laser off); `rotafab status {}` says when it is framed\n",
+               answer.value("id", 0), answer.value("framing_sheet", 0), answer.value("id", 0));
   } else if (action == "cancel" && state != "cancelled") {
     fmt::print("job {}: stopping (`rotafab status {}` says when it has)\n", answer.value("id", 0),
                answer.value("id", 0));
@@ -555,24 +566,37 @@ void addResumeCommand(CLI::App& app, int& status) {
   auto client = std::make_shared<ClientOptions>();
   auto job = std::make_shared<std::string>();
   auto fromSheet = std::make_shared<std::optional<int>>();
+  auto fromStroke = std::make_shared<std::optional<int>>();
+  auto wholeSheet = std::make_shared<bool>(false);
   CLI::App* resume =
       app.add_subcommand("resume", "Go on with a paused job, or an interrupted or failed one from a sheet");
   resume->add_option("JOB", *job, "The job's number")->required();
   resume
       ->add_option("--from-sheet", *fromSheet,
-                   "For an interrupted or failed job: the sheet to cut again from (loaded, fresh)")
+                   "For an interrupted or failed job: the sheet to go on with (the one it stopped in, left where "
+                   "it is, goes on from its first stroke not cut; another is cut whole, loaded fresh)")
       ->check(CLI::PositiveNumber);
+  auto* stroke = resume
+                     ->add_option("--from-stroke", *fromStroke,
+                                  "The stroke of that sheet to go on from (default: the first not cut)")
+                     ->check(CLI::PositiveNumber);
+  resume->add_flag("--whole-sheet", *wholeSheet, "Cut the sheet whole again (a fresh one loaded)")->excludes(stroke);
   addClientOptions(*resume, *client);
   resume->footer(
       "A job the daemon was cutting when it stopped comes back interrupted and never restarts by itself:\n"
-      "check the machine, load the sheet, then resume it from that sheet.\n\n"
+      "check the machine, then resume it from the sheet it stopped in. Left where it was, that sheet is\n"
+      "framed (laser off) and waits until you say it is in place (`rotafab next JOB`), then goes on from\n"
+      "the first stroke not cut; the strokes cut are not cut again.\n\n"
       "Examples:\n"
       "  rotafab resume 7\n"
-      "  rotafab resume 7 --from-sheet 3");
-  resume->callback([client, job, fromSheet, &status] {
+      "  rotafab resume 7 --from-sheet 3\n"
+      "  rotafab resume 7 --from-sheet 3 --whole-sheet");
+  resume->callback([client, job, fromSheet, fromStroke, wholeSheet, &status] {
     status = talking([&]() -> int {
       json body = json::object();
       if (*fromSheet) body["from_sheet"] = **fromSheet;
+      if (*fromStroke) body["from_stroke"] = **fromStroke;
+      if (*wholeSheet) body["from_stroke"] = 1;
       try {
         printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/resume", jobNumber(*job)), body,
                                                     kDeviceCheckPatience, saysWaiting),
@@ -583,6 +607,33 @@ void addResumeCommand(CLI::App& app, int& status) {
           throw;
         throw UserError(fmt::format("{}: give it with --from-sheet N", refused.what()));
       }
+      return kSuccess;
+    });
+  });
+}
+
+void addFrameCommand(CLI::App& app, int& status) {
+  auto client = std::make_shared<ClientOptions>();
+  auto job = std::make_shared<std::string>();
+  auto sheet = std::make_shared<std::optional<int>>();
+  CLI::App* frame = app.add_subcommand("frame", "Trace a sheet's box on the machine with the laser off, to check it");
+  frame->add_option("JOB", *job, "The job's number")->required();
+  frame->add_option("--sheet", *sheet, "The sheet (default: the one the job goes on with)")->check(CLI::PositiveNumber);
+  addClientOptions(*frame, *client);
+  frame->footer(
+      "The head goes round the box of the sheet's cuts with the laser off, so that you can check the sheet\n"
+      "is where the cut will be. A job waiting between sheets frames the one it waits for, and waits again;\n"
+      "a ready, interrupted or failed job is framed on the device it would be cut on.\n\n"
+      "Examples:\n"
+      "  rotafab frame 7\n"
+      "  rotafab frame 7 --sheet 2");
+  frame->callback([client, job, sheet, &status] {
+    status = talking([&]() -> int {
+      json body = json::object();
+      if (*sheet) body["sheet"] = **sheet;
+      printAnswer(clientOf(*client).postPatiently(fmt::format("/api/jobs/{}/frame", jobNumber(*job)), body,
+                                                  kDeviceCheckPatience, saysWaiting),
+                  "frame", client->json);
       return kSuccess;
     });
   });
@@ -666,7 +717,8 @@ void addQueueCommands(CLI::App& app, int& status) {
   addJobActionCommand(app, status, "pause", "Hold a running cut (feed hold); `rotafab resume JOB` goes on");
   addResumeCommand(app, status);
   addJobActionCommand(app, status, "start", "Cut a planned job on its device, from its first sheet (load it first)");
-  addJobActionCommand(app, status, "next", "Say the next sheet is loaded: the job cuts it");
+  addJobActionCommand(app, status, "next", "Say the next sheet is loaded (or a framed one in place): the job cuts it");
+  addFrameCommand(app, status);
   addMoveCommand(app, status);
   addDashboardCommand(app, status);
 }

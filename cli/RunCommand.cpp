@@ -23,8 +23,8 @@ namespace {
 
 struct RunOptions {
   std::string target, device, out, machine, material;
-  std::optional<int> sheet;
-  bool frame = false, dryRun = false, force = false;
+  std::optional<int> sheet, fromStroke;
+  bool frame = false, yes = false, dryRun = false, force = false;
 };
 
 // The device to cut on: the one given, else the connection of the machine
@@ -86,30 +86,37 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   const auto started = std::chrono::steady_clock::now();
   devices::RunSummary done;
   try {
-    done = job.run(options.frame,
-                   terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(stock), std::move(kits)),
+    done = job.run(terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(stock), std::move(kits),
+                                     {options.frame, options.yes}),
                    command.cancellation());
   } catch (const devices::DeviceFault& fault) {
     // Where the job stopped, so that the operator knows what is cut and can
     // go on from that sheet; and what is true of the laser.
-    const std::string where =
-        fault.sheet == 0    ? std::string("before the first sheet")
-        : fault.nothingSent ? fmt::format("at sheet {} of {}, before any of it was sent", fault.sheet, fault.sheets)
-                            : fmt::format("at sheet {} of {}, after stroke {} of {}", fault.sheet, fault.sheets,
-                                          fault.strokesDone, fault.strokes);
+    const std::string where = fault.sheet == 0    ? std::string("before the first sheet")
+                              : fault.nothingSent ? fmt::format("at sheet {}, before any of it was sent", fault.sheet)
+                                                  : fmt::format("at sheet {}, with {} of its {} strokes cut",
+                                                                fault.sheet, fault.strokesDone, fault.strokes);
+    // To go on: the strokes cut are not cut again (after a frame, to check the sheet has not moved):
+    // "leave sheet 1 and run it with --sheet 1 --from-stroke 102 --frame".
+    const std::string goOn =
+        fault.strokesDone > 0 && fault.strokesDone < fault.strokes
+            ? fmt::format("--sheet {} --from-stroke {} --frame", fault.sheet, fault.strokesDone + 1)
+            : fmt::format("--sheet {}", fault.sheet);
     const std::string laser = fault.nothingSent && fault.sheet > 1
                                   ? std::string("the sheets before it ended with the laser off")
                                   : devices::laserStateAfter(fault);
     if (fault.kind == devices::FaultKind::Cancelled) {
       // The operator's choice, not an error.
       fmt::print(stderr, "run: stopped {}; {}{}\n", where, laser,
-                 fault.sheet > 0
-                     ? fmt::format("; to go on, load sheet {} and run it with --sheet {}", fault.sheet, fault.sheet)
-                     : "");
+                 fault.sheet > 0 ? fmt::format("; to go on, {} sheet {} and run it with {}",
+                                               goOn.find("--from-stroke") != std::string::npos ? "leave" : "load",
+                                               fault.sheet, goOn)
+                                 : "");
       // (no signal: the operator did not say the next sheet was loaded)
       return command.signal() != 0 ? command.interruptedStatus() : kUserError;
     }
-    fmt::print(stderr, "error: {} ({}; stopped {}; {})\n", fault.what(), devices::faultName(fault.kind), where, laser);
+    fmt::print(stderr, "error: {} ({}; stopped {}; {}){}\n", fault.what(), devices::faultName(fault.kind), where, laser,
+               fault.sheet > 0 ? fmt::format("; once it is fixed, go on with {}", goOn) : "");
     return kDeviceFault;
   }
   // The spool only writes the sheets (and hands them to the print queue): a print driver cuts them later.
@@ -131,6 +138,11 @@ int runRun(const RunOptions& options) {
     try {
       devices::JobRunSetup setup;
       if (options.dryRun && options.out.empty()) throw UserError("--dry-run needs --out FILE: where the bytes go");
+      if (options.frame && !options.yes && !options.dryRun && ::isatty(STDIN_FILENO) == 0) {
+        throw UserError(
+            "--frame stops after the frame for you to check the sheet, and there is no terminal to ask: add --yes "
+            "to cut once framed");
+      }
       const std::vector<jobs::JobSheet> sheets = jobs::readJobSheets(options.target, options.sheet);
       const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
       const jobs::JobProfileNames madeFor = jobs::jobProfileNames(options.target);
@@ -141,6 +153,12 @@ int runRun(const RunOptions& options) {
         throw UserError(fmt::format("--device {}", error.what()));
       }
       const std::string_view driverName = setup.device.driver->name();
+      if (options.frame && !setup.device.driver->frames()) {
+        throw UserError(
+            fmt::format("--frame: {} writes files for a print driver and moves no head to frame a sheet "
+                        "with; frame it from the cutter's own software",
+                        device));
+      }
       jobs::CuttingProfiles cutting =
           jobs::cuttingProfiles(catalogue, madeFor, options.machine, options.material, driverName);
       if (cutting.machine.driver != driverName) {
@@ -158,6 +176,7 @@ int runRun(const RunOptions& options) {
       setup.material = std::move(cutting.material);
       for (const jobs::JobSheet& sheet : sheets) setup.sheets.push_back(sheet.drawing);
       setup.dryRun = options.dryRun;
+      setup.fromStroke = options.fromStroke ? static_cast<size_t>(*options.fromStroke - 1) : 0;
       setup.cancellation = &command.cancellation();
       setup.connected = [&](const std::string& identity) { fmt::print(stderr, "run: {}: {}\n", device, identity); };
       const auto& driver = *setup.device.driver;
@@ -171,6 +190,11 @@ int runRun(const RunOptions& options) {
         job = std::make_unique<devices::JobRun>(std::move(setup));
       } catch (const std::invalid_argument& error) {
         throw UserError(error.what());
+      }
+      if (const size_t strokes = job->toolpaths().front().strokes.size();
+          options.fromStroke && static_cast<size_t>(*options.fromStroke) > strokes) {
+        throw UserError(
+            fmt::format("--from-stroke {}: sheet {} has {} strokes", *options.fromStroke, *options.sheet, strokes));
       }
       if (!options.dryRun) {
         // Each sheet's kit, said as it is loaded and cut, where the folder's manifest gives them.
@@ -231,7 +255,13 @@ void addRunCommand(CLI::App& app, int& status) {
       "Nano board), "
       "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
-  run->add_flag("--frame", options->frame, "Trace each sheet's box with the laser off before cutting it");
+  run->add_flag("--frame", options->frame,
+                "Trace each sheet's box with the laser off, then ask \"cut sheet N now?\" (y cuts, f frames again)");
+  run->add_flag("--yes", options->yes, "With --frame: cut once framed without asking");
+  run->add_option("--from-stroke", options->fromStroke,
+                  "With --sheet: go on from this stroke (1-based), as a stopped run says; the strokes before it "
+                  "are not cut again")
+      ->check(CLI::PositiveNumber);
   run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
   run->add_option("--out", options->out,
                   "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool); "
@@ -256,6 +286,7 @@ void addRunCommand(CLI::App& app, int& status) {
       "  rotafab run cube/ --device sim:grbl\n"
       "  rotafab run cube/ --sheet 1   (on the machine profile's connection, grbl:///dev/ttyUSB0)\n"
       "  rotafab run cube/ --sheet 1 --device grbl:///dev/ttyUSB0 --frame\n"
+      "  rotafab run cube/ --sheet 2 --from-stroke 144 --frame   (go on where a stopped run said)\n"
       "  rotafab run cube/ --device grbl:///dev/ttyUSB0 --dry-run --out cube.gcode\n"
       "  rotafab make examples/cube.obj --structure band --machine k40-m2nano --out k40/\n"
       "  rotafab run k40/ --sheet 1 --device m2nano://usb/1a86:5512\n"
@@ -263,6 +294,9 @@ void addRunCommand(CLI::App& app, int& status) {
   run->callback([options, &status] {
     // A safety check before anything opens a device: `--out` without
     // `--dry-run` would otherwise cut for real and write nothing.
+    if (options->fromStroke && !options->sheet) {
+      throw CLI::ValidationError("--from-stroke", "needs --sheet N: the sheet to go on with");
+    }
     if (!options->out.empty() && !options->dryRun) {
       throw CLI::ValidationError("--out",
                                  "needs --dry-run: without it, run cuts on the device and writes no file; "

@@ -47,7 +47,7 @@ std::optional<std::string> readLine(const core::Cancellation& cancel) {
 }
 
 devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
-                                     std::map<int, std::string> kits) {
+                                     std::map<int, std::string> kits, TerminalFraming framing) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   auto bar = std::make_shared<ProgressBar>(terminal);
   // "; its kit: steps 174-352; once cut, ..." for a sheet the manifest gives a kit.
@@ -56,20 +56,40 @@ devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& ca
     return kit == kits->end() ? std::string() : fmt::format(" (its kit: {})", kit->second);
   };
   devices::RunEvents events;
-  events.beforeSheet = [&cancel, kitOf, stock](const jobs::Toolpath& next) {
-    fmt::print(stderr, "run: load sheet {}, {}{}, and press Enter (Ctrl-C stops)\n", next.sheet, stock,
-               kitOf(next.sheet));
-    return waitForEnter(cancel);  // Ctrl-C or the end of input: stop, do not cut blind
+  events.beforeSheet = [&cancel, kitOf, stock, framing](size_t index, const jobs::Toolpath& sheet, bool framed) {
+    using devices::SheetGo;
+    if (!framed) {
+      if (index > 0) {
+        fmt::print(stderr, "run: load sheet {}, {}{}, and press Enter (Ctrl-C stops)\n", sheet.sheet, stock,
+                   kitOf(sheet.sheet));
+        if (!waitForEnter(cancel)) return SheetGo::Stop;  // Ctrl-C or the end of input: stop, do not cut blind
+      }
+      return framing.frame ? SheetGo::Frame : SheetGo::Cut;
+    }
+    if (framing.yes) return SheetGo::Cut;
+    for (;;) {
+      fmt::print(stderr, "run: sheet {} framed: cut sheet {} now? [y/N, f to frame it again] ", sheet.sheet,
+                 sheet.sheet);
+      std::fflush(stderr);
+      const std::optional<std::string> answer = readLine(cancel);
+      if (!answer) return SheetGo::Stop;
+      if (*answer == "y" || *answer == "Y" || *answer == "yes") return SheetGo::Cut;
+      if (*answer == "f" || *answer == "F") return SheetGo::Frame;
+      return SheetGo::Stop;
+    }
   };
   events.sheetStarted = [bar, sheets, terminal, kitOf, stock](size_t s, const jobs::Toolpath& toolpath,
-                                                              double seconds) {
-    // A simulator faster than real: its time, and the machine's it stands for.
-    const std::string machineTime = std::abs(seconds - toolpath.seconds) > 0.5
+                                                              size_t fromStroke, double seconds) {
+    // A simulator faster than real: its time, and the machine's it stands for (of a whole sheet).
+    const std::string machineTime = fromStroke == 0 && std::abs(seconds - toolpath.seconds) > 0.5
                                         ? fmt::format(" ({} on the machine simulated)", minutes(toolpath.seconds))
                                         : "";
-    fmt::print(stderr, "run: sheet {} ({} of {}), {}: {} strokes, {:.1f} in to burn, about {}{}{}\n", toolpath.sheet,
-               s + 1, sheets, stock, toolpath.strokes.size(), toolpath.burnLength, minutes(seconds), machineTime,
-               kitOf(toolpath.sheet));
+    const std::string strokes =
+        fromStroke == 0 ? fmt::format("{} strokes, {:.1f} in to burn", toolpath.strokes.size(), toolpath.burnLength)
+                        : fmt::format("strokes {} to {} (the {} before were cut)", fromStroke + 1,
+                                      toolpath.strokes.size(), fromStroke);
+    fmt::print(stderr, "run: sheet {} ({} of {}), {}: {}, about {}{}{}\n", toolpath.sheet, s + 1, sheets, stock,
+               strokes, minutes(seconds), machineTime, kitOf(toolpath.sheet));
     *bar = ProgressBar(terminal);
   };
   events.framing = [] { fmt::print(stderr, "run: framing (laser off)\n"); };

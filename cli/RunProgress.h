@@ -37,13 +37,20 @@ bool waitForEnter(const core::Cancellation& cancel);
 // (Ctrl-C) or at the end of input.
 std::optional<std::string> readLine(const core::Cancellation& cancel);
 
+// Framing before each sheet (`rotafab run --frame`), and whether to cut
+// once framed without asking (--yes).
+struct TerminalFraming {
+  bool frame = false, yes = false;
+};
+
 // The events of a run of `sheets` sheets shown on standard error: a line as
 // each sheet starts, its progress bar, the question before each sheet after
-// the first (answered at the terminal), the framing. `stock`: what each
+// the first (answered at the terminal), the framing and the question after
+// it ("cut sheet 2 now? [y/N]"). `stock`: what each
 // sheet is (jobs::stockOf(), "posterboard (0.8 mm), 32 x 18 in"); `kits`:
 // each sheet's kit by its number, as the job's manifest says it
 // (ManifestSheets::kits).
 devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
-                                     std::map<int, std::string> kits = {});
+                                     std::map<int, std::string> kits = {}, TerminalFraming framing = {});
 
 }  // namespace rotafab::cli

@@ -42,7 +42,8 @@ class DeviceFault : public std::runtime_error {
   // file): the laser is off whatever the controller says.
   bool nothingSent = false;
   // Where the job stopped (JobRun fills these in): the sheet (1-based, 0
-  // before the first), and the strokes of it the device had acknowledged.
+  // before the first), and the strokes of it the machine had finished
+  // (Progress::strokesCut): a resume goes on from the next.
   int sheet = 0, sheets = 0;
   size_t strokesDone = 0, strokes = 0;
 };
@@ -54,7 +55,12 @@ std::string laserStateAfter(const DeviceFault& fault);
 
 struct Progress {
   int sheet = 1;
-  size_t stroke = 0, strokes = 0;  // strokes finished (acknowledged), of how many
+  size_t stroke = 0, strokes = 0;  // strokes the controller has taken (acknowledged), of how many
+  // Strokes the machine has surely finished cutting: a controller takes
+  // strokes ahead of the head (GRBL's planner holds 15 moves), so this
+  // trails `stroke`. Never more than were cut: a resume from the next
+  // stroke cuts none twice but the one the head was in.
+  size_t strokesCut = 0;
   size_t bytesAcknowledged = 0, bytesTotal = 0;
   double secondsLeft = 0;  // estimated
 };

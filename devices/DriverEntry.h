@@ -68,6 +68,9 @@ class DriverEntry {
   // dry run that opens nothing.
   [[nodiscard]] virtual bool connectsForDryRun(const DeviceAddress& /*address*/) const { return false; }
   [[nodiscard]] virtual std::string dryRunNote(const DeviceAddress& /*address*/) const { return {}; }
+  // Whether the device can trace a sheet's box with the laser off
+  // (Device::frame()); a print spool only writes files.
+  [[nodiscard]] virtual bool frames() const { return true; }
 };
 
 // Every driver, in the order discovery lists what they find.

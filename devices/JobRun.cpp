@@ -42,15 +42,23 @@ JobRun::~JobRun() {
   if (device_) device_->disconnect();
 }
 
+std::vector<jobs::Toolpath> JobRun::toCut() const {
+  std::vector<jobs::Toolpath> cut = toolpaths_;
+  if (!cut.empty() && setup_.fromStroke > 0)
+    cut[0] = jobs::restOfSheet(cut[0], setup_.fromStroke, device_->motionLimits());
+  return cut;
+}
+
 std::string JobRun::writeDryRun(const std::filesystem::path& file) const {
-  jobs::writeFileAtomically(file, device_->program(toolpaths_));
-  return device_->describeProgram(toolpaths_);
+  const std::vector<jobs::Toolpath> cut = toCut();
+  jobs::writeFileAtomically(file, device_->program(cut));
+  return device_->describeProgram(cut);
 }
 
 std::vector<std::string> JobRun::writeDryRunOfEachSheet(
     const std::function<std::filesystem::path(int sheet)>& fileOf) const {
   std::vector<std::string> written;
-  for (const jobs::Toolpath& toolpath : toolpaths_) {
+  for (const jobs::Toolpath& toolpath : toCut()) {
     throwIfCancelled(setup_.cancellation);
     const std::vector<jobs::Toolpath> one{toolpath};
     const std::filesystem::path file = fileOf(toolpath.sheet);
@@ -60,54 +68,73 @@ std::vector<std::string> JobRun::writeDryRunOfEachSheet(
   return written;
 }
 
-RunSummary JobRun::run(bool frame, const RunEvents& events, const core::Cancellation& cancel) {
+RunSummary JobRun::run(const RunEvents& events, const core::Cancellation& cancel) {
   try {
-    return runSheets(frame, events, cancel);
+    return runSheets(events, cancel);
   } catch (const DeviceFault&) {
     if (events.stopped) events.stopped();
     throw;
   }
 }
 
-RunSummary JobRun::runSheets(bool frame, const RunEvents& events, const core::Cancellation& cancel) {
+void JobRun::frameOnly(size_t index, const core::Cancellation& cancel) {
+  const jobs::Toolpath& toolpath = toolpaths_.at(index);
+  try {
+    throwIfCancelled(&cancel);
+    device_->frame(toolpath);
+    throwIfCancelled(&cancel);
+  } catch (DeviceFault& fault) {
+    fault.nothingSent = true;  // moves with the laser off
+    fault.sheet = toolpath.sheet, fault.sheets = static_cast<int>(toolpaths_.size());
+    throw;
+  }
+  device_->disconnect();
+}
+
+RunSummary JobRun::runSheets(const RunEvents& events, const core::Cancellation& cancel) {
   RunSummary summary;
   for (size_t s = 0; s < toolpaths_.size(); ++s) {
-    const jobs::Toolpath& toolpath = toolpaths_[s];
-    // Where a fault finds the job: this sheet, and its strokes acknowledged.
-    // Until the sheet's own run starts, none of it has been sent (framing
-    // moves with the laser off).
-    size_t acknowledged = 0;
+    const jobs::Toolpath& whole = toolpaths_[s];
+    const size_t first = s == 0 ? std::min(setup_.fromStroke, whole.strokes.size()) : 0;
+    // Where a fault finds the job: this sheet, and its strokes cut (those
+    // before `first` were, by the run that stopped). Until the sheet's own
+    // run starts, none of it has been sent (framing moves with the laser off).
+    size_t cut = first;
     bool streaming = false;
     try {
-      // Stop, do not cut blind, unless the next sheet is known to be loaded.
-      const bool loaded = s == 0 || !events.beforeSheet || events.beforeSheet(toolpath);
-      if (!loaded) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
-      throwIfCancelled(&cancel);
-      if (events.sheetStarted) events.sheetStarted(s, toolpath, toolpath.seconds / device_->timeScale());
-      if (frame) {
+      // Stop, do not cut blind, unless told to cut (the sheet loaded, its frame checked).
+      for (bool framed = false;;) {
+        const SheetGo go = events.beforeSheet ? events.beforeSheet(s, whole, framed) : SheetGo::Cut;
+        if (go == SheetGo::Stop) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
+        throwIfCancelled(&cancel);
+        if (go == SheetGo::Cut) break;
         if (events.framing) events.framing();
-        device_->frame(toolpath);
+        device_->frame(whole);
         throwIfCancelled(&cancel);  // a cancel while framing: the laser was never lit
+        framed = true;
       }
+      const jobs::Toolpath rest = first == 0 ? whole : jobs::restOfSheet(whole, first, device_->motionLimits());
+      if (events.sheetStarted) events.sheetStarted(s, whole, first, rest.seconds / device_->timeScale());
       streaming = true;
       device_->run(
-          toolpath,
+          rest,
           [&](Progress progress) {
-            acknowledged = progress.stroke;
+            progress.stroke += first, progress.strokesCut += first, progress.strokes = whole.strokes.size();
+            cut = progress.strokesCut;
             progress.secondsLeft /= device_->timeScale();
             if (events.progress) events.progress(progress);
           },
           cancel);
+      summary.burnt += rest.burnLength, summary.estimated += rest.seconds / device_->timeScale();
+      summary.strokes += rest.strokes.size();
     } catch (DeviceFault& fault) {
       fault.nothingSent = fault.nothingSent || !streaming;
-      fault.sheet = static_cast<int>(s) + 1, fault.sheets = static_cast<int>(toolpaths_.size());
-      fault.strokesDone = acknowledged, fault.strokes = toolpath.strokes.size();
+      fault.sheet = whole.sheet, fault.sheets = static_cast<int>(toolpaths_.size());
+      fault.strokesDone = cut, fault.strokes = whole.strokes.size();
       throw;
     }
     if (events.sheetFinished) events.sheetFinished();
     ++summary.sheets;
-    summary.burnt += toolpath.burnLength, summary.estimated += toolpath.seconds / device_->timeScale();
-    summary.strokes += toolpath.strokes.size();
   }
   device_->disconnect();
   return summary;

@@ -34,15 +34,26 @@ struct JobRunSetup {
   // Checked once connected and for each sheet planned: JobRun() then throws
   // DeviceFault Cancelled (the device is disconnected; nothing was sent).
   const core::Cancellation* cancellation = nullptr;
+  // The first sheet goes on from this stroke (0-based): the strokes before
+  // it were cut by a run that stopped. Framing traces the whole sheet.
+  size_t fromStroke = 0;
 };
 
+// Before a sheet is cut: cut it now, trace its box first with the laser
+// off (and then be asked again), or stop (nothing of it is sent).
+enum class SheetGo { Cut, Frame, Stop };
+
 struct RunEvents {
-  // Before each sheet but the first: whether the next sheet is loaded (if
-  // not, the job stops as cancelled). The command line asks at the
-  // terminal, a daemon waits for its client. Not set: go on.
-  std::function<bool(const jobs::Toolpath& next)> beforeSheet;
-  // Index of all, from 0; the estimated seconds, in real time (Device::timeScale).
-  std::function<void(size_t index, const jobs::Toolpath& toolpath, double seconds)> sheetStarted;
+  // Before each sheet (`index` from 0), and again after each frame of it
+  // (`framed`): whether to cut it, frame it, or stop (the job stops as
+  // cancelled). The command line asks at the terminal whether the next
+  // sheet is loaded, and after a frame whether to cut; a daemon waits for
+  // its client. Not set: cut.
+  std::function<SheetGo(size_t index, const jobs::Toolpath& sheet, bool framed)> beforeSheet;
+  // Index of all, from 0; the whole sheet, the stroke its cut begins at
+  // (JobRunSetup::fromStroke, else 0) and the estimated seconds of what is
+  // left, in real time (Device::timeScale).
+  std::function<void(size_t index, const jobs::Toolpath& sheet, size_t fromStroke, double seconds)> sheetStarted;
   std::function<void()> framing;
   std::function<void(const Progress&)> progress;
   std::function<void()> sheetFinished;
@@ -75,18 +86,25 @@ class JobRun {
   // to back, onto one. Returns what each holds, in the sheets' order.
   std::vector<std::string> writeDryRunOfEachSheet(const std::function<std::filesystem::path(int sheet)>& fileOf) const;
 
-  // Runs every sheet, each framed first if asked. Throws DeviceFault: the
-  // driver has stopped the machine and says whether the controller
-  // confirmed the laser off; a cancel is FaultKind::Cancelled.
-  RunSummary run(bool frame, const RunEvents& events, const core::Cancellation& cancel);
+  // Runs every sheet, each framed first where beforeSheet asks. Throws
+  // DeviceFault: the driver has stopped the machine and says whether the
+  // controller confirmed the laser off; a cancel is FaultKind::Cancelled.
+  // Progress is the whole sheet's (strokes counted from its first).
+  RunSummary run(const RunEvents& events, const core::Cancellation& cancel);
+
+  // Traces the box of the sheet at `index` (of the setup's) with the laser
+  // off, and disconnects; nothing is cut. Throws DeviceFault as run().
+  void frameOnly(size_t index, const core::Cancellation& cancel);
 
   // From another thread while run() goes on.
   void pause() { device_->pause(); }
   void resume() { device_->resume(); }
 
  private:
-  RunSummary runSheets(bool frame, const RunEvents& events, const core::Cancellation& cancel);
+  RunSummary runSheets(const RunEvents& events, const core::Cancellation& cancel);
   void throwIfCancelled(const core::Cancellation* cancel) const;
+  // The sheets as a dry run writes them: the first from JobRunSetup::fromStroke.
+  [[nodiscard]] std::vector<jobs::Toolpath> toCut() const;
 
   JobRunSetup setup_;
   std::unique_ptr<Device> device_;

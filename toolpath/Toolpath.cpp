@@ -193,6 +193,20 @@ std::vector<std::vector<Point2>> orderForTravel(const std::vector<Candidate>& ca
   return out;
 }
 
+// Its burn and travel lengths, and its time on a machine of `limits`.
+void measure(Toolpath& toolpath, const MotionLimits& limits) {
+  toolpath.burnLength = toolpath.travelLength = 0;
+  Point2 head(0, 0);
+  for (const ToolpathStroke& stroke : toolpath.strokes) {
+    toolpath.travelLength += (stroke.points.front() - head).norm();
+    for (size_t i = 1; i < stroke.points.size(); ++i)
+      toolpath.burnLength += (stroke.points[i] - stroke.points[i - 1]).norm();
+    head = stroke.points.back();
+  }
+  toolpath.travelLength += head.norm();
+  toolpath.seconds = estimateSeconds(toolpath, limits);
+}
+
 }  // namespace
 
 Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
@@ -256,16 +270,16 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
       }
     }
   }
-  Point2 head(0, 0);
-  for (const ToolpathStroke& stroke : toolpath.strokes) {
-    toolpath.travelLength += (stroke.points.front() - head).norm();
-    for (size_t i = 1; i < stroke.points.size(); ++i)
-      toolpath.burnLength += (stroke.points[i] - stroke.points[i - 1]).norm();
-    head = stroke.points.back();
-  }
-  toolpath.travelLength += head.norm();
-  toolpath.seconds = estimateSeconds(toolpath, limits);
+  measure(toolpath, limits);
   return toolpath;
+}
+
+Toolpath restOfSheet(const Toolpath& toolpath, size_t firstStroke, const MotionLimits& limits) {
+  Toolpath rest = toolpath;
+  rest.strokes.erase(rest.strokes.begin(),
+                     rest.strokes.begin() + static_cast<std::ptrdiff_t>(std::min(firstStroke, rest.strokes.size())));
+  measure(rest, limits);
+  return rest;
 }
 
 MotionLimits profileMotion(const profiles::MachineProfile& profile) {

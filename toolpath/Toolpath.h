@@ -61,6 +61,10 @@ MotionLimits profileMotion(const profiles::MachineProfile& profile);
 Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile& machine,
                       const profiles::MaterialProfile& material, const MotionLimits& limits);
 
+// The rest of a sheet from stroke `firstStroke` on (0-based; the strokes
+// before it were cut): a stopped sheet's resume. Lengths and time are the rest's.
+Toolpath restOfSheet(const Toolpath& toolpath, size_t firstStroke, const MotionLimits& limits);
+
 // The head's moves: from the origin to each stroke's start at the rapid
 // rate, along the stroke at its speed, and back to the origin once the
 // laser is off (after a stop: switching it off waits for the motion).

@@ -70,7 +70,7 @@ bool isLoopbackHost(std::string_view host) {
 std::string notFound(const RequestTarget& target) {
   const auto& parts = target.parts;
   if (parts.size() == 4 && parts[0] == "api" && parts[1] == "jobs") {
-    return fmt::format("no action {} (cancel, pause, resume, start, next, move)", parts[3]);
+    return fmt::format("no action {} (cancel, pause, resume, start, next, move, frame)", parts[3]);
   }
   if (!parts.empty() && parts[0] == "api") return fmt::format("no such resource: {}", target.path());
   return fmt::format("no such page: {} (the page is at /, the API under /api; see docs/API.md)", target.path());

@@ -191,8 +191,12 @@ json checkedActionArguments(std::string_view action, const json& body) {
     }
   };
   if (action == "resume") {
-    takes({kFromSheetField.name});
+    takes({kFromSheetField.name, kFromStrokeField.name});
     if (body.contains("from_sheet")) checked["from_sheet"] = wholeNumber(body["from_sheet"], kFromSheetField);
+    if (body.contains("from_stroke")) checked["from_stroke"] = wholeNumber(body["from_stroke"], kFromStrokeField);
+  } else if (action == "frame") {
+    takes({kSheetField.name});
+    if (body.contains("sheet")) checked["sheet"] = wholeNumber(body["sheet"], kSheetField);
   } else if (action == "move") {
     takes({kBeforeField.name, kPriorityField.name});
     if (body.contains("before")) checked["before"] = wholeNumber(body["before"], kBeforeField);

@@ -24,6 +24,7 @@ struct NumberField {
 constexpr int64_t kLargestJobId = 9007199254740991;
 constexpr NumberField kPriorityField{"priority", -1000000, 1000000};
 constexpr NumberField kFromSheetField{"from_sheet", 1, 1000000};
+constexpr NumberField kFromStrokeField{"from_stroke", 1, 100000000};
 constexpr NumberField kBeforeField{"before", 1, kLargestJobId};
 constexpr NumberField kJobField{"job", 1, kLargestJobId};
 constexpr NumberField kSheetField{"sheet", 1, 1000000};

@@ -71,7 +71,7 @@ std::optional<MatchedRoute> matchRoute(const std::vector<std::string>& parts) {
   const std::string& job = parts[2];
   if (n == 3) return MatchedRoute{Route::Job, job, ""};
   if (n == 4 && is(3, "manifest")) return MatchedRoute{Route::JobManifest, job, ""};
-  static const std::array<const char*, 6> kActions{"cancel", "pause", "resume", "start", "next", "move"};
+  static const std::array<const char*, 7> kActions{"cancel", "pause", "resume", "start", "next", "move", "frame"};
   if (n == 4 && std::find(kActions.begin(), kActions.end(), parts[3]) != kActions.end()) {
     return MatchedRoute{Route::JobAction, job, parts[3]};
   }

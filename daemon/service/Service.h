@@ -87,8 +87,8 @@ class Service {
   // Sheet `sheet` (from 1) as its device's laser would burn it: the strokes
   // in order, each with its operation and pass, and the time it takes.
   void sheet(JobId id, int sheet, ReplyHandler done);
-  // cancel, pause, resume, start, next, move; `arguments`: resume's
-  // from_sheet, move's before or priority, as checkedActionArguments()
+  // cancel, pause, resume, start, next, move, frame; `arguments`: resume's
+  // from_sheet and from_stroke, move's before or priority, frame's sheet, as checkedActionArguments()
   // (ApiInput.h) left them; `who` for the record.
   void act(JobId id, const std::string& action, const nlohmann::json& arguments, const std::string& who,
            ReplyHandler done);

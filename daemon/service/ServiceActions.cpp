@@ -31,7 +31,7 @@ Reply Service::Impl::act(JobId id, const std::string& action, const json& argume
   // (its driver, its planner): the action is left for it in the store,
   // and it acts within half a second (Impl::serveRequests).
   if (heldByAHost(job.state) && !job.host.empty() && job.host != config.host &&
-      (action == "cancel" || action == "pause" || action == "resume" || action == "next")) {
+      (action == "cancel" || action == "pause" || action == "resume" || action == "next" || action == "frame")) {
     return askItsHost(job, action, arguments, who);
   }
   // (Held by this host, a job is in `planning` or `cuts` until it leaves that state.)
@@ -53,8 +53,9 @@ Reply Service::Impl::act(JobId id, const std::string& action, const json& argume
     return {200, jobJson(store->job(id).value())};
   }
   if (action == "next") return nextSheet(job, who);
+  if (action == "frame") return frameJob(job, arguments, who);
   if (action == "move") return moveJob(job, arguments, who);
-  throw ApiError(404, fmt::format("no action {} (cancel, pause, resume, start, next, move)", action));
+  throw ApiError(404, fmt::format("no action {} (cancel, pause, resume, start, next, move, frame)", action));
 }
 
 void Service::Impl::cancelCut(Cut& cut, const std::string& who) {
@@ -63,7 +64,7 @@ void Service::Impl::cancelCut(Cut& cut, const std::string& who) {
   // stops from there, without moving again.)
   cut.control->cancel.cancel();
   if (cut.waiting) {
-    cut.waiting->set_value(false);
+    cut.waiting->set_value(devices::SheetGo::Stop);
     cut.waiting.reset();
   }
 }
@@ -74,7 +75,7 @@ Reply Service::Impl::askItsHost(const JobRecord& job, const std::string& action,
   if (action == "resume" && job.state != JobState::Paused) {
     refuse(job, "; only a paused, interrupted or failed job can be resumed");
   }
-  if (action == "next" && job.state != JobState::Running) {
+  if ((action == "next" || action == "frame") && job.state != JobState::Running) {
     refuse(job, "; only a job waiting between sheets takes `next`");
   }
   ActionRequest request;
@@ -102,6 +103,7 @@ Reply Service::Impl::cancelJob(const JobRecord& job, const std::string& who) {
     cancelCut(*cuts.at(id), who);
     return {202, jobJson(job)};
   }
+  if (auto c = cuts.find(id); c != cuts.end()) cancelCut(*c->second, who);  // its frame, stopped
   if (job.state == JobState::Done || job.state == JobState::Cancelled) refuse(job, "; there is nothing to cancel");
   const JobRecord cancelled = record(id, JobState::Cancelled, fmt::format("cancelled by {}", who));
   jobChanged(cancelled);
@@ -141,8 +143,70 @@ Reply Service::Impl::resumeJob(const JobRecord& job, const json& arguments, cons
                                     sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes)));
   }
   const int from = arguments["from_sheet"].get<int>();
-  startCut(job, from, fmt::format("resumed by {} from sheet {}", who, from));
+  // The sheet it stopped in goes on from the first stroke not cut (framed
+  // first, and only once its operator says it is in place); `from_stroke`
+  // 1 cuts it whole again.
+  int64_t fromStroke = from == job.sheet && job.stroke > 0 && job.stroke < job.strokes ? job.stroke : 0;
+  if (arguments.contains("from_stroke")) {
+    if (from != job.sheet && arguments["from_stroke"].get<int64_t>() != 1) {
+      throw ApiError(
+          400, fmt::format("job {} stopped in sheet {}: sheet {} goes on from its first stroke", id, job.sheet, from));
+    }
+    fromStroke = arguments["from_stroke"].get<int64_t>() - 1;
+    if (fromStroke >= job.strokes && job.strokes > 0) {
+      throw ApiError(400,
+                     fmt::format("sheet {} of job {} has {} strokes, not {}", from, id, job.strokes, fromStroke + 1));
+    }
+  }
+  startCut(job, from,
+           fromStroke > 0 ? fmt::format("resumed by {} from sheet {}, stroke {}", who, from, fromStroke + 1)
+                          : fmt::format("resumed by {} from sheet {}", who, from),
+           fromStroke);
   return {200, jobJson(store->job(id).value())};
+}
+
+Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const std::string& who) {
+  const JobId id = job.id;
+  if (auto c = cuts.find(id); c != cuts.end()) {
+    // Being cut: only between sheets, by its own cut, and only the sheet it waits for.
+    Cut& cut = *c->second;
+    if (!cut.waiting) {
+      refuse(job, cut.frameOnly ? fmt::format(", and its sheet {} is being framed", cut.sheet)
+                                : fmt::format(", cutting sheet {} of {}: a sheet is framed before its cut, while the "
+                                              "job waits for it",
+                                              job.sheet, job.sheets));
+    }
+    if (!devices::parseDeviceUri(devices[cut.device].config.uri).driver->frames()) {
+      throw ApiError(409, fmt::format("{} writes files for a print driver and moves no head to frame a sheet with",
+                                      devices[cut.device].config.name));
+    }
+    if (arguments.contains("sheet") && arguments["sheet"].get<int>() != cut.sheet) {
+      throw ApiError(
+          409, fmt::format("job {} waits for {}; only sheet {} can be framed now", id, cut.waitingFor, cut.sheet));
+    }
+    cut.waiting->set_value(devices::SheetGo::Frame);
+    cut.waiting.reset();
+    cut.waitingFor.clear();
+    store->addEvent(id, "frame", fmt::format("{} asked for a frame of sheet {}", who, cut.sheet));
+    jobChanged(job);
+    json answer = jobJson(job);
+    answer["framing_sheet"] = cut.sheet;
+    return {202, answer};
+  }
+  if (holdsDevice(job.state) || job.state == JobState::Queued || job.state == JobState::Planning ||
+      job.state == JobState::Done || job.sheets == 0) {
+    refuse(job, job.state == JobState::Done ? "; its sheets are cut" : "; only a planned job's sheets can be framed");
+  }
+  const int sheet = arguments.contains("sheet") ? arguments["sheet"].get<int>() : std::max(1, job.sheet);
+  if (sheet > job.sheets) throw ApiError(400, fmt::format("job {} has sheets 1 to {}, not {}", id, job.sheets, sheet));
+  Device& device = idleDeviceFor(job);
+  if (!devices::parseDeviceUri(device.config.uri).driver->frames()) {
+    throw ApiError(409, fmt::format("{} writes files for a print driver and moves no head to frame a sheet with",
+                                    device.config.name));
+  }
+  store->addEvent(id, "frame", fmt::format("{} asked for a frame of sheet {} on {}", who, sheet, device.config.name));
+  launchCut(job, device, sheet, 0, true);
+  return {202, jobJson(store->job(id).value())};
 }
 
 Reply Service::Impl::nextSheet(const JobRecord& job, const std::string& who) {
@@ -153,9 +217,10 @@ Reply Service::Impl::nextSheet(const JobRecord& job, const std::string& who) {
                                                              job.sheet, job.sheets)
                                                : std::string("; only a job waiting between sheets takes `next`"));
   }
-  c->second->waiting->set_value(true);
+  c->second->waiting->set_value(devices::SheetGo::Cut);
   c->second->waiting.reset();
-  store->addEvent(job.id, "next", fmt::format("{} loaded sheet {}", who, job.sheet + 1));
+  c->second->waitingFor.clear();
+  store->addEvent(job.id, "next", fmt::format("{} said sheet {} is in place", who, c->second->sheet));
   return {200, jobJson(job)};
 }
 

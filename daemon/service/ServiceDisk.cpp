@@ -19,7 +19,7 @@ void Service::Impl::stopCutByItself(Cut& cut, const std::string& because) {
   cut.control->shutdown = true;
   cut.control->cancel.cancel();
   if (cut.waiting) {
-    cut.waiting->set_value(false);
+    cut.waiting->set_value(devices::SheetGo::Stop);
     cut.waiting.reset();
   }
 }

@@ -85,9 +85,9 @@ void Service::Impl::open() {
 
 std::pair<JobState, std::string> Service::Impl::released(const JobRecord& job, const std::string& who) {
   if (holdsDevice(job.state)) {
-    return {JobState::Interrupted,
-            fmt::format("{} stopped while it cut, {}; check the machine, then load sheet {} and resume from it", who,
-                        sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes), std::max(1, job.sheet))};
+    return {JobState::Interrupted, fmt::format("{} stopped while it cut, {}; check the machine, then {}", who,
+                                               sheetWhere(job.sheet, job.sheets, job.stroke, job.strokes),
+                                               goOnSaid(std::max(1, job.sheet), job.stroke, job.strokes))};
   }
   return {JobState::Queued, fmt::format("{} stopped while it planned; it is planned again", who)};
 }

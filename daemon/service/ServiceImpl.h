@@ -66,6 +66,9 @@ std::string inSubmittersWords(std::string message, const fs::path& folder, const
 
 // Where a cut stopped, for messages: "at sheet 2 of 4, after stroke 10 of 90".
 std::string sheetWhere(int sheet, int sheets, int64_t stroke, int64_t strokes);
+// How a job stopped in `sheet` with `cut` of its strokes cut goes on: from
+// the next stroke, after a frame; from the sheet's start when none or all were cut.
+std::string goOnSaid(int sheet, int64_t cut, int64_t strokes);
 
 // Between a running job's driver thread and the strand.
 struct RunControl {
@@ -106,10 +109,16 @@ struct Service::Impl {
     size_t device = 0;
     int firstSheet = 1;
     json progress;
-    std::optional<std::promise<bool>> waiting;  // set while the job waits for `next`
+    // Set while the job waits for its operator: `next` cuts, `frame` traces
+    // the sheet first, a cancel stops. `waitingFor` says for what.
+    std::optional<std::promise<devices::SheetGo>> waiting;
+    std::string waitingFor;
+    bool frameOnly = false;  // a frame of a job not being cut: its state stays as it was
+    int sheet = 1;           // the sheet framed (frameOnly), or waited for
     std::string cancelledBy;
     std::string stoppedBecause;  // stopped by the daemon for this (a full disk): interrupted
     Clock::time_point lastStored{}, lastSent{};
+    int64_t storedCut = -1;  // the strokes cut, as last stored
   };
 
   Impl(asio::io_context& io, const DaemonConfig& config, std::shared_ptr<spdlog::logger> log)
@@ -332,7 +341,9 @@ struct Service::Impl {
   // (this host's before the others') whose machine profile the job's
   // options do not rule out. It reads only what open() set and the other
   // hosts' devices under their lock, so a submission may ask it off the strand.
-  std::optional<Target> deviceFor(const std::string& named, const std::string& options, std::string& why);
+  // `madeFor`: the machine a planned folder was made for, unless the options name one.
+  std::optional<Target> deviceFor(const std::string& named, const std::string& options, std::string& why,
+                                  const std::string& madeFor = "");
 
   static std::string planningReason(const Target& device);
 
@@ -368,10 +379,20 @@ struct Service::Impl {
   // Otherwise another host's device: the job is started there.
   Device& localDeviceFor(const JobRecord& job);
 
-  void startCut(const JobRecord& job, int fromSheet, const std::string& reason);
+  // `fromStroke` (0-based): the strokes of the first sheet cut before; the
+  // cut frames that sheet and waits for its operator before it goes on.
+  void startCut(const JobRecord& job, int fromSheet, const std::string& reason, int64_t fromStroke = 0);
 
-  // A job this host moved to running on `device`: its cut on a thread of its own.
-  void launchCut(const JobRecord& job, Device& on, int fromSheet);
+  // Where a job's cut would go on: the device it would be cut on, idle.
+  Device& idleDeviceFor(const JobRecord& job);
+
+  // A job this host moved to running on `device` (or, `frameOnly`, whose
+  // sheet `fromSheet` is framed on it): its cut on a thread of its own.
+  void launchCut(const JobRecord& job, Device& on, int fromSheet, int64_t fromStroke, bool frameOnly = false);
+
+  // The frame of a sheet: of the job waiting for its next sheet, traced by
+  // its cut; of a job not being cut, on the device it would be cut on.
+  Reply frameJob(const JobRecord& job, const json& arguments, const std::string& who);
 
   // The material a planned job is cut with: the one its manifest names (it
   // was made for it: kerf, power, speed, passes), else the device's.
@@ -381,14 +402,29 @@ struct Service::Impl {
                                                           const profiles::MaterialProfile& device) const;
 
   // On the job's own thread: the driver's loop, its events posted to the strand.
-  void runCut(JobId id, const std::shared_ptr<RunControl>& control, const std::string& uri,
-              const profiles::MachineProfile& machine, const profiles::MaterialProfile& material,
-              const fs::path& folder, int fromSheet, int sheets);
+  struct CutSetup {
+    std::string uri;
+    profiles::MachineProfile machine;
+    profiles::MaterialProfile material;
+    fs::path folder;
+    int fromSheet = 1, sheets = 0;
+    int64_t fromStroke = 0;
+    bool frameOnly = false;
+  };
+  void runCut(JobId id, const std::shared_ptr<RunControl>& control, const CutSetup& setup);
+  // On the cut's thread: waits until the operator says what to do, the
+  // job told as waiting for `what` ("sheet 3 to be loaded").
+  devices::SheetGo waitForOperator(JobId id, const std::shared_ptr<RunControl>& control, int sheet,
+                                   const std::string& what);
 
-  void cutProgress(JobId id, const devices::Progress& progress, int sheet, int sheets);
+  void cutProgress(JobId id, const devices::Progress& progress, int sheets);
 
   void cutEnded(JobId id, const std::optional<devices::DeviceFault>& fault, const std::optional<std::string>& failure,
                 const devices::RunSummary& summary);
+
+  // A frame of a job not being cut has ended: said in the job's events.
+  void frameEnded(JobId id, const Cut& cut, Device& device, const std::optional<devices::DeviceFault>& fault,
+                  const std::optional<std::string>& failure);
 
   // A stop asked for, once every cut and plan has ended: its `done` called.
   void finishIfStopping();

@@ -135,7 +135,7 @@ void Service::Impl::pump() {
                        });
       for (const JobRecord& job : claimed) {
         try {
-          launchCut(job, device, 1);
+          launchCut(job, device, 1, 0);
         } catch (const std::exception& error) {
           // Claimed but not started: not left running with nothing cutting it.
           log->error("job {}: {}", job.id, error.what());
@@ -153,8 +153,8 @@ auto Service::Impl::targetOf(const Device& device, const std::string& host) -> T
   return {device.config.name, host, device.machine, device.material};
 }
 
-auto Service::Impl::deviceFor(const std::string& named, const std::string& options, std::string& why)
-    -> std::optional<Target> {
+auto Service::Impl::deviceFor(const std::string& named, const std::string& options, std::string& why,
+                              const std::string& madeFor) -> std::optional<Target> {
   std::vector<Target> all;
   for (const Device& device : devices) all.push_back(targetOf(device, config.host));
   {
@@ -163,9 +163,32 @@ auto Service::Impl::deviceFor(const std::string& named, const std::string& optio
   }
   std::string names;
   for (const Target& target : all) names += (names.empty() ? "" : ", ") + target.name;
+  std::string machine = madeFor;
+  try {
+    if (const auto given = storedOptions(options); given && given->given.contains("machine")) {
+      machine = given->machine;
+    }
+  } catch (const ApiError&) {
+    // (Its plan says what is wrong with them.)
+  }
   if (!named.empty()) {
     for (const Target& target : all) {
-      if (target.name == named) return target;
+      if (target.name != named) continue;
+      // Planned for one machine, cut on another's bed and settings: refused now, not when it fails.
+      if (!machine.empty() && target.machine.name != machine) {
+        std::string same;
+        for (const Target& other : all) {
+          if (other.machine.name == machine) same += (same.empty() ? "" : ", ") + other.name;
+        }
+        why = fmt::format(
+            "device {} is a {}, not the {} {}: {}, or name a device of that machine{}", named, target.machine.name,
+            machine, madeFor.empty() ? "asked for" : "the folder was made for",
+            madeFor.empty() ? fmt::format("leave out the machine (the job is planned for {}'s)", named)
+                            : fmt::format("make it again with --machine {}", target.machine.name),
+            same.empty() ? fmt::format(" (none here has it; the devices: {})", names) : fmt::format(" ({})", same));
+        return std::nullopt;
+      }
+      return target;
     }
     why = fmt::format("there is no device {} (the devices: {})", named, names);
     return std::nullopt;
@@ -173,14 +196,6 @@ auto Service::Impl::deviceFor(const std::string& named, const std::string& optio
   if (all.empty()) {
     why = "the daemon has no devices";
     return std::nullopt;
-  }
-  std::string machine;
-  try {
-    if (const auto given = storedOptions(options); given && given->given.contains("machine")) {
-      machine = given->machine;
-    }
-  } catch (const ApiError&) {
-    // (Its plan says what is wrong with them.)
   }
   for (const Target& target : all) {
     if (machine.empty() || target.machine.name == machine) return target;
@@ -225,8 +240,15 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
 
 void Service::Impl::planOnSubmission(NewJob& job, const fs::path& folder, const fs::path& submitted) {
   std::string why;
-  const std::optional<Target> device = deviceFor(job.device, job.options, why);
-  if (!device) throw ApiError(409, why);
+  // A folder made for a machine is cut on a device of that machine.
+  std::optional<std::string> madeFor;
+  try {
+    madeFor = jobs::jobProfileNames(folder).machine;
+  } catch (const std::exception&) {
+    // (An unreadable manifest: its plan says what is wrong.)
+  }
+  const std::optional<Target> device = deviceFor(job.device, job.options, why, madeFor.value_or(""));
+  if (!device) throw ApiError(409, inSubmittersWords(why, folder, submitted));
   json summary;
   try {
     summary = planOfFolder(folder, device->machine, device->material);

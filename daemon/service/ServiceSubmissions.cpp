@@ -103,7 +103,7 @@ void Service::submit(Submission submission, ReplyHandler done) {
       if (!submission.device.empty()) {
         // (Any host's: on a shared store a job may be submitted here for a device of another.)
         std::string why;
-        if (!impl.deviceFor(submission.device, "", why)) throw ApiError(400, why);
+        if (!impl.deviceFor(submission.device, job.options, why)) throw ApiError(400, why);
       }
       if (submission.upload) {
         // (Its mesh already written, a piece at a time, as it arrived: UploadForm.h.)

@@ -4,6 +4,18 @@ namespace rotafab::service {
 
 namespace {
 
+// The sheets cut whole, as the job's cut left them: those before the one it
+// is at, and that one too once its every stroke is cut (a job waiting for
+// its next sheet, or stopped at a sheet's end), whatever became of the job since.
+int sheetsCut(const JobRecord& job) {
+  if (job.state == JobState::Done) return job.sheets;
+  if (job.sheet <= 0 || job.state == JobState::Queued || job.state == JobState::Planning ||
+      job.state == JobState::Ready) {
+    return 0;
+  }
+  return std::min(job.sheets, job.sheet - 1 + (job.strokes > 0 && job.stroke >= job.strokes ? 1 : 0));
+}
+
 // A sheet's toolpath for people (docs/API.md, GET /api/jobs/ID/sheets/N): every
 // stroke in the order the laser burns it, so that the stroke a cut's
 // progress counts is the stroke at that index; to a thousandth of an inch.
@@ -93,6 +105,7 @@ json Service::Impl::jobJson(const JobRecord& stored) const {
            {"sheet", job.sheet},
            {"stroke", job.stroke},
            {"strokes", job.strokes},
+           {"sheets_cut", sheetsCut(job)},
            {"message", job.message}};
   out["host"] = job.host.empty() ? json(nullptr) : json(job.host);
   // (As the words of `rotafab make`, as the API has always shown them.)
@@ -109,6 +122,8 @@ json Service::Impl::jobJson(const JobRecord& stored) const {
   if (const auto c = cuts.find(job.id); c != cuts.end()) {
     if (!c->second->progress.is_null()) out["progress"] = c->second->progress;
     out["waiting_for_next"] = c->second->waiting.has_value();
+    if (c->second->waiting) out["waiting_for"] = c->second->waitingFor, out["waiting_sheet"] = c->second->sheet;
+    if (c->second->frameOnly) out["framing_sheet"] = c->second->sheet;
   }
   return out;
 }
@@ -154,6 +169,12 @@ void Service::status(JobId id, ReplyHandler done) {
                              {"reason", t.reason}});
     }
     out["transitions"] = transitions;
+    // What happened within its states, newest last: sheets started, frames, the operator's word.
+    json events = json::array();
+    for (const Event& event : impl_->store->events(id, 20)) {
+      events.push_back({{"at", isoTime(event.at)}, {"kind", event.kind}, {"text", event.text}});
+    }
+    out["events"] = events;
     return Reply{200, out};
   });
 }

@@ -26,7 +26,9 @@ export function renderDevices() {
       device.message ? element('p', { class: 'device-message' }, device.message) : null,
       device.job ? element('p', {}, `job ${device.job}` + (cutting ? `, sheet ${progress.sheet} of ${progress.sheets}` : '')) : null,
       waitingJob(device) ? element('p', { class: 'waiting' },
-        `waiting for sheet ${waitingJob(device).sheet + 1} to be loaded`) : null,
+        `waiting for ${waitingJob(device).waiting_for || `sheet ${waitingJob(device).sheet + 1} to be loaded`}`) : null,
+      progress && progress.phase === 'framing'
+        ? element('p', { class: 'waiting' }, `framing sheet ${progress.sheet} (laser off)`) : null,
       fraction !== null
         ? element('progress', { max: '1', value: String(fraction), 'data-percent': String(Math.round(fraction * 100)) })
         : null,

@@ -24,6 +24,19 @@ function cutWith(job) {
   return element('div', { class: 'cut-with' }, `${summary.material} on ${summary.machine}`);
 }
 
+// A job waiting for its operator after a frame (not for a sheet to be loaded).
+function framedWaiting(job) {
+  return (job.waiting_for || '').includes('framed');
+}
+
+// What a waiting job waits for, in the words of its buttons.
+function waitingSaid(job) {
+  if (framedWaiting(job)) return `${job.waiting_for}: press “In place: cut”, or “Frame” to trace it again`;
+  const sheet = job.waiting_sheet || job.sheet + 1;
+  return `sheet ${sheet - 1} cut: load sheet ${sheet}${whatToLoad(job, sheet)}, then press “Next sheet loaded” `
+    + '(“Frame” traces it first)';
+}
+
 function actionsOf(job) {
   const buttons = [];
   const act = (label, action, body, extra = {}) =>
@@ -45,12 +58,18 @@ function actionsOf(job) {
       if (unable) {
         buttons.push(element('span', { class: 'unable' },
           `${unable.name} is ${unable.state}${unable.message ? `: ${unable.message}` : ''}`));
+      } else if (job.framing_sheet) {
+        buttons.push(element('span', { class: 'unable' }, `framing sheet ${job.framing_sheet}…`));
       } else {
         act('Start', 'start', {}, { class: 'primary' });
+        act('Frame', 'frame', { sheet: 1 }, { title: 'Trace sheet 1’s box with the laser off, to check where it is' });
       }
       break;
     case 'running':
-      if (job.waiting_for_next) act('Next sheet loaded', 'next', {}, { class: 'primary' });
+      if (job.waiting_for_next) {
+        act(framedWaiting(job) ? 'In place: cut' : 'Next sheet loaded', 'next', {}, { class: 'primary' });
+        act('Frame', 'frame', {}, { title: `Trace sheet ${job.waiting_sheet}’s box with the laser off` });
+      }
       act('Pause', 'pause');
       break;
     case 'paused':
@@ -60,9 +79,21 @@ function actionsOf(job) {
     case 'failed':
       // Only a cut that was under way goes on; a plan that failed has no sheets.
       if (!job.sheets || !job.sheet) break;
+      if (job.framing_sheet) {
+        buttons.push(element('span', { class: 'unable' }, `framing sheet ${job.framing_sheet}…`));
+        break;
+      }
+      if (!unable) {
+        act('Frame', 'frame', { sheet: job.sheet },
+          { title: `Trace sheet ${job.sheet}’s box with the laser off, to check where it is` });
+      }
       act('Resume from sheet…', 'resume', () => {
-        const answer = window.prompt(`Cut again from which sheet (1 to ${job.sheets})? Load it fresh first.`,
-                                     String(Math.max(1, job.sheet || 1)));
+        const goesOn = job.stroke > 0 && job.stroke < job.strokes;
+        const answer = window.prompt(goesOn
+          ? `Go on from which sheet (1 to ${job.sheets})? Sheet ${job.sheet}, left where it is, is framed and goes on `
+            + `from stroke ${job.stroke + 1} once you say it is in place; another sheet is cut whole, loaded fresh.`
+          : `Cut again from which sheet (1 to ${job.sheets})? Load it fresh first.`,
+        String(Math.max(1, job.sheet || 1)));
         return answer === null ? null : { from_sheet: Number(answer) };
       });
       break;
@@ -98,9 +129,7 @@ export function renderJobs() {
       element('td', {}, String(job.id)),
       element('td', {}, job.source || '', cutWith(job)),
       element('td', {}, element('span', { class: `state ${job.state}` }, job.state),
-              element('span', { class: 'message' }, job.waiting_for_next
-                ? `sheet ${job.sheet} cut: load sheet ${job.sheet + 1}${whatToLoad(job, job.sheet + 1)}, then press “Next sheet loaded”`
-                : job.message || ''),
+              element('span', { class: 'message' }, job.waiting_for_next ? waitingSaid(job) : job.message || ''),
               warningsOf(job)),
       element('td', {}, job.owner || ''),
       // On a shared store, the host that plans or cuts it: laser2@room-2.

@@ -14,11 +14,7 @@ export function duration(seconds) {
 
 export function sheetsDone(job) {
   if (!job.sheets) return '–';
-  if (job.state === 'done') return `${job.sheets}/${job.sheets}`;
-  if (['running', 'paused', 'interrupted', 'failed'].includes(job.state)) {
-    return `${Math.max(0, (job.sheet || 0) - 1)}/${job.sheets}`;
-  }
-  return `0/${job.sheets}`;
+  return `${job.sheets_cut || 0}/${job.sheets}`;
 }
 
 // Each sheet's estimate in real time: the profile's estimates scaled as

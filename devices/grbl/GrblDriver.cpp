@@ -8,6 +8,7 @@
 #include <regex>
 #include <thread>
 
+#include "devices/grbl/CutTracker.h"
 #include "devices/grbl/GrblCodes.h"
 
 namespace rotafab::devices::grbl {
@@ -267,7 +268,8 @@ DeviceStatus GrblDriver::status() {
   }
 }
 
-void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter) {
+void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter,
+                          const std::function<void(const std::string&)>& reported) {
   // As long as status reports come and the position changes, the machine is working (or held).
   bool idleBefore = false;
   StallWatch stall(stallAfter);
@@ -290,6 +292,7 @@ void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel, Mill
       }
       if (line->starts_with("ALARM:")) throw alarmFault(link_->name(), *line);
       report = parseStatusReport(*line);
+      if (report && reported) reported(*line);
     }
     // Two Idle reports in a row: one may have been on its way from before the last lines ran.
     if (report->state == "Idle" && idleBefore) return;
@@ -345,6 +348,16 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
   auto idleSince = lastHeard;
   int garbled = 0;
   StallWatch stall(timeouts_.answer);
+  CutTracker cut(program, plannerBlocks_);
+  // A report that shows the head further on: the strokes behind it are cut.
+  const auto placeHead = [&](const std::string& report) {
+    const size_t before = cut.strokesCut();
+    cut.observe(report, acknowledged);
+    if (cut.strokesCut() != before) {
+      state.strokesCut = cut.strokesCut();
+      if (progress) progress(state);
+    }
+  };
   holdRequested_ = false, resumeRequested_ = false;  // none left over from an earlier job
   try {
     while (acknowledged < lines.size()) {
@@ -397,6 +410,8 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
           state.secondsLeft = std::max(0.0, timing.seconds - timing.endsAt[move]);
         }
         ++acknowledged;
+        cut.acknowledged(acknowledged);
+        state.strokesCut = cut.strokesCut();
         state.stroke =
             static_cast<size_t>(std::upper_bound(program.strokeEnds.begin(), program.strokeEnds.end(), acknowledged) -
                                 program.strokeEnds.begin());
@@ -410,6 +425,7 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
         if (status->state.starts_with("Alarm")) {
           throw DeviceFault(FaultKind::Alarm, link_->name() + ": the controller went into alarm");
         }
+        placeHead(*line);
         if (status->state == "Idle" && !inFlight.empty()) {
           if (!idle) idle = true, idleSince = std::chrono::steady_clock::now();
           if (std::chrono::steady_clock::now() - idleSince > timeouts_.answer) {
@@ -432,7 +448,11 @@ void GrblDriver::run(const jobs::Toolpath& toolpath, const std::function<void(co
     // Every line is in the planner: wait for the motion to end.
     waitIdle(timeouts_.answer, &cancel,
              stallBound(timing.endsAt, program, lines.size() > plannerBlocks_ ? lines.size() - plannerBlocks_ : 0,
-                        lines.size(), timeouts_.answer, timeScale_));
+                        lines.size(), timeouts_.answer, timeScale_),
+             placeHead);
+    cut.finished();
+    state.strokesCut = cut.strokesCut();
+    if (progress) progress(state);
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }

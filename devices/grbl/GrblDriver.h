@@ -66,7 +66,9 @@ class GrblDriver : public Device {
   std::string expectLine(Millis timeout, const char* waitingFor);
   // Polls until the controller is Idle; throws on silence, an alarm, a cancel,
   // or a stall (Run at one position for `stallAfter`).
-  void waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter = Millis(30000));
+  // `reported`: told each status report line on the way.
+  void waitIdle(Millis silence, const core::Cancellation* cancel, Millis stallAfter = Millis(30000),
+                const std::function<void(const std::string&)>& reported = nullptr);
   // Feed hold; once the machine has stopped (Hold:0), soft reset, which
   // turns the laser off without the alarm a reset in motion raises; then
   // M5 S0. Returns whether the controller answered it all. Never throws.

@@ -258,6 +258,17 @@ void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(
         report.stroke =
             first + static_cast<size_t>(std::upper_bound(job.strokeEnds.begin(), job.strokeEnds.end(), sent) -
                                         job.strokeEnds.begin());
+        // The board runs what it has queued after the packets are taken: a
+        // stroke is surely cut once twice the simulator's queue (8 packets;
+        // a real board's depth is not documented) has been sent after it.
+        constexpr size_t kQueuedBytes = 16 * 30;
+        if (sent > kQueuedBytes) {
+          report.strokesCut =
+              std::max(report.strokesCut,
+                       first + static_cast<size_t>(
+                                   std::upper_bound(job.strokeEnds.begin(), job.strokeEnds.end(), sent - kQueuedBytes) -
+                                   job.strokeEnds.begin()));
+        }
         report.secondsLeft =  // the board queues only a few packets
             toolpath.seconds * (1 - static_cast<double>(report.bytesAcknowledged) /
                                         static_cast<double>(std::max<size_t>(report.bytesTotal, 1)));
@@ -308,7 +319,7 @@ void M2NanoDriver::run(const jobs::Toolpath& toolpath, const std::function<void(
     if (finishing) {
       waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * toolpath.seconds * 1000)), &cancel);
     }
-    report.stroke = report.strokes;
+    report.stroke = report.strokesCut = report.strokes;
     report.bytesAcknowledged = report.bytesTotal;
     report.secondsLeft = 0;
     if (progress) progress(report);

@@ -43,9 +43,13 @@ jobs::Toolpath toolpathOf(const nlohmann::json& json) {
 }
 
 nlohmann::json toJson(const Progress& p) {
-  return {{"sheet", p.sheet},      {"stroke", p.stroke},
-          {"strokes", p.strokes},  {"acknowledged", p.bytesAcknowledged},
-          {"total", p.bytesTotal}, {"left", p.secondsLeft}};
+  return {{"sheet", p.sheet},
+          {"stroke", p.stroke},
+          {"cut", p.strokesCut},
+          {"strokes", p.strokes},
+          {"acknowledged", p.bytesAcknowledged},
+          {"total", p.bytesTotal},
+          {"left", p.secondsLeft}};
 }
 
 Progress progressOf(const nlohmann::json& json) {
@@ -53,6 +57,7 @@ Progress progressOf(const nlohmann::json& json) {
   p.sheet = json.at("sheet").get<int>();
   p.stroke = json.at("stroke").get<size_t>();
   p.strokes = json.at("strokes").get<size_t>();
+  p.strokesCut = json.at("cut").get<size_t>();
   p.bytesAcknowledged = json.at("acknowledged").get<size_t>();
   p.bytesTotal = json.at("total").get<size_t>();
   p.secondsLeft = json.at("left").get<double>();

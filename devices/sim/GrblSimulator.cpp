@@ -391,6 +391,11 @@ void GrblSimulator::advance(double seconds) {
     if (block.lit) record_.litSeconds += used;
     setLaser(block.lit);
     if (blockDone_ >= block.length - 1e-9) {
+      if (block.lit) {
+        record_.litMoves.push_back(
+            {block.x - block.unitX * block.length, block.y - block.unitY * block.length, block.x, block.y});
+        if (options_.litMoveFinished) options_.litMoveFinished(record_.litMoves.back());
+      }
       record_.x = block.x, record_.y = block.y;
       planner_.erase(planner_.begin());
       blockDone_ = 0;

@@ -17,6 +17,7 @@
 // Faults can be injected: unplug, stop answering, garbage bytes, a garbled
 // status report, a stall (it says Run and never moves), an alarm.
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <deque>
@@ -43,6 +44,9 @@ struct GrblSimulatorOptions {
   // Told each time the laser goes on or off (from the simulator's thread):
   // a witness outside the process that drives it (sim:grbl?witness=FILE).
   std::function<void(bool lit)> laserChanged;
+  // Told each lit move the machine finished, from (x, y) to (x, y) in mm
+  // (from the simulator's thread): what was cut (sim:grbl?cuts=FILE).
+  std::function<void(const std::array<double, 4>& move)> litMoveFinished;
 };
 
 // What a test checks after a run.
@@ -60,6 +64,8 @@ struct GrblSimulatorRecord {
   // move entered the planner, and when the planner last emptied.
   double motionStartedAt = -1, motionEndedAt = -1;
   double topSpeed = 0;  // mm/s, the fastest the head moved
+  // Every lit move the machine finished, from (x, y) to (x, y), mm: what was cut.
+  std::vector<std::array<double, 4>> litMoves;
 };
 
 class GrblSimulator {

@@ -27,7 +27,7 @@ struct SimAddress : DeviceAddress {
   size_t after = 20;
   // A file the simulated laser's every change is appended to ("on", "off"),
   // for a test that watches the laser from outside the process.
-  std::string witness;
+  std::string witness, cutWitness;
   // Each reply this much later (a slow USB adapter's; a check that takes its time).
   int latencyMs = 0;
 };
@@ -36,12 +36,12 @@ struct SimAddress : DeviceAddress {
 // operator sees (and for the command line's tests).
 constexpr const char* kGrblFaults = "stall, noise, garbage, alarm, silence or unplug";
 
-// sim:NAME[?speed=N][&fault=KIND[&after=LINES]][&witness=FILE][&latency=MS]
+// sim:NAME[?speed=N][&fault=KIND[&after=LINES]][&witness=FILE][&cuts=FILE][&latency=MS]
 std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
   auto parsed = std::make_unique<SimAddress>(uri);
   std::string query = splitQuery(uri).second;
   const std::string takes =
-      faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES, witness=FILE and latency=MS", kGrblFaults)
+      faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES, witness=FILE, cuts=FILE and latency=MS", kGrblFaults)
              : "speed=N, a positive number";
   while (!query.empty()) {
     const size_t end = query.find('&');
@@ -62,6 +62,8 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
       parsed->after = *wholeNumber<size_t>(value);
     } else if (faults && key == "witness" && !value.empty()) {
       parsed->witness = value;
+    } else if (faults && key == "cuts" && !value.empty()) {
+      parsed->cutWitness = value;
     } else if (faults && key == "latency" && wholeNumber<unsigned>(value) && *wholeNumber<unsigned>(value) <= 10000) {
       parsed->latencyMs = static_cast<int>(*wholeNumber<unsigned>(value));
     } else {
@@ -120,6 +122,15 @@ class SimGrblEntry : public DriverEntry {
         // Appended and closed at once: what is written survives a kill of the process.
         if (FILE* out = std::fopen(file.c_str(), "a")) {
           std::fputs(lit ? "on\n" : "off\n", out);
+          std::fclose(out);
+        }
+      };
+    }
+    if (!sim.cutWitness.empty()) {
+      options.litMoveFinished = [file = sim.cutWitness](const std::array<double, 4>& move) {
+        // A line for each lit move finished: what was cut, as it was cut.
+        if (FILE* out = std::fopen(file.c_str(), "a")) {
+          std::fputs(fmt::format("{:.3f} {:.3f} {:.3f} {:.3f}\n", move[0], move[1], move[2], move[3]).c_str(), out);
           std::fclose(out);
         }
       };

@@ -103,7 +103,7 @@ void SpoolDevice::run(const jobs::Toolpath& toolpath, const std::function<void(c
   if (progress) {
     Progress done;
     done.sheet = toolpath.sheet;
-    done.stroke = done.strokes = toolpath.strokes.size();
+    done.stroke = done.strokes = done.strokesCut = toolpath.strokes.size();
     done.bytesAcknowledged = done.bytesTotal = std::filesystem::file_size(eps);
     progress(done);
   }

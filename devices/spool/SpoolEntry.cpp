@@ -18,6 +18,7 @@ class SpoolEntry : public DriverEntry {
   [[nodiscard]] std::string_view name() const override { return "spool"; }
   [[nodiscard]] std::string_view scheme() const override { return "spool:"; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return uri.starts_with("spool:"); }
+  [[nodiscard]] bool frames() const override { return false; }
 
   // spool:DIR[?printer=NAME]
   [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {

@@ -25,11 +25,11 @@ TEST(UsageCli, EachUsageErrorSaysWhatIsWrongAndWhichHelpToRead) {
   expectUsage("bake " + cube, "bake is not a rotafab command; did you mean `rotafab make`?", "rotafab --help");
   expectUsage("fabricate " + cube,
               "fabricate is not a rotafab command (the commands: inspect, make, manifest, nest, profiles, devices, "
-              "run, submit, jobs, status, cancel, pause, resume, start, next, move, dashboard)",
+              "run, submit, jobs, status, cancel, pause, resume, start, next, frame, move, dashboard)",
               "rotafab --help");
   expectUsage("",
               "give a command: inspect, make, manifest, nest, profiles, devices, run, submit, jobs, status, cancel, "
-              "pause, resume, start, next, move, dashboard",
+              "pause, resume, start, next, frame, move, dashboard",
               "rotafab --help");
   expectUsage("dashbord", "dashbord is not a rotafab command; did you mean `rotafab dashboard`?", "rotafab --help");
   // A mesh is planned by the daemon with `make`'s options, --structure first.

@@ -104,6 +104,20 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
       const current = document.querySelector('#sheet-view polyline[data-current]');
       if (current) window.highlighted.push(Number(current.dataset.stroke));
     }).observe(document.getElementById('sheet-view'), {attributes: true, subtree: true});)");
+  // Framed first, beside Start: the head traces the sheet's box, laser off, and the job stays ready.
+  click(browser, "tr[data-job=\"1\"] button[data-action=\"frame\"]");
+  ASSERT_TRUE(eventually(
+      [&] {
+        const json events = daemon.job(1)["events"];
+        return events.is_array() && !events.empty() &&
+               events.back().value("text", "") == "sheet 1 framed on laser1 (laser off)";
+      },
+      20))
+      << daemon.job(1).dump();
+  ASSERT_TRUE(
+      browser.waitFor("document.querySelector('tr[data-job=\"1\"] button[data-action=\"start\"]') && "
+                      "document.querySelector('.device[data-device=\"laser1\"][data-state=\"idle\"]')",
+                      10s));
   click(browser, "tr[data-job=\"1\"] button[data-action=\"start\"]");
   ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"done\"]')", 60s))
       << rowState(browser, 1) << ": " << daemon.job(1).dump();

@@ -11,6 +11,7 @@
 #include <map>
 #include <mutex>
 #include <random>
+#include <regex>
 #include <set>
 #include <thread>
 
@@ -94,6 +95,11 @@ TEST(Daemon, EachSheetAfterTheFirstWaitsForNextAndACutCanBePausedAndResumed) {
     ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
     EXPECT_EQ(job["sheet"], sheet - 1);
     EXPECT_EQ(state(job), "running");
+    // The sheets cut are counted as they are cut.
+    EXPECT_EQ(job["sheets_cut"], sheet - 1) << job.dump();
+    EXPECT_TRUE(std::regex_search(daemon.client("jobs").out,
+                                  std::regex(fmt::format(R"(running\*?\s+laser1(@\S+)?\s+{}/3\s)", sheet - 1))))
+        << daemon.client("jobs").out;
     // The operator is told what to load (the material, its thickness, the
     // sheet's size), and what the builders can do once it is cut.
     const std::string stock = job["summary"].value("stock", "");
@@ -216,12 +222,13 @@ TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
   EXPECT_NE(job.value("message", "").find("the daemon stopped at sheet 1 of 3"), std::string::npos) << job.dump();
   EXPECT_NE(job.value("message", "").find("laser off"), std::string::npos) << job.dump();
   // The daemon says it in its own words, which the page shows; the command line adds its command.
-  EXPECT_NE(job.value("message", "").find("to go on, load sheet 1 and resume from it"), std::string::npos)
+  EXPECT_TRUE(job.value("message", "").find("to go on, load sheet 1 and resume from it") != std::string::npos ||
+              job.value("message", "").find("to go on, leave sheet 1 where it is and resume from it") !=
+                  std::string::npos)
       << job.dump();
   EXPECT_EQ(job.value("message", "").find("rotafab"), std::string::npos) << job.dump();
   const CommandResult status = daemon.client(fmt::format("status {}", id));
-  EXPECT_NE(status.out.find(fmt::format("resume from it (`rotafab resume {} --from-sheet 1`)\n", id)),
-            std::string::npos)
+  EXPECT_NE(status.out.find(fmt::format(" (`rotafab resume {} --from-sheet 1`)\n", id)), std::string::npos)
       << status.out;
   const json last = job["transitions"].back();
   EXPECT_EQ(last["from"], "running");
@@ -234,6 +241,113 @@ TEST(Daemon, SigtermMidCutLeavesTheSimulatedLaserOffAndTheJobInterrupted) {
   daemon.client(fmt::format("cancel {}", id));
   const json cancelled = daemon.waitForJob(id, [](const json& j) { return state(j) == "cancelled"; });
   EXPECT_NE(cancelled.value("message", "").find("at sheet 3 of 3"), std::string::npos) << cancelled.dump();
+}
+
+// Whether the job's events, newest last, say `text`.
+bool saidInEvents(const json& job, const std::string& text) {
+  if (!job.contains("events")) return false;
+  return std::any_of(job["events"].begin(), job["events"].end(),
+                     [&](const json& event) { return event.value("text", "").find(text) != std::string::npos; });
+}
+
+TEST(Daemon, ASheetIsFramedLaserOffAndAStoppedOneGoesOnFromTheStrokeItStoppedAtOnceSaidInPlace) {
+  TempDir root;
+  const fs::path witness = root.path() / "laser";
+  Daemon daemon(root.path(), witnessedLaser(5, witness));
+  daemon.start();
+  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
+  ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+  // A ready job's sheet framed on its device: the head moves, the laser stays off, the job stays ready.
+  const CommandResult frame = daemon.client(fmt::format("frame {} --sheet 2", id));
+  ASSERT_EQ(frame.status, 0) << frame.err;
+  EXPECT_NE(frame.out.find("framing sheet 2 (laser off)"), std::string::npos) << frame.out;
+  json job = daemon.waitForJob(id, [](const json& j) { return saidInEvents(j, "sheet 2 framed on laser1"); });
+  ASSERT_TRUE(saidInEvents(job, "sheet 2 framed on laser1 (laser off)")) << job.dump();
+  EXPECT_EQ(state(job), "ready");
+  EXPECT_EQ(readFile(witness).find("on\n"), std::string::npos) << "lit while framing";
+  EXPECT_NE(daemon.client(fmt::format("status {}", id)).out.find("latest: sheet 2 framed on laser1"),
+            std::string::npos);
+  // Cut until some strokes are surely cut, then the daemon stopped.
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  job = daemon.waitForJob(
+      id, [](const json& j) { return j.value("/progress/cut"_json_pointer, 0) >= 4; }, 60);
+  ASSERT_GE(job.value("/progress/cut"_json_pointer, 0), 4) << job.dump();
+  daemon.signal(SIGTERM);
+  ASSERT_EQ(daemon.wait(30), 0) << readFile(daemon.log());
+  daemon.start();
+  job = daemon.job(id);
+  ASSERT_EQ(state(job), "interrupted") << job.dump();
+  const int cut = job["stroke"].get<int>(), strokes = job["strokes"].get<int>();
+  ASSERT_GE(cut, 4) << job.dump();
+  ASSERT_LT(cut, strokes) << job.dump();
+  EXPECT_NE(job.value("message", "").find(fmt::format("with {} of its {} strokes cut", cut, strokes)),
+            std::string::npos)
+      << job.dump();
+  EXPECT_NE(job.value("message", "").find(fmt::format("goes on from stroke {} once you say it is in place", cut + 1)),
+            std::string::npos)
+      << job.dump();
+  const std::string litBefore = readFile(witness);
+  // Resumed: the sheet is framed, and the job waits for the operator, the laser off.
+  ASSERT_EQ(daemon.client(fmt::format("resume {} --from-sheet 1", id)).status, 0);
+  job = daemon.waitForJob(
+      id, [](const json& j) { return j.value("waiting_for_next", false); }, 60);
+  ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
+  EXPECT_EQ(job.value("waiting_for", ""),
+            fmt::format("sheet 1 framed: once it is in place, go on from stroke {}", cut + 1));
+  const CommandResult status = daemon.client(fmt::format("status {}", id));
+  EXPECT_NE(status.out.find(fmt::format("`rotafab next {}`", id)), std::string::npos) << status.out;
+  // Framed again on request, and waiting again.
+  ASSERT_EQ(daemon.client(fmt::format("frame {}", id)).status, 0);
+  job = daemon.waitForJob(
+      id, [](const json& j) { return j.value("waiting_for_next", false); }, 60);
+  ASSERT_TRUE(job.value("waiting_for_next", false)) << job.dump();
+  EXPECT_EQ(daemon.client(fmt::format("frame {} --sheet 3", id)).status, 1) << "only the sheet it waits for";
+  EXPECT_EQ(readFile(witness), litBefore) << "lit before the operator said the sheet is in place";
+  // Told it is in place: it goes on from the first stroke not cut.
+  ASSERT_EQ(daemon.client(fmt::format("next {}", id)).status, 0);
+  job = daemon.waitForJob(id, [](const json& j) { return j.contains("progress") && j["progress"].contains("cut"); });
+  EXPECT_GE(job.value("/progress/stroke"_json_pointer, 0), cut) << job.dump();
+  job = daemon.job(id);
+  EXPECT_TRUE(saidInEvents(job, fmt::format("sheet 1 of 3 goes on from stroke {}", cut + 1))) << job.dump();
+  daemon.client(fmt::format("cancel {}", id));
+  job = daemon.waitForJob(id, [](const json& j) { return state(j) == "cancelled"; });
+  EXPECT_TRUE(readFile(witness).ends_with("off\n"));
+}
+
+// A kill -9 mid-cut: the job is interrupted at a stroke no more than a few
+// behind what the laser had cut (the lit moves the simulated controller
+// finished), and never ahead of it.
+TEST(Daemon, AKillMidCutKeepsWhereTheCutWasToAFewStrokes) {
+  TempDir root;
+  const fs::path cuts = root.path() / "cuts";
+  Daemon daemon(root.path(),
+                fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=2&cuts={}\"}}]\n",
+                            cuts.string()));
+  daemon.start();
+  const long long id = cuttingThreeSheets(daemon);
+  ASSERT_NE(id, 0);
+  daemon.waitForJob(
+      id, [](const json& j) { return j.value("/progress/cut"_json_pointer, 0) >= 6; }, 60);
+  daemon.kill9();
+  daemon.wait(10);
+  const std::string said = readFile(cuts);
+  const auto finished = static_cast<size_t>(std::count(said.begin(), said.end(), '\n'));
+  daemon.start();
+  const json job = daemon.job(id);
+  ASSERT_EQ(state(job), "interrupted") << job.dump();
+  // The strokes whose every lit move (segment) had finished, in cutting order.
+  const json sheet = daemon.get(fmt::format("/api/jobs/{}/sheets/1", id)).body;
+  size_t segments = 0, cut = 0;
+  for (const json& stroke : sheet["strokes"]) {
+    const json& points = stroke["points"];
+    for (size_t i = 1; i < points.size(); ++i) segments += points[i] == points[i - 1] ? 0 : 1;
+    if (segments > finished) break;
+    ++cut;
+  }
+  const auto stored = job["stroke"].get<size_t>();
+  EXPECT_GE(cut, 6U);
+  EXPECT_LE(stored, cut) << "never ahead of the cut";
+  EXPECT_GE(stored + 3, cut) << "no more than a few strokes behind: stored " << stored << ", cut " << cut;
 }
 
 // `clients` clients at once, each submitting `each` jobs through the daemon
@@ -458,7 +572,10 @@ TEST(Daemon, ADeviceFaultFailsOnlyItsJobWithTheDevicesOwnMessage) {
   const json failed = daemon.waitForJob(bad, [](const json& j) { return state(j) == "failed"; });
   EXPECT_EQ(state(failed), "failed") << failed.dump();
   EXPECT_NE(failed.value("message", "").find("ALARM:1"), std::string::npos) << failed.dump();
-  EXPECT_NE(failed.value("message", "").find("once it is fixed, load sheet 1 and resume from it"), std::string::npos)
+  EXPECT_TRUE(failed.value("message", "").find("once it is fixed, load sheet 1 and resume from it") !=
+                  std::string::npos ||
+              failed.value("message", "").find("once it is fixed, leave sheet 1 where it is and resume from it") !=
+                  std::string::npos)
       << failed.dump();
   for (int sheet = 2; sheet <= 3; ++sheet) {
     const json waiting = daemon.waitForJob(
@@ -860,6 +977,37 @@ TEST(Daemon, AJobIsCutWithTheMaterialItWasMadeFor) {
   const json done = daemon.waitForJob(id, [](const json& job) { return job["state"] == "done"; });
   ASSERT_EQ(done["state"], "done") << done.dump();
   EXPECT_EQ(done["strokes"].get<size_t>(), sheet.body["strokes"].size()) << "the strokes cut are plywood's";
+}
+
+// A job whose machine and device disagree is refused when it is submitted,
+// not when its cut fails: a mesh asked for another machine than its
+// device's, and a folder made for another machine (sent, unnamed, to a
+// device of its own machine where there is one).
+TEST(Daemon, ASubmissionWhoseMachineAndDeviceDisagreeIsRefusedAtOnce) {
+  TempDir root;
+  Daemon daemon(root.path(),
+                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}, "
+                "{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=400\"}]\n");
+  daemon.start();
+  const CommandResult mesh = daemon.client("submit " + quoted(kSource / "examples/cube.obj") +
+                                           " --structure band --machine workshop-32x18 --device laser1");
+  EXPECT_EQ(mesh.status, 1);
+  EXPECT_NE(mesh.err.find("device laser1 is a grbl-diode-400, not the workshop-32x18 asked for"), std::string::npos)
+      << mesh.err;
+  EXPECT_EQ(daemon.clientJson("jobs --json")["jobs"].size(), 0U) << "nothing queued";
+  const fs::path k40 = root.path() / "k40-cube";
+  ASSERT_EQ(run(kCli + " make " + quoted(kSource / "examples/cube.obj") +
+                " --structure band --machine k40-m2nano --size 4in --time 0 --out " + quoted(k40))
+                .status,
+            0);
+  const CommandResult folder = daemon.client("submit " + quoted(k40) + " --device laser1");
+  EXPECT_EQ(folder.status, 1);
+  EXPECT_NE(folder.err.find("device laser1 is a grbl-diode-400, not the k40-m2nano the folder was made for: make it "
+                            "again with --machine grbl-diode-400, or name a device of that machine (k40)"),
+            std::string::npos)
+      << folder.err;
+  const json unnamed = daemon.clientJson("submit " + quoted(k40));
+  EXPECT_EQ(unnamed["device"], "k40") << unnamed.dump();
 }
 
 }  // namespace

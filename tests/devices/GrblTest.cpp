@@ -3,12 +3,14 @@
 // G-code a controller accepts, and every fault ending with the laser off, a
 // typed error and no hang.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <cmath>
 #include <exception>
 #include <regex>
+#include <set>
 #include <thread>
 
 #include <arpa/inet.h>
@@ -234,6 +236,65 @@ void expectFault(FaultKind kind, const std::function<void(sim::GrblSimulator&)>&
     EXPECT_EQ(record.state, kind == FaultKind::Alarm ? "Alarm" : "Idle");
   } else {
     EXPECT_FALSE(confirmed);
+  }
+}
+
+// A cut stopped mid-sheet says how many strokes the machine finished (not
+// only took into its planner); going on from the next stroke cuts every
+// segment of the sheet, and cuts again only the stroke the head was in.
+TEST(Grbl, AStoppedSheetGoesOnFromTheStrokeItStoppedInAndMissesNothing) {
+  const size_t lines = grbl::gcodeProgram(toolpath(), {}).lines.size();
+  for (const size_t stopAt : {lines / 3, 2 * lines / 3, 5 * lines / 6}) {
+    SCOPED_TRACE(fmt::format("stopped after {} of {} lines", stopAt, lines));
+    Rig rig(40);
+    auto& [simulator, driver, path] = rig;
+    core::Cancellation cancel;
+    simulator.afterLines(stopAt, [&](sim::GrblSimulator&) { cancel.cancel(); });
+    size_t cut = 0, taken = 0;
+    EXPECT_THROW(driver->run(
+                     path,
+                     [&](const Progress& p) {
+                       EXPECT_GE(p.strokesCut, cut) << "never backwards";
+                       cut = p.strokesCut, taken = p.stroke;
+                     },
+                     cancel),
+                 DeviceFault);
+    EXPECT_LE(cut, taken);
+    core::Cancellation never;
+    driver->run(jobs::restOfSheet(path, cut, driver->motionLimits()), nullptr, never);
+    const auto lit = simulator.record().litMoves;
+    // Each segment of the sheet as often as its strokes go over it (a cut's
+    // passes go over the same ones): cut at least that often, and more often
+    // only along the stroke the head was in when it stopped.
+    const auto same = [](const std::array<double, 4>& move, jobs::Point2 a, jobs::Point2 b) {
+      return std::hypot(move[0] - a.x() * 25.4, move[1] - a.y() * 25.4) < 0.01 &&
+             std::hypot(move[2] - b.x() * 25.4, move[3] - b.y() * 25.4) < 0.01;
+    };
+    size_t extra = 0;
+    std::set<std::pair<size_t, size_t>> counted;  // (stroke, segment) of a geometry already counted
+    for (size_t i = 0; i < path.strokes.size(); ++i) {
+      const auto& points = path.strokes[i].points;
+      for (size_t j = 1; j < points.size(); ++j) {
+        if ((points[j] - points[j - 1]).norm() < 1e-4 || counted.contains({i, j})) continue;
+        size_t needed = 0, burnt = 0;
+        for (size_t k = i; k < path.strokes.size(); ++k) {
+          const auto& others = path.strokes[k].points;
+          for (size_t l = 1; l < others.size(); ++l) {
+            if ((others[l] - points[j]).norm() < 1e-6 && (others[l - 1] - points[j - 1]).norm() < 1e-6) {
+              ++needed, counted.insert({k, l});
+            }
+          }
+        }
+        for (const auto& move : lit) burnt += same(move, points[j - 1], points[j]) ? 1 : 0;
+        EXPECT_GE(burnt, needed) << "stroke " << i << ", segment " << j << ": a cut missed";
+        extra += burnt > needed ? burnt - needed : 0;
+      }
+    }
+    EXPECT_LT(cut, path.strokes.size());
+    EXPECT_LE(extra, path.strokes[cut].points.size() - 1) << "more cut again than the stroke the head was in";
+    if (stopAt > lines / 2) {
+      EXPECT_GT(cut, 0U) << "the strokes the machine finished, counted";
+    }
   }
 }
 
