@@ -133,7 +133,7 @@ void printJobs(const json& jobs) {
     fmt::print("{:>4}  {:<11}  {:<{}}  {:>6}  {:<10}  {:<22}  {}\n", job.value("id", 0), state, device, width,
                sheetsOf(job), shortened(job.value("owner", ""), 10),
                shortened(fs::path(job.value("source", "")).filename().string(), 22),
-               shortened(job.value("message", ""), 70));
+               shortened(job.value("device_missing", job.value("message", "")), 70));
   }
   if (std::any_of(jobs.begin(), jobs.end(), [](const json& job) { return job.value("waiting_for_next", false); })) {
     fmt::print("* waiting for the next sheet to be loaded: `rotafab next ID` once it is\n");
@@ -163,6 +163,12 @@ std::string progressLine(const json& progress) {
 // beside its buttons): "planned: 3 sheets; start it with
 // `rotafab start 7`".
 std::string withCommand(const json& job, long long id) {
+  if (job.contains("device_missing") && job["device_missing"].is_string()) {
+    return fmt::format(
+        "{}; {}: move it to another device with `rotafab move {} --device NAME` (`rotafab "
+        "devices --daemon` lists them)",
+        job.value("message", ""), job["device_missing"].get<std::string>(), id);
+  }
   const std::string message = job.value("message", ""), state = job.value("state", "");
   if (state == "ready") return message + fmt::format("; start it with `rotafab start {}`", id);
   // The sheet the daemon says to go on from, where it says one (a stop or a device's fault).
@@ -643,21 +649,35 @@ void addMoveCommand(CLI::App& app, int& status) {
   auto client = std::make_shared<ClientOptions>();
   auto job = std::make_shared<std::string>();
   auto before = std::make_shared<std::string>();
+  auto device = std::make_shared<std::string>();
   auto priority = std::make_shared<std::optional<int>>();
-  CLI::App* move = app.add_subcommand("move", "Reorder the queue: a job before another, or a new priority");
+  CLI::App* move = app.add_subcommand(
+      "move", "Reorder the queue (a job before another, or a new priority), or move a job to another device");
   move->add_option("JOB", *job, "The job's number")->required();
   auto* beforeOption = move->add_option("--before", *before, "Put it just before this job (and at its priority)");
-  move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
+  auto* priorityOption =
+      move->add_option("--priority", *priority, "Its new priority (higher is cut first)")->excludes(beforeOption);
+  move->add_option("--device", *device,
+                   "Cut it on this device instead: a queued, ready, interrupted or failed job (a ready one made "
+                   "from a mesh is planned again where the device's machine differs)")
+      ->excludes(beforeOption)
+      ->excludes(priorityOption);
   addClientOptions(*move, *client);
-  move->footer("Examples:\n  rotafab move 9 --before 7\n  rotafab move 9 --priority 5");
-  move->callback([client, job, before, priority, &status] {
+  move->footer(
+      "Examples:\n  rotafab move 9 --before 7\n  rotafab move 9 --priority 5\n  rotafab move 9 --device laser2");
+  move->callback([client, job, before, priority, device, &status] {
     status = talking([&]() -> int {
       json body = json::object();
       if (!before->empty()) body["before"] = jobNumber(*before);
       if (*priority) body["priority"] = **priority;
-      if (body.empty()) throw UserError("move: give --before OTHER or --priority P");
+      if (!device->empty()) body["device"] = *device;
+      if (body.empty()) throw UserError("move: give --before OTHER, --priority P or --device NAME");
       const DaemonClient daemon = clientOf(*client);
-      daemon.post(fmt::format("/api/jobs/{}/move", jobNumber(*job)), body);
+      const json moved = daemon.post(fmt::format("/api/jobs/{}/move", jobNumber(*job)), body);
+      if (!device->empty()) {
+        printAnswer(moved, "move", client->json);
+        return kSuccess;
+      }
       const json answer = daemon.get("/api/jobs");
       if (client->json) {
         std::cout << answer.dump(1) << '\n';

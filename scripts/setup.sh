@@ -15,7 +15,7 @@ packages=(
   libassimp-dev libeigen3-dev libcli11-dev nlohmann-json3-dev libsimdjson-dev
   libspdlog-dev libfmt-dev libyaml-cpp-dev libboost-dev libboost-system-dev
   libsqlite3-dev libpq-dev libssl-dev libusb-1.0-0-dev libserialport-dev libpolyclipping-dev
-  libopenmesh-dev
+  libopenmesh-dev libmosquitto-dev
   hershey-fonts-data libumockdev-dev umockdev
   # the workshop page's 3D view, served from Debian's path
   libjs-three
@@ -29,6 +29,8 @@ packages=(
   chromium
   # a real PostgreSQL server for the job store's tests (scripts/test-postgres.sh)
   postgresql-15
+  # a real MQTT broker and subscriber for the notifications' tests
+  mosquitto mosquitto-clients
   # meshes other people made, read by the tests where these packages install
   # them (tests/data/external/README.md)
   assimp-testmodels geomview openscad-testing-data libcgal-demo

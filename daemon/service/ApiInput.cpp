@@ -198,7 +198,8 @@ json checkedActionArguments(std::string_view action, const json& body) {
     takes({kSheetField.name});
     if (body.contains("sheet")) checked["sheet"] = wholeNumber(body["sheet"], kSheetField);
   } else if (action == "move") {
-    takes({kBeforeField.name, kPriorityField.name});
+    takes({kBeforeField.name, kPriorityField.name, "device"});
+    if (body.contains("device")) checked["device"] = checkedText(body["device"], "device", 64);
     if (body.contains("before")) checked["before"] = wholeNumber(body["before"], kBeforeField);
     if (body.contains("priority")) checked["priority"] = wholeNumber(body["priority"], kPriorityField);
   } else {

@@ -88,11 +88,11 @@ DaemonConfig loadConfig(const fs::path& file) {
     throw ConfigError(error.what());
   }
   try {
-    const auto keys =
-        reader.keys(root, "",
-                    {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "origins", "devices",
-                     "upload_limit", "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout"},
-                    {});
+    const auto keys = reader.keys(
+        root, "",
+        {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "origins", "devices", "upload_limit",
+         "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout", "notify"},
+        {});
     bool listenGiven = false;
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
     if (root["store"]) {
@@ -128,6 +128,39 @@ DaemonConfig loadConfig(const fs::path& file) {
         }
         config.listen.push_back(address.starts_with("unix:") ? "unix:" + expanded(address.substr(5)).string()
                                                              : address);
+      }
+    }
+    if (const YAML::Node notify = root["notify"]) {
+      reader.keys(notify, "notify", {"webhooks", "mqtt", "topic"}, {});
+      if (const YAML::Node hooks = notify["webhooks"]) {
+        if (!hooks.IsSequence())
+          reader.fail(hooks, "notify.webhooks", "expected a list such as [http://HOST:PORT/PATH]");
+        for (size_t i = 0; i < hooks.size(); ++i) {
+          const std::string key = fmt::format("notify.webhooks[{}]", i);
+          const std::string url = reader.text(hooks[i], key);
+          try {
+            webhookEndpoint(url);
+          } catch (const std::invalid_argument& error) {
+            reader.fail(hooks[i], key, error.what());
+          }
+          config.notify.webhooks.push_back(url);
+        }
+      }
+      if (notify["mqtt"]) {
+        config.notify.mqtt = reader.text(notify["mqtt"], "notify.mqtt");
+        try {
+          mqttEndpoint(config.notify.mqtt);
+        } catch (const std::invalid_argument& error) {
+          reader.fail(notify["mqtt"], "notify.mqtt", error.what());
+        }
+      }
+      if (notify["topic"]) {
+        config.notify.topic = reader.text(notify["topic"], "notify.topic");
+        if (config.notify.topic.empty() || config.notify.topic.find_first_of("#+") != std::string::npos ||
+            config.notify.topic.ends_with("/")) {
+          reader.fail(notify["topic"], "notify.topic",
+                      "expected a topic such as rotafab or lab/lasers, without # or +");
+        }
       }
     }
     if (const YAML::Node tokens = root["tokens"]) {

@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+
 #include <vector>
+#include "daemon/service/Notifier.h"
 
 #include "core/ProgramFolders.h"
 
@@ -64,6 +66,7 @@ struct DaemonConfig {
   double bodyTimeout = 120;   // seconds for its body
   unsigned planners = 1;      // jobs planned at once (each on every core)
   double planTimeout = 3600;  // seconds a plan may take before its job fails
+  NotifyConfig notify;        // webhooks and an MQTT broker told of the operator's events
 };
 
 using core::defaultSocket;  // (core/ProgramFolders.h: the command line finds the socket too)

@@ -51,7 +51,8 @@ bool allowedTransition(JobState from, JobState to) {
     case S::Planning:
       return to == S::Ready || to == S::Failed || to == S::Cancelled || to == S::Queued;
     case S::Ready:
-      return to == S::Running || to == S::Cancelled;
+      // (Queued again: moved to a device whose machine differs, to be planned for it.)
+      return to == S::Running || to == S::Cancelled || to == S::Queued;
     case S::Running:
       return to == S::Paused || to == S::Done || to == S::Failed || to == S::Cancelled || to == S::Interrupted;
     case S::Paused:

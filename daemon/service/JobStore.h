@@ -204,6 +204,8 @@ class JobStore {
   virtual void update(JobId id, const JobChange& change) = 0;
   // A new place in the queue.
   virtual void reorder(JobId id, int priority, double position) = 0;
+  // Another device for a job not being planned or cut (it is no longer for any device).
+  virtual void setDevice(JobId id, const std::string& device) = 0;
   [[nodiscard]] virtual std::vector<Transition> transitions(JobId id) = 0;
   virtual void addEvent(std::optional<JobId> job, std::string_view kind, std::string_view text) = 0;
   [[nodiscard]] virtual std::vector<Event> events(std::optional<JobId> job, size_t newest) = 0;

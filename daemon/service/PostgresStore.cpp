@@ -389,6 +389,14 @@ class PostgresStore final : public JobStore, private JobRows {
           {std::to_string(priority), number(position), number(unixSeconds()), std::to_string(id)});
   }
 
+  void setDevice(JobId id, const std::string& device) override {
+    // (Only a job no host plans or cuts: one claimed meanwhile keeps its device.)
+    query(
+        "UPDATE jobs SET device = $1, any_device = 0, updated = $2 WHERE id = $3 AND state IN "
+        "('queued', 'ready', 'interrupted', 'failed')",
+        {device, number(unixSeconds()), std::to_string(id)});
+  }
+
   std::vector<Transition> transitions(JobId id) override {
     const Result found =
         query("SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = $1 ORDER BY id",

@@ -16,7 +16,8 @@ Reply Service::Impl::act(JobId id, const std::string& action, const json& argume
   const JobRecord job = jobOrThrow(id);
   // A cut or plan of this host's is stopped whatever the store says of its
   // job (released to another host meanwhile, the laser must still go off).
-  if (action == "cancel" && (cuts.contains(id) || planning.contains(id)) && store->shared() &&
+  const bool frameOnly = cuts.contains(id) && cuts.at(id)->frameOnly;
+  if (action == "cancel" && !frameOnly && (cuts.contains(id) || planning.contains(id)) && store->shared() &&
       !(job.host == config.host && heldByAHost(job.state))) {
     if (auto c = cuts.find(id); c != cuts.end()) cancelCut(*c->second, who);
     if (auto p = planning.find(id); p != planning.end()) p->second.cancel->cancel();
@@ -115,6 +116,7 @@ Reply Service::Impl::pauseJob(const JobRecord& job, const std::string& who) {
   if (job.state != JobState::Running) refuse(job, "; only a running job can be paused");
   Cut& cut = *cuts.at(job.id);
   if (cut.waiting) refuse(job, ", waiting for the next sheet: nothing moves, so there is nothing to pause");
+  if (cut.between) refuse(job, ", between sheets (one starting or being framed): pause once it cuts");
   if (auto* run = cut.control->run.load()) run->pause();
   const JobRecord paused = record(job.id, JobState::Paused, fmt::format("paused by {}", who));
   devices[cut.device].state = "paused";
@@ -184,6 +186,7 @@ Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const
       throw ApiError(
           409, fmt::format("job {} waits for {}; only sheet {} can be framed now", id, cut.waitingFor, cut.sheet));
     }
+    if (job.state != JobState::Running) refuse(job, "; only a job waiting between sheets is framed by its cut");
     cut.waiting->set_value(devices::SheetGo::Frame);
     cut.waiting.reset();
     cut.waitingFor.clear();
@@ -217,6 +220,8 @@ Reply Service::Impl::nextSheet(const JobRecord& job, const std::string& who) {
                                                              job.sheet, job.sheets)
                                                : std::string("; only a job waiting between sheets takes `next`"));
   }
+  if (job.state != JobState::Running) refuse(job, "; only a job waiting between sheets takes `next`");
+  c->second->between = true;
   c->second->waiting->set_value(devices::SheetGo::Cut);
   c->second->waiting.reset();
   c->second->waitingFor.clear();
@@ -229,6 +234,7 @@ Reply Service::Impl::moveJob(const JobRecord& job, const json& arguments, const 
   if (isFinal(job.state) && job.state != JobState::Interrupted && job.state != JobState::Failed) {
     refuse(job, "; only a job still to cut has a place in the queue");
   }
+  if (arguments.contains("device")) return moveToDevice(job, arguments["device"].get<std::string>(), who);
   int priority = job.priority;
   if (arguments.contains("priority")) {
     if (!arguments["priority"].is_number_integer()) throw ApiError(400, "priority: expected a whole number");
@@ -249,12 +255,55 @@ Reply Service::Impl::moveJob(const JobRecord& job, const json& arguments, const 
     }
     position = (previous + other.position) / 2;
   } else if (!arguments.contains("priority")) {
-    throw ApiError(400, "move needs before (a job number) or priority (a whole number)");
+    throw ApiError(400, "move needs before (a job number), priority (a whole number) or device (a device's name)");
   }
   store->reorder(id, priority, position);
   store->addEvent(id, "move", fmt::format("moved by {}", who));
   const JobRecord moved = store->job(id).value();
   jobChanged(moved);
+  return {200, jobJson(moved)};
+}
+
+Reply Service::Impl::moveToDevice(const JobRecord& job, const std::string& name, const std::string& who) {
+  const JobId id = job.id;
+  if (job.state != JobState::Queued && job.state != JobState::Ready && job.state != JobState::Interrupted &&
+      job.state != JobState::Failed) {
+    refuse(job, "; only a job waiting to be planned or cut, or one stopped mid-way, moves to another device");
+  }
+  if (cuts.contains(id)) refuse(job, ", and its sheet is being framed; move it once the frame is done");
+  std::string why;
+  const std::optional<Target> target = deviceFor(name, job.options, why);
+  if (!target) throw ApiError(409, why);
+  // The machine its sheets were planned for, where they were.
+  std::string planned;
+  if (!job.summary.empty()) {
+    const json summary = json::parse(job.summary, nullptr, false);
+    if (summary.is_object()) planned = summary.value("machine", "");
+  }
+  if (!planned.empty() && planned != target->machine.name) {
+    if (job.state != JobState::Ready || job.kind != JobKind::Mesh) {
+      refuse(job, fmt::format(", its sheets planned for {}{}; {} is a {}: a device of {} can cut them", planned,
+                              job.kind == JobKind::Mesh ? " and partly cut" : " (a folder is cut as it was made)", name,
+                              target->machine.name, planned));
+    }
+    // Planned again for the other machine's bed and settings.
+    JobChange change;
+    change.device = name;
+    record(id, JobState::Queued,
+           fmt::format("moved by {} to {} (a {}): to be planned again for it", who, name, target->machine.name),
+           change);
+    store->setDevice(id, name);
+    store->addEvent(id, "move", fmt::format("moved by {} to {}", who, name));
+    jobChanged(store->job(id).value());
+    pump();
+    return {200, jobJson(store->job(id).value())};
+  }
+  store->setDevice(id, name);
+  store->addEvent(id, "move",
+                  fmt::format("moved by {} from {} to {}", who, job.device.empty() ? "any device" : job.device, name));
+  const JobRecord moved = store->job(id).value();
+  jobChanged(moved);
+  pump();
   return {200, jobJson(moved)};
 }
 

@@ -86,6 +86,9 @@ void Service::Impl::startCut(const JobRecord& job, int fromSheet, const std::str
 }
 
 void Service::Impl::launchCut(const JobRecord& job, Device& on, int fromSheet, int64_t fromStroke, bool frameOnly) {
+  if (cuts.contains(job.id)) {
+    throw ApiError(409, fmt::format("job {} is being framed; ask again once the frame is done", job.id));
+  }
   Device* device = &on;
   const size_t index = static_cast<size_t>(device - devices.data());
   auto cut = std::make_unique<Cut>();
@@ -94,6 +97,8 @@ void Service::Impl::launchCut(const JobRecord& job, Device& on, int fromSheet, i
   cut->firstSheet = fromSheet;
   cut->frameOnly = frameOnly;
   cut->sheet = fromSheet;
+  // A frame leaves the device as it found it (a fault the operator checks stays one).
+  cut->stateBefore = device->state, cut->messageBefore = device->message;
   device->job = job.id;
   device->state = frameOnly ? "framing" : "running";
   device->message.clear();
@@ -140,7 +145,15 @@ devices::SheetGo Service::Impl::waitForOperator(JobId id, const std::shared_ptr<
     c->second->sheet = sheet;
     try {
       store->addEvent(id, "waiting", fmt::format("waiting for {}", what));
-      jobChanged(store->job(id).value());
+      const JobRecord job = store->job(id).value();
+      jobChanged(job);
+      // The operator is needed at the machine: a sheet to load, or a framed one to check.
+      json extra = {{"waiting_for", what}, {"waiting_sheet", sheet}};
+      if (job.summary.find("\"stock\"") != std::string::npos) {
+        const json summary = json::parse(job.summary, nullptr, false);
+        if (summary.is_object() && summary.contains("stock")) extra["stock"] = summary["stock"];
+      }
+      notify(job, what.find("framed") == std::string::npos ? "load_sheet" : "sheet_framed", extra);
     } catch (const std::exception& error) {
       storeTrouble(fmt::format("job {}", id), error);
     }
@@ -200,6 +213,7 @@ void Service::Impl::runCut(JobId id, const std::shared_ptr<RunControl>& control,
       events.framing = [this, id] {
         onStrand([this, id] {
           if (auto c = cuts.find(id); c != cuts.end()) {
+            c->second->between = true;
             c->second->progress["phase"] = "framing";
             publish("progress", c->second->progress);
           }
@@ -211,6 +225,7 @@ void Service::Impl::runCut(JobId id, const std::shared_ptr<RunControl>& control,
         onStrand([this, id, sheet, sheets, strokes, first, seconds] {
           auto c = cuts.find(id);
           if (c == cuts.end()) return;
+          c->second->between = false;
           c->second->progress = {{"job", id},       {"phase", "cutting"}, {"sheet", sheet},         {"sheets", sheets},
                                  {"stroke", first}, {"strokes", strokes}, {"seconds_left", seconds}};
           JobChange change;
@@ -370,7 +385,8 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
 void Service::Impl::frameEnded(JobId id, const Cut& cut, Device& device,
                                const std::optional<devices::DeviceFault>& fault,
                                const std::optional<std::string>& failure) {
-  // The job stays as it was: a frame moves the head with the laser off.
+  // The job stays as it was, and the device: a frame moves the head with the laser off.
+  device.state = cut.stateBefore, device.message = cut.messageBefore;
   std::string said = fmt::format("sheet {} framed on {} (laser off)", cut.sheet, device.config.name);
   if (failure) said = fmt::format("sheet {} not framed: {}", cut.sheet, *failure);
   if (fault && fault->kind == devices::FaultKind::Cancelled) {

@@ -58,6 +58,16 @@ void Service::Impl::watchDisk() {
 
 JobRecord Service::Impl::record(JobId id, JobState to, const std::string& reason, const JobChange& change,
                                 bool keepIfFull) {
+  JobRecord recorded = recordInStore(id, to, reason, change, keepIfFull);
+  // The ends of a job, told to whoever listens (Notifier.h).
+  if (to == JobState::Done || to == JobState::Failed || to == JobState::Interrupted || to == JobState::Cancelled) {
+    notify(recorded, std::string("job_") + std::string(stateName(to)), json::object());
+  }
+  return recorded;
+}
+
+JobRecord Service::Impl::recordInStore(JobId id, JobState to, const std::string& reason, const JobChange& change,
+                                       bool keepIfFull) {
   if (!unrecorded.contains(id)) {
     try {
       return store->transition(id, to, reason, change);

@@ -115,6 +115,11 @@ struct Service::Impl {
     std::string waitingFor;
     bool frameOnly = false;  // a frame of a job not being cut: its state stays as it was
     int sheet = 1;           // the sheet framed (frameOnly), or waited for
+    // Between sheets (starting one, framing it, waiting for its operator):
+    // nothing moves that a pause could hold, and the driver's next run
+    // would forget a hold asked now.
+    bool between = true;
+    std::string stateBefore, messageBefore;  // the device's, before a frame (frameOnly)
     std::string cancelledBy;
     std::string stoppedBecause;  // stopped by the daemon for this (a full disk): interrupted
     Clock::time_point lastStored{}, lastSent{};
@@ -126,7 +131,8 @@ struct Service::Impl {
         config(config),
         log(std::move(log)),
         planners(config.planners),
-        executor(std::make_unique<core::Executor>(std::max(1u, std::thread::hardware_concurrency()))) {}
+        executor(std::make_unique<core::Executor>(std::max(1u, std::thread::hardware_concurrency()))),
+        notifier(config.notify.any() ? std::make_unique<Notifier>(config.notify, this->log) : nullptr) {}
 
   asio::io_context& io;
   const DaemonConfig& config;
@@ -137,6 +143,7 @@ struct Service::Impl {
   asio::thread_pool planners;
   std::unique_ptr<core::Executor> executor;
   std::unique_ptr<JobStore> store;
+  std::unique_ptr<Notifier> notifier;  // none when no receiver is configured
   std::unique_ptr<Spool> spool;
   profiles::ProfileCatalogue catalogue;
   std::vector<Device> devices;
@@ -203,7 +210,7 @@ struct Service::Impl {
 
   // The devices of the other live hosts, as the last heartbeat found them;
   // read off the strand too (a planned folder's submission), hence the lock.
-  std::mutex othersMutex;
+  mutable std::mutex othersMutex;
   std::vector<Target> others;
   std::function<void()> stopped;
 
@@ -276,6 +283,11 @@ struct Service::Impl {
                    bool keepIfFull = false);
 
   void writeUnrecorded();
+  JobRecord recordInStore(JobId id, JobState to, const std::string& reason, const JobChange& change, bool keepIfFull);
+
+  // An event for the webhooks and the MQTT broker (Notifier.h): its kind,
+  // the job's number, source, device, state, sheets, message and `extra`.
+  void notify(const JobRecord& job, const std::string& kind, json extra) noexcept;
 
   // ---- this host: its start, its lease on a shared store, its devices' checks (ServiceHosts.cpp) ----
 
@@ -343,7 +355,7 @@ struct Service::Impl {
   // hosts' devices under their lock, so a submission may ask it off the strand.
   // `madeFor`: the machine a planned folder was made for, unless the options name one.
   std::optional<Target> deviceFor(const std::string& named, const std::string& options, std::string& why,
-                                  const std::string& madeFor = "");
+                                  const std::string& madeFor = "") const;
 
   static std::string planningReason(const Target& device);
 
@@ -393,6 +405,11 @@ struct Service::Impl {
   // The frame of a sheet: of the job waiting for its next sheet, traced by
   // its cut; of a job not being cut, on the device it would be cut on.
   Reply frameJob(const JobRecord& job, const json& arguments, const std::string& who);
+
+  // A job not being planned or cut moved to the device `name`: as it is
+  // where that device's machine is the one its sheets were planned for; a
+  // ready mesh's planned again otherwise; refused where that cannot be.
+  Reply moveToDevice(const JobRecord& job, const std::string& name, const std::string& who);
 
   // The material a planned job is cut with: the one its manifest names (it
   // was made for it: kerf, power, speed, passes), else the device's.

@@ -130,7 +130,8 @@ void Service::Impl::pump() {
       const std::vector<JobRecord> claimed =
           store->claim({JobState::Ready, 1, device.config.name, device.machine.name, device.material.name},
                        [&](const JobRecord& job) -> std::optional<Claim> {
-                         if (job.sheets < 1) return std::nullopt;
+                         // (Not one whose sheet is being framed: it waits for its operator.)
+                         if (job.sheets < 1 || cuts.contains(job.id)) return std::nullopt;
                          return Claim{JobState::Running, reason, cutFromSheet(1, device.config.name)};
                        });
       for (const JobRecord& job : claimed) {
@@ -154,7 +155,7 @@ auto Service::Impl::targetOf(const Device& device, const std::string& host) -> T
 }
 
 auto Service::Impl::deviceFor(const std::string& named, const std::string& options, std::string& why,
-                              const std::string& madeFor) -> std::optional<Target> {
+                              const std::string& madeFor) const -> std::optional<Target> {
   std::vector<Target> all;
   for (const Device& device : devices) all.push_back(targetOf(device, config.host));
   {

@@ -116,6 +116,14 @@ json Service::Impl::jobJson(const JobRecord& stored) const {
     out["options"] = json::parse(job.options, nullptr, false);
   }
   if (!job.summary.empty()) out["summary"] = json::parse(job.summary, nullptr, false);
+  // A job still to cut for a device no longer configured (nor another host's): said, for it to be moved.
+  if (!job.device.empty() && (job.state == JobState::Queued || job.state == JobState::Ready ||
+                              job.state == JobState::Interrupted || job.state == JobState::Failed)) {
+    std::string why;
+    if (!deviceFor(job.device, "", why)) {
+      out["device_missing"] = fmt::format("{} is no longer configured (on any running host)", job.device);
+    }
+  }
   if (const auto p = planning.find(job.id); p != planning.end() && !p->second.progress.is_null()) {
     out["progress"] = p->second.progress;
   }
@@ -126,6 +134,28 @@ json Service::Impl::jobJson(const JobRecord& stored) const {
     if (c->second->frameOnly) out["framing_sheet"] = c->second->sheet;
   }
   return out;
+}
+
+void Service::Impl::notify(const JobRecord& job, const std::string& kind, json extra) noexcept {
+  if (!notifier) return;
+  // (What is told to others never stops what it tells of.)
+  try {
+    json event = {{"event", kind},
+                  {"at", isoTime(job.updated)},
+                  {"host", config.host},
+                  {"job", job.id},
+                  {"source", fs::path(job.source).filename().string()},
+                  {"device", job.device},
+                  {"state", stateName(job.state)},
+                  {"sheet", job.sheet},
+                  {"sheets", job.sheets},
+                  {"sheets_cut", sheetsCut(job)},
+                  {"message", job.message}};
+    if (extra.is_object()) event.update(extra);
+    notifier->send(std::move(event));
+  } catch (const std::exception& error) {
+    log->error("job {}: its {} event: {}", job.id, kind, error.what());
+  }
 }
 
 void Service::Impl::jobChanged(const JobRecord& job) {

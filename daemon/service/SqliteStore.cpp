@@ -397,6 +397,17 @@ class SqliteStore final : public JobStore, private JobRows {
     transaction.commit();
   }
 
+  void setDevice(JobId id, const std::string& device) override {
+    Transaction transaction(db_);
+    // (Only a job no host plans or cuts: one claimed meanwhile keeps its device.)
+    Statement set(*statements_,
+                  "UPDATE jobs SET device = ?, any_device = 0, updated = ? WHERE id = ? AND state IN "
+                  "('queued', 'ready', 'interrupted', 'failed')");
+    set.bind(1, device).bind(2, unixSeconds()).bind(3, id);
+    set.step();
+    transaction.commit();
+  }
+
   std::vector<Transition> transitions(JobId id) override {
     Statement select(*statements_,
                      "SELECT job, from_state, to_state, at, reason FROM transitions WHERE job = ? ORDER BY id");

@@ -53,9 +53,22 @@ function actionsOf(job) {
   // a fault can: the daemon starts a cut on it, and the operator has cleared it.)
   const device = state.devices.find((d) => d.name === job.device);
   const unable = device && ['offline', 'gone'].includes(device.state) ? device : null;
+  // A job whose device is no longer configured, or cannot cut: moved to another.
+  if (job.device_missing || (unable && ['queued', 'ready', 'interrupted', 'failed'].includes(job.state))) {
+    if (job.device_missing) buttons.push(element('span', { class: 'unable' }, job.device_missing));
+    const others = state.devices.filter((d) => d.name !== job.device).map((d) => d.name);
+    if (others.length) {
+      act('Move to…', 'move', () => {
+        const answer = window.prompt(`Cut job ${job.id} on which device (${others.join(', ')})?`, others[0]);
+        return answer === null ? null : { device: answer.trim() };
+      });
+    }
+  }
   switch (job.state) {
     case 'ready':
-      if (unable) {
+      if (job.device_missing) {
+        // (Said beside Move to…, above.)
+      } else if (unable) {
         buttons.push(element('span', { class: 'unable' },
           `${unable.name} is ${unable.state}${unable.message ? `: ${unable.message}` : ''}`));
       } else if (job.framing_sheet) {
@@ -83,7 +96,7 @@ function actionsOf(job) {
         buttons.push(element('span', { class: 'unable' }, `framing sheet ${job.framing_sheet}…`));
         break;
       }
-      if (!unable) {
+      if (!unable && !job.device_missing) {
         act('Frame', 'frame', { sheet: job.sheet },
           { title: `Trace sheet ${job.sheet}’s box with the laser off, to check where it is` });
       }

@@ -8,8 +8,15 @@
 namespace rotafab::devices::grbl {
 namespace {
 
-// Both the program's coordinates and the reports' are rounded to 0.001 mm.
-constexpr double kToleranceMm = 0.005;
+// How near a reported position must be to a move to be on it: a few
+// steps (GRBL reports whole steps, 0.0125 mm at 80 a mm, and a diagonal
+// is stepped a step off the line), so that the move the head is in always
+// holds its position, and the first that does is never a later one.
+constexpr double kToleranceMm = 0.05;
+// GRBL frees a planner block once its last segment is prepared for the
+// stepper, which holds up to 6 (grbl's stepper.c, SEGMENT_BUFFER_SIZE):
+// so many moves beyond the planner's may have left it and not yet run.
+constexpr size_t kStepperSegments = 6;
 // A move this long has steps at any resolution a laser has (over 5 steps a mm).
 constexpr double kSurelyStepsMm = 0.2;
 
@@ -72,10 +79,11 @@ void CutTracker::acknowledged(size_t acknowledgedLines) {
       static_cast<size_t>(std::partition_point(moves_.begin(), moves_.end(),
                                                [&](const Segment& move) { return move.line < acknowledgedLines; }) -
                           moves_.begin());
-  if (sureBlocks_[taken] <= plannerBlocks_) return;
-  // At least this many blocks have run (the planner holds the rest), and
-  // so every move of the first i, for the most i that may hold no more.
-  const size_t run = sureBlocks_[taken] - plannerBlocks_;
+  const size_t ahead = plannerBlocks_ + kStepperSegments;
+  if (sureBlocks_[taken] <= ahead) return;
+  // At least this many blocks have run (the planner and the stepper hold
+  // the rest), and so every move of the first i, for the most i that may hold no more.
+  const size_t run = sureBlocks_[taken] - ahead;
   const auto done = static_cast<size_t>(
       std::partition_point(mayBlocks_.begin(), mayBlocks_.end(), [&](size_t blocks) { return blocks <= run; }) -
       mayBlocks_.begin() - 1);

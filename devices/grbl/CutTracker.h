@@ -3,7 +3,8 @@
 // line when it enters the planner, up to 15 moves ahead of the head, and
 // a stop (feed hold, reset) drops what the planner held: acknowledged is
 // not cut. Two things say where the head is. The planner's depth: of the
-// moves acknowledged, all but the planner's last `plannerBlocks` have run
+// moves acknowledged, all but the last `plannerBlocks` (and the stepper's
+// few prepared segments) have run
 // (GRBL drops a move of no steps, so only moves surely of some steps are
 // counted). And the position in the status reports, placed on the first
 // move from there on that holds it (a sheet's passes repeat the same

@@ -362,19 +362,6 @@ TEST(Browser, TheQueueIsReorderedByDraggingItsRowsUpAndDown) {
   expectNoErrors(browser);
 }
 
-// A port nobody listens on now, for a daemon to take again after a restart.
-int freePort() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-  socklen_t size = sizeof address;
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
-  ::close(fd);
-  return ntohs(address.sin_port);
-}
-
 TEST(Browser, WithoutASessionThePageSaysHowToGetOneAndSoItDoesWhenTheDaemonStartsAgain) {
   TempDir root;
   const int port = freePort();

@@ -314,6 +314,19 @@ inline int pagePort(const Daemon& daemon) {
   return port;
 }
 
+// A loopback port nobody listens on now, for a server started after (a daemon again, a broker).
+inline int freePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  socklen_t size = sizeof address;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &size);
+  ::close(fd);
+  return ntohs(address.sin_port);
+}
+
 // The configuration's one device: a simulated GRBL diode laser running at
 // `speed` times real time, whose laser's changes ("on", "off") are written to `witness`.
 inline std::string witnessedLaser(double speed, const std::filesystem::path& witness) {

@@ -3,10 +3,16 @@
 // kills at any instant; SIGTERM mid-cut; many clients at once; hostile
 // requests; a full disk; a device's fault.
 
+#include <arpa/inet.h>
 #include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <poll.h>
 #include <sys/mount.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <fstream>
 #include <map>
 #include <mutex>
@@ -348,6 +354,167 @@ TEST(Daemon, AKillMidCutKeepsWhereTheCutWasToAFewStrokes) {
   EXPECT_GE(cut, 6U);
   EXPECT_LE(stored, cut) << "never ahead of the cut";
   EXPECT_GE(stored + 3, cut) << "no more than a few strokes behind: stored " << stored << ", cut " << cut;
+}
+
+const fs::path& oneSheet();  // (below: a planned folder of one sheet)
+
+// A webhook's receiver: an HTTP server on a loopback port that keeps the
+// body of each request and answers 204, as a phone's push relay would.
+class WebhookReceiver {
+ public:
+  WebhookReceiver() {
+    listener_ = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ::bind(listener_, reinterpret_cast<sockaddr*>(&address), sizeof address);
+    ::listen(listener_, 8);
+    socklen_t size = sizeof address;
+    ::getsockname(listener_, reinterpret_cast<sockaddr*>(&address), &size);
+    port_ = ntohs(address.sin_port);
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~WebhookReceiver() {
+    stopping_ = true;
+    thread_.join();
+    ::close(listener_);
+  }
+  WebhookReceiver(const WebhookReceiver&) = delete;
+  WebhookReceiver& operator=(const WebhookReceiver&) = delete;
+  [[nodiscard]] int port() const { return port_; }
+  [[nodiscard]] std::vector<json> events() const {
+    std::lock_guard lock(mutex_);
+    return events_;
+  }
+
+ private:
+  void serve() {
+    while (!stopping_) {
+      pollfd ready{listener_, POLLIN, 0};
+      if (::poll(&ready, 1, 100) <= 0) continue;
+      const int client = ::accept(listener_, nullptr, nullptr);
+      if (client < 0) continue;
+      std::string request;
+      char buffer[4096];
+      for (;;) {
+        const size_t header = request.find("\r\n\r\n");
+        if (header != std::string::npos) {
+          const size_t length = request.find("Content-Length: ");
+          const size_t body = length == std::string::npos ? 0 : std::stoul(request.substr(length + 16));
+          if (request.size() >= header + 4 + body) {
+            std::lock_guard lock(mutex_);
+            events_.push_back(json::parse(request.substr(header + 4, body), nullptr, false));
+            break;
+          }
+        }
+        const ssize_t got = ::read(client, buffer, sizeof buffer);
+        if (got <= 0) break;
+        request.append(buffer, static_cast<size_t>(got));
+      }
+      const std::string reply = "HTTP/1.1 204 No Content\r\nContent-Length: 0\r\nConnection: close\r\n\r\n";
+      (void)!::write(client, reply.data(), reply.size());
+      ::close(client);
+    }
+  }
+  int listener_ = -1, port_ = 0;
+  std::atomic<bool> stopping_{false};
+  mutable std::mutex mutex_;
+  std::vector<json> events_;
+  std::thread thread_;
+};
+
+// The events of a job reach a webhook and, through a real broker (Debian's
+// mosquitto, started here), an MQTT subscriber: the next sheet to load, and
+// the job's end.
+TEST(Daemon, TheOperatorsEventsReachAWebhookAndAnMqttBroker) {
+  TempDir root;
+  const int broker = freePort();
+  std::ofstream(root.path() / "mosquitto.conf")
+      << fmt::format("listener {} 127.0.0.1\nallow_anonymous true\npersistence false\npid_file {}\nuser root\n", broker,
+                     (root.path() / "mosquitto.pid").string());
+  ASSERT_EQ(run("mosquitto -d -c " + quoted(root.path() / "mosquitto.conf")).status, 0);
+  struct StopBroker {
+    fs::path pid;
+    ~StopBroker() { run("kill $(cat " + quoted(pid) + ")"); }
+  } stopBroker{root.path() / "mosquitto.pid"};
+  const fs::path heard = root.path() / "mqtt";
+  ASSERT_TRUE(eventually([&] { return fs::exists(root.path() / "mosquitto.pid"); }, 10));
+  run(fmt::format("(timeout 120 mosquitto_sub -h 127.0.0.1 -p {} -t 'lab/lasers/#' -v -C 3 > {} 2>&1 &)", broker,
+                  quoted(heard)));
+  WebhookReceiver webhook;
+  Daemon daemon(root.path(),
+                fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}}]\n"
+                            "notify:\n  webhooks: [http://127.0.0.1:{}/rotafab]\n  mqtt: mqtt://127.0.0.1:{}\n"
+                            "  topic: lab/lasers\n",
+                            webhook.port(), broker));
+  daemon.start();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));  // (the subscriber connected)
+  const long long id = daemon.clientJson("submit " + quoted(threeSheets()))["id"];
+  ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+  ASSERT_TRUE(daemon
+                  .waitForJob(
+                      id, [](const json& j) { return j.value("waiting_for_next", false); }, 120)
+                  .value("waiting_for_next", false));
+  ASSERT_TRUE(eventually([&] { return webhook.events().size() >= 1; }, 10));
+  const json load = webhook.events().front();
+  EXPECT_EQ(load["event"], "load_sheet") << load.dump();
+  EXPECT_EQ(load["job"], id);
+  EXPECT_EQ(load["waiting_sheet"], 2);
+  EXPECT_EQ(load["waiting_for"], "sheet 2 to be loaded");
+  EXPECT_EQ(load["sheets_cut"], 1);
+  EXPECT_TRUE(load.value("stock", "").starts_with("posterboard (0.8 mm)")) << load.dump();
+  ASSERT_EQ(daemon.client(fmt::format("cancel {}", id)).status, 0);
+  ASSERT_TRUE(eventually([&] { return webhook.events().size() >= 2; }, 10));
+  EXPECT_EQ(webhook.events()[1]["event"], "job_cancelled") << webhook.events()[1].dump();
+  // A one-sheet job cut to its end.
+  const long long one = daemon.clientJson("submit " + quoted(oneSheet()))["id"];
+  ASSERT_EQ(state(daemon.waitForJob(one, [](const json& j) { return state(j) == "ready"; })), "ready");
+  ASSERT_EQ(daemon.client(fmt::format("start {}", one)).status, 0);
+  ASSERT_TRUE(eventually([&] { return webhook.events().size() >= 3; }, 60));
+  EXPECT_EQ(webhook.events()[2]["event"], "job_done") << webhook.events()[2].dump();
+  EXPECT_EQ(webhook.events()[2]["job"], one);
+  // The same events, in order, on the broker's topic.
+  ASSERT_TRUE(eventually(
+      [&] {
+        const std::string lines = readFile(heard);
+        return std::count(lines.begin(), lines.end(), '\n') >= 3;
+      },
+      10))
+      << readFile(heard);
+  const std::string said = readFile(heard);
+  const size_t a = said.find("lab/lasers/load_sheet {"), b = said.find("lab/lasers/job_cancelled {"),
+               c = said.find("lab/lasers/job_done {");
+  EXPECT_NE(a, std::string::npos) << said;
+  EXPECT_LT(a, b) << said;
+  EXPECT_LT(b, c) << said;
+  EXPECT_NE(said.find(fmt::format("\"job\":{}", one)), std::string::npos) << said;
+}
+
+// A receiver that is not there holds up nothing: the job is cut, and the log says so once.
+TEST(Daemon, AnAbsentReceiverHoldsUpNothingAndIsLoggedOnce) {
+  TempDir root;
+  Daemon daemon(root.path(),
+                fmt::format("devices: [{{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}}]\n"
+                            "notify: {{webhooks: [http://127.0.0.1:{}/], mqtt: mqtt://127.0.0.1:{}}}\n",
+                            freePort(), freePort()));
+  daemon.start();
+  for (int i = 0; i < 2; ++i) {
+    const long long id = daemon.clientJson("submit " + quoted(oneSheet()))["id"];
+    ASSERT_EQ(state(daemon.waitForJob(id, [](const json& j) { return state(j) == "ready"; })), "ready");
+    ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+    ASSERT_EQ(state(daemon.waitForJob(
+                  id, [](const json& j) { return state(j) == "done"; }, 60)),
+              "done");
+  }
+  ASSERT_TRUE(eventually([&] { return readFile(daemon.log()).find("mqtt://") != std::string::npos; }, 15));
+  const std::string log = readFile(daemon.log());
+  size_t webhookLines = 0;
+  for (size_t at = log.find("notifications: http://"); at != std::string::npos;
+       at = log.find("notifications: http://", at + 1)) {
+    ++webhookLines;
+  }
+  EXPECT_EQ(webhookLines, 1U) << log;
 }
 
 // `clients` clients at once, each submitting `each` jobs through the daemon
@@ -1008,6 +1175,62 @@ TEST(Daemon, ASubmissionWhoseMachineAndDeviceDisagreeIsRefusedAtOnce) {
       << folder.err;
   const json unnamed = daemon.clientJson("submit " + quoted(k40));
   EXPECT_EQ(unnamed["device"], "k40") << unnamed.dump();
+}
+
+// A job moves to another device: as it is to one of its machine, planned
+// again from its mesh for another machine; a folder made for one machine
+// stays on it; and a job whose device is no longer configured says so and moves.
+TEST(Daemon, AJobMovesToAnotherDeviceAndOneWhoseDeviceIsGoneSaysSo) {
+  TempDir root;
+  const std::string three =
+      "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}, "
+      "{name: laser2, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}, "
+      "{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=400\"}]\n";
+  Daemon daemon(root.path(), three);
+  daemon.start();
+  const long long folder = daemon.clientJson("submit " + quoted(threeSheets()) + " --device laser1")["id"];
+  ASSERT_EQ(state(daemon.waitForJob(folder, [](const json& j) { return state(j) == "ready"; })), "ready");
+  const CommandResult same = daemon.client(fmt::format("move {} --device laser2", folder));
+  ASSERT_EQ(same.status, 0) << same.err;
+  EXPECT_EQ(daemon.job(folder)["device"], "laser2");
+  EXPECT_EQ(state(daemon.job(folder)), "ready");
+  const CommandResult other = daemon.client(fmt::format("move {} --device k40", folder));
+  EXPECT_EQ(other.status, 1);
+  EXPECT_NE(other.err.find("its sheets planned for grbl-diode-400 (a folder is cut as it was made); k40 is a "
+                           "k40-m2nano: a device of grbl-diode-400 can cut them"),
+            std::string::npos)
+      << other.err;
+  // A mesh's job, planned again for the K40's bed.
+  const long long mesh = daemon.clientJson("submit " + quoted(kSource / "examples/cube.obj") +
+                                           " --structure band --size 4in --evaluations 1 --device laser1")["id"];
+  ASSERT_EQ(state(daemon.waitForJob(mesh, [](const json& j) { return state(j) == "ready"; })), "ready");
+  ASSERT_EQ(daemon.client(fmt::format("move {} --device k40", mesh)).status, 0);
+  json moved = daemon.waitForJob(mesh, [](const json& j) { return state(j) == "ready" && j["device"] == "k40"; });
+  ASSERT_EQ(state(moved), "ready") << moved.dump();
+  EXPECT_EQ(moved["summary"]["machine"], "k40-m2nano") << moved.dump();
+  // laser2 taken out of the configuration: its job says so, and moves.
+  daemon.signal(SIGTERM);
+  ASSERT_EQ(daemon.wait(30), 0);
+  const std::string two =
+      "devices: [{name: laser1, machine: grbl-diode-400, uri: \"sim:grbl?speed=400\"}, "
+      "{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=400\"}]\n";
+  std::ofstream(root.path() / "rotafabd.yaml") << two;
+  daemon.start();
+  EXPECT_EQ(daemon.job(folder).value("device_missing", ""), "laser2 is no longer configured (on any running host)");
+  EXPECT_NE(daemon.client("jobs").out.find("laser2 is no longer configured (on any running host)"), std::string::npos)
+      << daemon.client("jobs").out;
+  EXPECT_NE(
+      daemon.client(fmt::format("status {}", folder))
+          .out.find(fmt::format(
+              "laser2 is no longer configured (on any running host): move it to another device with `rotafab move {} "
+              "--device NAME`",
+              folder)),
+      std::string::npos);
+  ASSERT_EQ(daemon.client(fmt::format("move {} --device laser1", folder)).status, 0);
+  EXPECT_FALSE(daemon.job(folder).contains("device_missing"));
+  ASSERT_EQ(daemon.client(fmt::format("start {}", folder)).status, 0);
+  EXPECT_EQ(daemon.job(folder)["device"], "laser1");
+  daemon.client(fmt::format("cancel {}", folder));
 }
 
 }  // namespace

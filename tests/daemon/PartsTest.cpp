@@ -77,7 +77,17 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
   expectRefused(
       "statedir: /tmp\n",
       "1:1: statedir: unknown key (expected one of: state_dir, store, host, spool, lease, listen, tokens, "
-      "origins, devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout)");
+      "origins, devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout, "
+      "notify)");
+  expectRefused("notify: {webhooks: [https://hooks.example/x]}\n",
+                "1:21: notify.webhooks[0]: expected http://HOST[:PORT][/PATH], found 'https://hooks.example/x' (TLS "
+                "is not supported: a receiver on the lab's network, or a relay beside the daemon)");
+  expectRefused("notify: {mqtt: \"mqtt://broker:99999\"}\n",
+                "1:16: notify.mqtt: expected mqtt://HOST[:PORT], found 'mqtt://broker:99999'");
+  expectRefused("notify: {mqtt: mqtt://broker, topic: \"lab/#\"}\n",
+                "1:38: notify.topic: expected a topic such as rotafab or lab/lasers, without # or +");
+  expectRefused("notify: {webhook: [http://x/]}\n",
+                "1:10: notify.webhook: unknown key (expected one of: webhooks, mqtt, topic)");
   expectRefused("host: cutter room\n",
                 "1:7: host: expected a name of letters, digits, '.', '_' and '-', such as cutter-room-2");
   expectRefused("lease: 0.5\n", "1:8: lease: must be between 1 and 3600, not 0.5");
