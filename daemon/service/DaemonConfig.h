@@ -10,7 +10,7 @@
 #include <string>
 
 #include <vector>
-#include "daemon/service/Notifier.h"
+#include "daemon/service/NotifyConfig.h"
 
 #include "core/ProgramFolders.h"
 

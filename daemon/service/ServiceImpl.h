@@ -34,6 +34,7 @@
 #include "core/WorkContext.h"
 #include "daemon/service/ApiInput.h"
 #include "daemon/service/DiskReserve.h"
+#include "daemon/service/Notifier.h"
 #include "daemon/service/UploadForm.h"
 #include "devices/Device.h"
 #include "devices/DriverEntry.h"
