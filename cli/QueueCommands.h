@@ -1,7 +1,8 @@
 #pragma once
 // The verbs that talk to the fabrication daemon (docs/CONTRACT.md, "Command line"):
-// submit, jobs, status, cancel, pause, resume, start, next, move; and the
-// daemon's side of `devices --daemon` and `manifest JOB`.
+// submit, jobs, status, cancel, pause, resume, start, next, frame, move; and
+// the daemon's side of `devices --daemon` and `manifest JOB`. How their jobs
+// are shown: JobViews.h.
 
 #include <CLI/CLI.hpp>
 #include <string>

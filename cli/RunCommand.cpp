@@ -98,10 +98,10 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
                                                                 fault.sheet, fault.strokesDone, fault.strokes);
     // To go on: the strokes cut are not cut again (after a frame, to check the sheet has not moved):
     // "leave sheet 1 and run it with --sheet 1 --from-stroke 102 --frame".
+    const bool midSheet = fault.strokesDone > 0 && fault.strokesDone < fault.strokes;
     const std::string goOn =
-        fault.strokesDone > 0 && fault.strokesDone < fault.strokes
-            ? fmt::format("--sheet {} --from-stroke {} --frame", fault.sheet, fault.strokesDone + 1)
-            : fmt::format("--sheet {}", fault.sheet);
+        midSheet ? fmt::format("--sheet {} --from-stroke {} --frame", fault.sheet, fault.strokesDone + 1)
+                 : fmt::format("--sheet {}", fault.sheet);
     const std::string laser = fault.nothingSent && fault.sheet > 1
                                   ? std::string("the sheets before it ended with the laser off")
                                   : devices::laserStateAfter(fault);
@@ -109,8 +109,7 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
       // The operator's choice, not an error.
       fmt::print(stderr, "run: stopped {}; {}{}\n", where, laser,
                  fault.sheet > 0 ? fmt::format("; to go on, {} sheet {} and run it with {}",
-                                               goOn.find("--from-stroke") != std::string::npos ? "leave" : "load",
-                                               fault.sheet, goOn)
+                                               midSheet ? "leave" : "load", fault.sheet, goOn)
                                  : "");
       // (no signal: the operator did not say the next sheet was loaded)
       return command.signal() != 0 ? command.interruptedStatus() : kUserError;

@@ -9,6 +9,14 @@ namespace {
   throw ApiError(409, fmt::format("job {} is {}{}", job.id, stateName(job.state), why));
 }
 
+// A device with no head to frame with (a print spool): 409, saying so.
+void refuseUnlessItFrames(const DeviceConfig& device) {
+  if (!devices::parseDeviceUri(device.uri).driver->frames()) {
+    throw ApiError(
+        409, fmt::format("{} writes files for a print driver and moves no head to frame a sheet with", device.name));
+  }
+}
+
 }  // namespace
 
 Reply Service::Impl::act(JobId id, const std::string& action, const json& arguments, const std::string& who) {
@@ -178,10 +186,7 @@ Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const
                                               "job waits for it",
                                               job.sheet, job.sheets));
     }
-    if (!devices::parseDeviceUri(devices[cut.device].config.uri).driver->frames()) {
-      throw ApiError(409, fmt::format("{} writes files for a print driver and moves no head to frame a sheet with",
-                                      devices[cut.device].config.name));
-    }
+    refuseUnlessItFrames(devices[cut.device].config);
     if (arguments.contains("sheet") && arguments["sheet"].get<int>() != cut.sheet) {
       throw ApiError(
           409, fmt::format("job {} waits for {}; only sheet {} can be framed now", id, cut.waitingFor, cut.sheet));
@@ -203,10 +208,7 @@ Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const
   const int sheet = arguments.contains("sheet") ? arguments["sheet"].get<int>() : std::max(1, job.sheet);
   if (sheet > job.sheets) throw ApiError(400, fmt::format("job {} has sheets 1 to {}, not {}", id, job.sheets, sheet));
   Device& device = idleDeviceFor(job);
-  if (!devices::parseDeviceUri(device.config.uri).driver->frames()) {
-    throw ApiError(409, fmt::format("{} writes files for a print driver and moves no head to frame a sheet with",
-                                    device.config.name));
-  }
+  refuseUnlessItFrames(device.config);
   store->addEvent(id, "frame", fmt::format("{} asked for a frame of sheet {} on {}", who, sheet, device.config.name));
   launchCut(job, device, sheet, 0, true);
   return {202, jobJson(store->job(id).value())};
