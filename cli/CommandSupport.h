@@ -14,6 +14,7 @@
 #include "jobs/OutputFolder.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
+#include "profiles/UserSettings.h"
 
 namespace rotafab::cli {
 
@@ -40,6 +41,23 @@ int reportingErrors(const std::string& subject, Body&& body) {
     fmt::print(stderr, "error: {}: {}\n", subject, error.what());
   }
   return kUserError;
+}
+
+// The unit to show lengths in: `given` (--units, "mm" or "in") when not
+// empty, else the user's setting (profiles/UserSettings.h: a bad settings
+// file throws ProfileError, reported as above), else `otherwise` (the job's
+// own, or the unit --size is written in).
+inline core::LengthUnit unitShown(const std::string& given, core::LengthUnit otherwise) {
+  if (const auto unit = core::LengthUnit::named(given)) return *unit;
+  return profiles::readUserSettings().units.value_or(otherwise);
+}
+
+// --units, for the verbs that show lengths.
+inline CLI::Option* addUnitsOption(CLI::App* command, std::string& units) {
+  return command
+      ->add_option("--units", units,
+                   "Show lengths in mm or in (default: `units:` in ~/.config/rotafab/config.yaml, else the job's)")
+      ->check(CLI::IsMember({"mm", "in"}));
 }
 
 // An --out folder option's check (a usage error, before any work): not a

@@ -285,8 +285,8 @@ void printAnswer(const json& answer, const std::string& action, bool asJson) {
     fmt::print("job {}: {} on host {}: asked it to {} it (`rotafab status {}` says when it has)\n",
                answer.value("id", 0), state, answer.value("asked_host", ""), action, answer.value("id", 0));
   } else if (action == "frame") {
-    fmt::print("job {}: framing sheet {} (laser off); `rotafab status {}` says when it is framed\n",
-               answer.value("id", 0), answer.value("framing_sheet", 0), answer.value("id", 0));
+    fmt::print("job {}: framing sheet {} ({}); `rotafab status {}` says when it is framed\n", answer.value("id", 0),
+               answer.value("framing_sheet", 0), answer.value("frame_light", "laser off"), answer.value("id", 0));
   } else if (action == "cancel" && state != "cancelled") {
     fmt::print("job {}: stopping (`rotafab status {}` says when it has)\n", answer.value("id", 0),
                answer.value("id", 0));

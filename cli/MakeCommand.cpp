@@ -29,19 +29,21 @@ std::string nestingStopped(const std::string& stopped) {
 }
 
 // "stands: ..." or "tips over: ... hang it from ...", with the mass when the material gives it.
-std::string stabilityLine(const geometry::Stability& stability) {
+std::string stabilityLine(const geometry::Stability& stability, core::LengthUnit unit) {
   const std::string mass = stability.massKg ? fmt::format("; mass {:.3g} kg", *stability.massKg) : "";
   if (stability.stands) {
-    return fmt::format("stands: its centre of mass is {:.2f} in inside its footprint{}", stability.margin, mass);
+    return fmt::format("stands: its centre of mass is {} inside its footprint{}", unit(stability.margin, 2), mass);
   }
+  const auto point = [unit](const geometry::Point3& p) {
+    return fmt::format("({}, {}, {}) {}", unit.number(p.x()), unit.number(p.y()), unit.number(p.z()), unit.name());
+  };
   const geometry::Point3 &p = stability.hangPoints.at(0), &q = stability.hangPoints.at(1);
-  const std::string hang =
-      p == q ? geometry::formatPoint(p) : fmt::format("{} and {}", geometry::formatPoint(p), geometry::formatPoint(q));
+  const std::string hang = p == q ? point(p) : fmt::format("{} and {}", point(p), point(q));
   if (!(stability.margin < -geometry::kBalanceInches)) {
     return fmt::format("balances on the edge of its footprint, and a touch tips it{}; hang it from {}", mass, hang);
   }
-  return fmt::format("tips over: its centre of mass is {:.2f} in outside its footprint{}; hang it from {}",
-                     -stability.margin, mass, hang);
+  return fmt::format("tips over: its centre of mass is {} outside its footprint{}; hang it from {}",
+                     unit(-stability.margin, 2), mass, hang);
 }
 
 void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const CommandContext& command) {
@@ -75,16 +77,21 @@ void printSummary(const MakeOptions& options, const jobs::PlannedJob& job, const
       fmt::print("  panels asked: {}; the mesh has {} faces, kept as drawn\n", count->asked, remeshing.facesAfter);
     }
   }
-  fmt::print("  built, {:.1f} x {:.1f} x {:.1f} in; {}\n", job.size.x(), job.size.y(), job.size.z(),
-             stabilityLine(job.stability));
-  fmt::print("  it takes {}\n", jobs::costLine(job.cost));
+  fmt::print("  built, {}; {}\n", job.shownIn.size(job.size.x(), job.size.y(), job.size.z(), 1),
+             stabilityLine(job.stability, job.shownIn));
+  fmt::print("  it takes {}\n", jobs::costLine(job.cost, job.shownIn));
   fmt::print("  import {:.2f} s, geometry {:.2f} s, nesting {:.2f} s{}, estimate {:.2f} s, writing {:.2f} s\n",
              s.import, s.geometry, s.nesting, nestingStopped(job.sheets.stopped), s.estimate, s.writing);
   fmt::print("  assembly: {}/manifest.txt (or `rotafab manifest {}`)\n", job.folder.string(), job.folder.string());
 }
 
-int runMake(const MakeOptions& options) {
-  return reportingErrors(options.mesh, [&]() -> int {
+int runMake(const MakeOptions& given) {
+  return reportingErrors(given.mesh, [&]() -> int {
+    MakeOptions options = given;
+    // (--units, else the user's setting; else requestOf() takes --size's unit, else the machine's.)
+    if (options.units.empty()) {
+      if (const auto preferred = profiles::readUserSettings().units) options.units = std::string(preferred->name());
+    }
     const auto catalogue = profiles::loadProfiles(profiles::profileSearchPath());
     const jobs::MakeRequest request = requestOf(options, catalogue);
     const std::filesystem::path folder =
@@ -93,8 +100,8 @@ int runMake(const MakeOptions& options) {
     lines.prefix = "make: ";
     lines.nestingPrefix = "nesting: ";
     const auto& bed = request.machine.bed;
-    const double k = profiles::unitsPerInch(bed.unit);
-    lines.bed = fmt::format("{:.4g} x {:.4g} {}", bed.width * k, bed.height * k, bed.unit);
+    lines.bed = request.shownIn.size(bed.width, bed.height, 3);
+    lines.unit = request.shownIn;
     lines.rows = request.rows;
     lines.folder = folder.string();
     CommandContext command{ProgressLines(lines)};

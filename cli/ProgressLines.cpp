@@ -59,8 +59,8 @@ void ProgressLines::operator()(const core::Progress& p) {
       }
     } else if (p.step == "first layout") {
       const double left = p.budget - p.elapsed;
-      step = fmt::format("{} sheet{}, last sheet {:.2f} in long, in {:.1f} s; {}", p.sheets, plural(p.sheets), p.length,
-                         p.elapsed,
+      step = fmt::format("{} sheet{}, last sheet {} long, in {:.1f} s; {}", p.sheets, plural(p.sheets),
+                         options_.unit(p.length, 2), p.elapsed,
                          left >= 0.5 ? fmt::format("improving it for up to {:.0f} s more, while that helps", left)
                                      : std::string("no time left in --time to improve it"));
       nextCount_ = std::chrono::steady_clock::now() + kCountEvery;
@@ -68,9 +68,9 @@ void ProgressLines::operator()(const core::Progress& p) {
       // Every better layout; that the search goes on, every few seconds.
       const auto now = std::chrono::steady_clock::now();
       if (p.step != "searching" || now > nextCount_) {
-        const std::string layout =
-            options_.strip ? fmt::format("strip {:.2f} long", p.length)
-                           : fmt::format("{} sheet{}, last sheet {:.2f} in long", p.sheets, plural(p.sheets), p.length);
+        const std::string layout = options_.strip ? fmt::format("strip {:.2f} long", p.length)
+                                                  : fmt::format("{} sheet{}, last sheet {} long", p.sheets,
+                                                                plural(p.sheets), options_.unit(p.length, 2));
         step = fmt::format("{}{} ({:.0f} of {:.0f} s)",
                            p.step == "searching"    ? "searching, best so far "
                            : p.step == "compacting" ? "compacting: "

@@ -7,6 +7,7 @@
 #include <chrono>
 #include <string>
 
+#include "core/LengthUnit.h"
 #include "core/Progress.h"
 
 namespace rotafab::cli {
@@ -18,6 +19,7 @@ struct ProgressLineOptions {
   std::string bed;            // "32 x 18 in", for the start of nesting
   bool rows = false;          // the layout is rows, not nesting
   std::string folder;         // where the sheets are written
+  core::LengthUnit unit;      // of the lengths said
 };
 
 class ProgressLines {

@@ -143,7 +143,8 @@ int runDaemonDevices(bool asJson, const std::string& server, const std::string& 
   });
 }
 
-int runDaemonManifest(long long job, const std::string& format, const std::string& server, const std::string& token) {
+int runDaemonManifest(long long job, const std::string& format, const std::string& server, const std::string& token,
+                      const std::string& units) {
   return talking([&]() -> int {
     const json manifest = DaemonClient(serverAddress(server, token)).get(fmt::format("/api/jobs/{}/manifest", job));
     if (format == "json") {
@@ -151,7 +152,7 @@ int runDaemonManifest(long long job, const std::string& format, const std::strin
     } else if (format == "html") {
       throw UserError("--format html needs the sheets beside the manifest: run it on a `make` output folder");
     } else {
-      std::cout << jobs::manifestText(manifest);
+      std::cout << jobs::manifestText(manifest, unitShown(units, jobs::displayUnitOf(manifest)));
     }
     return kSuccess;
   });
@@ -328,7 +329,8 @@ void addResumeCommand(CLI::App& app, int& status) {
   resume->footer(
       "A job the daemon was cutting when it stopped comes back interrupted and never restarts by itself:\n"
       "check the machine, then resume it from the sheet it stopped in. Left where it was, that sheet is\n"
-      "framed (laser off) and waits until you say it is in place (`rotafab next JOB`), then goes on from\n"
+      "framed (laser off, or at the machine's frame_power) and waits until you say it is in place (`rotafab next "
+      "JOB`), then goes on from\n"
       "the first stroke not cut; the strokes cut are not cut again.\n\n"
       "Examples:\n"
       "  rotafab resume 7\n"
@@ -359,12 +361,13 @@ void addFrameCommand(CLI::App& app, int& status) {
   auto client = std::make_shared<ClientOptions>();
   auto job = std::make_shared<std::string>();
   auto sheet = std::make_shared<std::optional<int>>();
-  CLI::App* frame = app.add_subcommand("frame", "Trace a sheet's box on the machine with the laser off, to check it");
+  CLI::App* frame = app.add_subcommand("frame", "Trace a sheet's box on the machine, to check where it lies");
   frame->add_option("JOB", *job, "The job's number")->required();
   frame->add_option("--sheet", *sheet, "The sheet (default: the one the job goes on with)")->check(CLI::PositiveNumber);
   addClientOptions(*frame, *client);
   frame->footer(
-      "The head goes round the box of the sheet's cuts with the laser off, so that you can check the sheet\n"
+      "The head goes round the box of the sheet's cuts with the laser off (or lit at the machine profile's\n"
+      "frame_power, a few percent), so that you can check the sheet\n"
       "is where the cut will be. A job waiting between sheets frames the one it waits for, and waits again;\n"
       "a ready, interrupted or failed job is framed on the device it would be cut on.\n\n"
       "Examples:\n"

@@ -15,6 +15,7 @@ void addQueueCommands(CLI::App& app, int& status);
 int runDaemonDevices(bool json, const std::string& server, const std::string& token);
 
 // `rotafab manifest JOB`: the manifest of a planned job, from the daemon.
-int runDaemonManifest(long long job, const std::string& format, const std::string& server, const std::string& token);
+int runDaemonManifest(long long job, const std::string& format, const std::string& server, const std::string& token,
+                      const std::string& units);
 
 }  // namespace rotafab::cli

@@ -22,7 +22,7 @@ namespace rotafab::cli {
 namespace {
 
 struct RunOptions {
-  std::string target, device, out, machine, material;
+  std::string target, device, out, machine, material, units;
   std::optional<int> sheet, fromStroke;
   bool frame = false, yes = false, dryRun = false, force = false;
 };
@@ -75,7 +75,7 @@ void confirmChanges(const RunOptions& options, const jobs::JobProfileNames& made
 }
 
 int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command, std::string stock,
-        std::map<int, std::string> kits) {
+        std::map<int, std::string> kits, core::LengthUnit unit) {
   const auto& toolpaths = job.toolpaths();
   if (toolpaths.size() > 1 && !::isatty(STDIN_FILENO)) {
     throw UserError(
@@ -87,7 +87,7 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   devices::RunSummary done;
   try {
     done = job.run(terminalRunEvents(toolpaths.size(), command.cancellation(), std::move(stock), std::move(kits),
-                                     {options.frame, options.yes}),
+                                     {options.frame, options.yes}, unit),
                    command.cancellation());
   } catch (const devices::DeviceFault& fault) {
     // Where the job stopped, so that the operator knows what is cut and can
@@ -123,8 +123,8 @@ int cut(const RunOptions& options, devices::JobRun& job, CommandContext& command
   const char* what = !spool                                                 ? "cut on"
                      : options.device.find("printer=") != std::string::npos ? "sent to the printer by"
                                                                             : "written as EPS by";
-  fmt::print("{}: {} sheet{} {} {}: {} strokes, {:.1f} in burnt, in {} (estimated {})\n", options.target, done.sheets,
-             done.sheets == 1 ? "" : "s", what, options.device, done.strokes, done.burnt,
+  fmt::print("{}: {} sheet{} {} {}: {} strokes, {} burnt, in {} (estimated {})\n", options.target, done.sheets,
+             done.sheets == 1 ? "" : "s", what, options.device, done.strokes, unit(done.burnt, 1),
              minutes(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count()),
              minutes(done.estimated));
   return kSuccess;
@@ -164,11 +164,14 @@ int runRun(const RunOptions& options) {
         throw UserError(fmt::format("--machine {} is driven by {}, not by --device {}'s {} driver",
                                     cutting.machine.name, cutting.machine.driver, device, driverName));
       }
-      jobs::checkSheetsFitBed(sheets, cutting.machine);
+      // --units, else the user's setting, else the job's, else the machine's bed's.
+      const core::LengthUnit unit = unitShown(
+          options.units, madeFor.shownIn.value_or(profiles::shownUnit("", std::nullopt, "", cutting.machine.bed.unit)));
+      jobs::checkSheetsFitBed(sheets, cutting.machine, unit);
       confirmChanges(options, madeFor, cutting, command.cancellation());
       // (The job's sheets' own size: a bed larger than theirs holds them as they are.)
-      std::string stock = jobs::stockOf(cutting.material, sheets.front().drawing.width, sheets.front().drawing.height,
-                                        cutting.machine.bed.unit);
+      std::string stock =
+          jobs::stockOf(cutting.material, sheets.front().drawing.width, sheets.front().drawing.height, unit);
       RunOptions resolved = options;
       resolved.device = device;
       setup.machine = std::move(cutting.machine);
@@ -202,7 +205,7 @@ int runRun(const RunOptions& options) {
             std::filesystem::is_directory(options.target) && std::filesystem::exists(manifest)) {
           if (const auto read = jobs::readManifestSheets(manifest)) kits = read->kits;
         }
-        return cut(resolved, *job, command, std::move(stock), std::move(kits));
+        return cut(resolved, *job, command, std::move(stock), std::move(kits), unit);
       }
       if (command.cancellation().cancelled()) {
         fmt::print(stderr, "run: stopped; nothing was written\n");
@@ -255,12 +258,14 @@ void addRunCommand(CLI::App& app, int& status) {
       "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame,
-                "Trace each sheet's box with the laser off, then ask \"cut sheet N now?\" (y cuts, f frames again)");
+                "Trace each sheet's box with the laser off (or at the machine profile's frame_power), then ask \"cut "
+                "sheet N now?\" (y cuts, f frames again)");
   run->add_flag("--yes", options->yes, "With --frame: cut once framed without asking");
   run->add_option("--from-stroke", options->fromStroke,
                   "With --sheet: go on from this stroke (1-based), as a stopped run says; the strokes before it "
                   "are not cut again")
       ->check(CLI::PositiveNumber);
+  addUnitsOption(run, options->units);
   run->add_flag("--dry-run", options->dryRun, "Write what would be sent to --out instead of sending it");
   run->add_option("--out", options->out,
                   "With --dry-run: the file for the bytes (G-code for GRBL, .egv for the M2 Nano, EPS for the spool); "

@@ -47,7 +47,7 @@ std::optional<std::string> readLine(const core::Cancellation& cancel) {
 }
 
 devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
-                                     std::map<int, std::string> kits, TerminalFraming framing) {
+                                     std::map<int, std::string> kits, TerminalFraming framing, core::LengthUnit unit) {
   const bool terminal = ::isatty(STDERR_FILENO) != 0;
   auto bar = std::make_shared<ProgressBar>(terminal);
   // "; its kit: steps 174-352; once cut, ..." for a sheet the manifest gives a kit.
@@ -78,21 +78,23 @@ devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& ca
       return SheetGo::Stop;
     }
   };
-  events.sheetStarted = [bar, sheets, terminal, kitOf, stock](size_t s, const jobs::Toolpath& toolpath,
-                                                              size_t fromStroke, double seconds) {
+  events.sheetStarted = [bar, sheets, terminal, kitOf, stock, unit](size_t s, const jobs::Toolpath& toolpath,
+                                                                    size_t fromStroke, double seconds) {
     // A simulator faster than real: its time, and the machine's it stands for (of a whole sheet).
     const std::string machineTime = fromStroke == 0 && std::abs(seconds - toolpath.seconds) > 0.5
                                         ? fmt::format(" ({} on the machine simulated)", minutes(toolpath.seconds))
                                         : "";
     const std::string strokes =
-        fromStroke == 0 ? fmt::format("{} strokes, {:.1f} in to burn", toolpath.strokes.size(), toolpath.burnLength)
+        fromStroke == 0 ? fmt::format("{} strokes, {} to burn", toolpath.strokes.size(), unit(toolpath.burnLength, 1))
                         : fmt::format("strokes {} to {} (the {} before were cut)", fromStroke + 1,
                                       toolpath.strokes.size(), fromStroke);
     fmt::print(stderr, "run: sheet {} ({} of {}), {}: {}, about {}{}{}\n", toolpath.sheet, s + 1, sheets, stock,
                strokes, minutes(seconds), machineTime, kitOf(toolpath.sheet));
     *bar = ProgressBar(terminal);
   };
-  events.framing = [] { fmt::print(stderr, "run: framing (laser off)\n"); };
+  events.framing = [](const jobs::Toolpath& sheet) {
+    fmt::print(stderr, "run: framing ({})\n", profiles::frameLight(sheet.framePower));
+  };
   events.progress = [bar](const devices::Progress& p) { (*bar)(p); };
   events.sheetFinished = [bar] { bar->end(); };
   events.stopped = [bar] { bar->end(); };

@@ -8,6 +8,7 @@
 
 #include "core/Cancellation.h"
 #include "core/Duration.h"
+#include "core/LengthUnit.h"
 #include "devices/Device.h"
 #include "devices/JobRun.h"
 
@@ -47,10 +48,11 @@ struct TerminalFraming {
 // each sheet starts, its progress bar, the question before each sheet after
 // the first (answered at the terminal), the framing and the question after
 // it ("cut sheet 2 now? [y/N]"). `stock`: what each
-// sheet is (jobs::stockOf(), "posterboard (0.8 mm), 32 x 18 in"); `kits`:
+// sheet is (jobs::stockOf(), "posterboard (0.031 in), 32 x 18 in"); `kits`:
 // each sheet's kit by its number, as the job's manifest says it
-// (ManifestSheets::kits).
+// (ManifestSheets::kits); `unit`: of the lengths said.
 devices::RunEvents terminalRunEvents(size_t sheets, const core::Cancellation& cancel, std::string stock,
-                                     std::map<int, std::string> kits = {}, TerminalFraming framing = {});
+                                     std::map<int, std::string> kits = {}, TerminalFraming framing = {},
+                                     core::LengthUnit unit = {});
 
 }  // namespace rotafab::cli

@@ -81,8 +81,10 @@ class Device {
   // Connects and checks that the controller is one this driver drives; returns what it says it is.
   virtual std::string connect() = 0;
   virtual void home() = 0;
-  // Traces the box of the toolpath's strokes with the laser off.
-  virtual void frame(const jobs::Toolpath& toolpath) = 0;
+  // Traces the box of the toolpath's strokes with the laser off, or lit at
+  // its framePower where the machine allows one (GRBL); a cancel stops it,
+  // and the machine, safely (DeviceFault Cancelled).
+  virtual void frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) = 0;
   // Runs the job to its end; `progress` is called as the device acknowledges it.
   virtual void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
                    const core::Cancellation& cancel) = 0;

@@ -77,14 +77,35 @@ RunSummary JobRun::run(const RunEvents& events, const core::Cancellation& cancel
   }
 }
 
+namespace {
+
+// What a fault says of the laser when it came while a sheet was framed
+// (`tracing`) or after its frame was traced (`traced`): a dark frame sends
+// nothing that lights it; a lit one (the machine's frame_power) leaves it as
+// the driver's stop found it, or, traced whole, off as its closing M5 was
+// acknowledged.
+void sayLaserAfterFrame(DeviceFault& fault, const jobs::Toolpath& sheet, bool tracing, bool traced) {
+  if (!(sheet.framePower > 0) || (!tracing && !traced)) {
+    fault.nothingSent = true;
+  } else {
+    fault.nothingSent = false;
+    if (!tracing) fault.laserOffConfirmed = true;
+  }
+}
+
+}  // namespace
+
 void JobRun::frameOnly(size_t index, const core::Cancellation& cancel) {
   const jobs::Toolpath& toolpath = toolpaths_.at(index);
+  bool tracing = false, traced = false;
   try {
     throwIfCancelled(&cancel);
-    device_->frame(toolpath);
+    tracing = true;
+    device_->frame(toolpath, cancel);
+    tracing = false, traced = true;
     throwIfCancelled(&cancel);
   } catch (DeviceFault& fault) {
-    fault.nothingSent = true;  // moves with the laser off
+    sayLaserAfterFrame(fault, toolpath, tracing, traced);
     fault.sheet = toolpath.sheet, fault.sheets = static_cast<int>(toolpaths_.size());
     throw;
   }
@@ -98,9 +119,10 @@ RunSummary JobRun::runSheets(const RunEvents& events, const core::Cancellation& 
     const size_t first = s == 0 ? std::min(setup_.fromStroke, whole.strokes.size()) : 0;
     // Where a fault finds the job: this sheet, and its strokes cut (those
     // before `first` were, by the run that stopped). Until the sheet's own
-    // run starts, none of it has been sent (framing moves with the laser off).
+    // run starts, none of it has been sent; a frame lights the laser only at
+    // the machine's frame_power.
     size_t cut = first;
-    bool streaming = false;
+    bool streaming = false, tracing = false, traced = false;
     try {
       // Stop, do not cut blind, unless told to cut (the sheet loaded, its frame checked).
       for (bool framed = false;;) {
@@ -108,9 +130,11 @@ RunSummary JobRun::runSheets(const RunEvents& events, const core::Cancellation& 
         if (go == SheetGo::Stop) throw DeviceFault(FaultKind::Cancelled, setup_.device.address->uri() + ": cancelled");
         throwIfCancelled(&cancel);
         if (go == SheetGo::Cut) break;
-        if (events.framing) events.framing();
-        device_->frame(whole);
-        throwIfCancelled(&cancel);  // a cancel while framing: the laser was never lit
+        if (events.framing) events.framing(whole);
+        tracing = true;
+        device_->frame(whole, cancel);
+        tracing = false, traced = true;
+        throwIfCancelled(&cancel);
         framed = true;
       }
       const jobs::Toolpath rest = first == 0 ? whole : jobs::restOfSheet(whole, first, device_->motionLimits());
@@ -128,7 +152,9 @@ RunSummary JobRun::runSheets(const RunEvents& events, const core::Cancellation& 
       summary.burnt += rest.burnLength, summary.estimated += rest.seconds / device_->timeScale();
       summary.strokes += rest.strokes.size();
     } catch (DeviceFault& fault) {
-      fault.nothingSent = fault.nothingSent || !streaming;
+      if (!streaming) {
+        sayLaserAfterFrame(fault, whole, tracing, traced);
+      }
       fault.sheet = whole.sheet, fault.sheets = static_cast<int>(toolpaths_.size());
       fault.strokesDone = cut, fault.strokes = whole.strokes.size();
       throw;

@@ -54,7 +54,7 @@ struct RunEvents {
   // (JobRunSetup::fromStroke, else 0) and the estimated seconds of what is
   // left, in real time (Device::timeScale).
   std::function<void(size_t index, const jobs::Toolpath& sheet, size_t fromStroke, double seconds)> sheetStarted;
-  std::function<void()> framing;
+  std::function<void(const jobs::Toolpath& sheet)> framing;
   std::function<void(const Progress&)> progress;
   std::function<void()> sheetFinished;
   std::function<void()> stopped;  // by a fault or a cancel, before the fault is thrown

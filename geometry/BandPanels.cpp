@@ -306,12 +306,13 @@ void refuseUnetched(const BandBuild& b, const std::vector<std::vector<Unetched>>
     }
   }
   if (edges.empty() || b.options.glueBandsWithoutRoom) {
-    if (auto warning = unetchedLabelsWarning(whatOf, "band")) result.warnings.push_back(std::move(*warning));
+    if (auto warning = unetchedLabelsWarning(whatOf, "band", b.options.names.unit))
+      result.warnings.push_back(std::move(*warning));
     return;
   }
   NoRoomForHoleError error =
-      NoRoomForHoleError::forLabels(fmt::format("{}: its number fits on neither its band nor its panel, even at {} in",
-                                                b.edgeName(*edges.begin()), kSmallestLabel),
+      NoRoomForHoleError::forLabels(fmt::format("{}: its number fits on neither its band nor its panel, even at {}",
+                                                b.edgeName(*edges.begin()), b.options.names.unit(kSmallestLabel, 3)),
                                     static_cast<int>(edges.size()), b.options.names);
   error.edges.assign(edges.begin(), edges.end());
   throw b.withPlaces(error);

@@ -294,8 +294,8 @@ bool OverlapMending::cutOff(int f, int index, bool glued, std::string& why, doub
     return true;
   }
   if (clearance < kLeastClearance) {
-    why = fmt::format("its tab has no room for a {:.3f} in fastener hole {:g} diameter{} from every outline", fastener,
-                      kLeastClearance, kLeastClearance == 1 ? "" : "s");
+    why = fmt::format("its tab has no room for a {} fastener hole {:g} diameter{} from every outline",
+                      b_.options.names.unit(fastener, 3), kLeastClearance, kLeastClearance == 1 ? "" : "s");
     return false;
   }
   cut.tab = hole;
@@ -354,12 +354,12 @@ void countFasteners(const BandBuild& b, const std::vector<BandHoles>& holes, con
     if (narrowest < 0 || h.clearance < holes[narrowest].clearance) narrowest = h.edge;
   }
   if (const int gluedTabs = mended.gluedTabs; gluedTabs > 0) {
-    result.warnings.push_back(fmt::format(
-        "{} band{} cut off {} panel{} that would overlap {}: no room for {} tab's {:.3f} in fastener hole, so {} "
-        "tab{} {} glued",
-        gluedTabs, gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "a" : "the", gluedTabs == 1 ? "" : "s",
-        gluedTabs == 1 ? "itself" : "themselves", gluedTabs == 1 ? "its" : "their", fastener,
-        gluedTabs == 1 ? "its" : "their", gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "is" : "are"));
+    result.warnings.push_back(
+        fmt::format("{} band{} cut off {} panel{} that would overlap {}: no room for {} tab's {} fastener hole, so {} "
+                    "tab{} {} glued",
+                    gluedTabs, gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "a" : "the", gluedTabs == 1 ? "" : "s",
+                    gluedTabs == 1 ? "itself" : "themselves", gluedTabs == 1 ? "its" : "their", names.unit(fastener, 3),
+                    gluedTabs == 1 ? "its" : "their", gluedTabs == 1 ? "" : "s", gluedTabs == 1 ? "is" : "are"));
   }
   if (!result.glued.empty()) {
     std::sort(result.glued.begin(), result.glued.end());
@@ -368,17 +368,17 @@ void countFasteners(const BandBuild& b, const std::vector<BandHoles>& holes, con
       some += fmt::format("{}{}", i ? ", " : "", result.glued[i]);
     }
     const size_t n = result.glued.size();
-    result.warnings.push_back(fmt::format(
-        "{} band{} no room for a {:.3f} in fastener hole {:g} diameter from every outline, so no hole: glue {} "
-        "(edge{} {}{})",
-        n, n == 1 ? " has" : "s have", fastener, kLeastClearance, n == 1 ? "it" : "them", n == 1 ? "" : "s", some,
-        n > 5 ? ", ..." : ""));
+    result.warnings.push_back(
+        fmt::format("{} band{} no room for a {} fastener hole {:g} diameter from every outline, so no hole: glue {} "
+                    "(edge{} {}{})",
+                    n, n == 1 ? " has" : "s have", names.unit(fastener, 3), kLeastClearance, n == 1 ? "it" : "them",
+                    n == 1 ? "" : "s", some, n > 5 ? ", ..." : ""));
   }
   if (narrow > 0) {
     result.warnings.push_back(fmt::format(
-        "{} band{} too narrow for a {:.3f} in hole {} diameters from its outlines: one hole each, down to {:.2f} "
+        "{} band{} too narrow for a {} hole {} diameters from its outlines: one hole each, down to {:.2f} "
         "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
-        narrow, narrow == 1 ? " is" : "s are", fastener, kClearance, holes[narrowest].clearance,
+        narrow, narrow == 1 ? " is" : "s are", names.unit(fastener, 3), kClearance, holes[narrowest].clearance,
         b.edgeNumber[narrowest], names(Parameter::Size), names(Parameter::Fastener)));
   }
 }

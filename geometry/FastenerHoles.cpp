@@ -76,9 +76,8 @@ NoRoomForHoleError::NoRoomForHoleError(std::string firstBand, int bands, double 
   static_cast<std::invalid_argument&>(*this) = std::invalid_argument(
       bandsWithoutRoom +
       (std::isfinite(scaleNeeded)
-           ? fmt::format(
-                 "; a fastener of {:.3f} in or less, or the mesh {:.2f} times larger, would give every band room",
-                 std::floor(diameter / scaleNeeded * 1000) / 1000, scaleNeeded)
+           ? fmt::format("; a fastener of {} or less, or the mesh {:.2f} times larger, would give every band room",
+                         names.unit(diameter / scaleNeeded, 3, -1), scaleNeeded)
            : fmt::format("; use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size))));
 }
 
@@ -114,7 +113,7 @@ const std::vector<Point2>& holesOnPart(const PlacedHoles& placed, const std::pai
 class BandHolePlacer {
  public:
   BandHolePlacer(const EdgeBand& band, const std::vector<FlatPanel>& panels, double diameter,
-                 const PlacedHoles& holesOn, const std::function<std::string(int)>& edgeName)
+                 const PlacedHoles& holesOn, const std::function<std::string(int)>& edgeName, core::LengthUnit unit)
       : band_(band),
         panels_(panels),
         diameter_(diameter),
@@ -122,6 +121,7 @@ class BandHolePlacer {
         fromHole_((kClearance + 1) * diameter),
         holesOn_(holesOn),
         edgeName_(edgeName),
+        unit_(unit),
         copies_{bandCopy(panels[band.faceA], band.edge), bandCopy(panels[band.faceB], band.edge)},
         faces_{band.faceA, band.faceB},
         flat_(copies_[0]->fromA ? *copies_[0] : *copies_[1]),
@@ -226,9 +226,9 @@ class BandHolePlacer {
     placed.clearance = std::min(kClearance, clearanceFromOutlines(placed.holes));
     if (most < kLeastClearance / kClearance) {
       throw BandTooSmall{
-          fmt::format("{}: its band ({:.3f} x {:.3f} in), cut across its middle, has no room for a {:.3f} in fastener "
+          fmt::format("{}: its band ({}), cut across its middle, has no room for a {} fastener "
                       "hole on each half {:g} diameter{} from every outline (centre to edge)",
-                      edgeName_(band_.edge), length_, width_, diameter_, kLeastClearance,
+                      edgeName_(band_.edge), unit_.size(length_, width_, 3), unit_(diameter_, 3), kLeastClearance,
                       kLeastClearance == 1 ? "" : "s"),
           most > 0 ? 1.02 * kLeastClearance / kClearance / most : std::numeric_limits<double>::infinity()};
     }
@@ -258,9 +258,9 @@ class BandHolePlacer {
     placed.clearance = std::min(kClearance, clearanceFromOutlines(placed.holes));
     if (most < kLeastClearance / kClearance) {
       throw BandTooSmall{
-          fmt::format("{}: its band ({:.3f} x {:.3f} in) has no room for a {:.3f} in fastener hole {:g} diameter{} "
+          fmt::format("{}: its band ({}) has no room for a {} fastener hole {:g} diameter{} "
                       "from every outline (centre to edge)",
-                      edgeName_(band_.edge), length_, width_, diameter_, kLeastClearance,
+                      edgeName_(band_.edge), unit_.size(length_, width_, 3), unit_(diameter_, 3), kLeastClearance,
                       kLeastClearance == 1 ? "" : "s"),
           // (with 2% to spare: the search for the hole's place is on a grid)
           most > 0 ? 1.02 * kLeastClearance / kClearance / most : std::numeric_limits<double>::infinity()};
@@ -272,6 +272,7 @@ class BandHolePlacer {
   const double diameter_, fromOutline_, fromHole_;
   const PlacedHoles& holesOn_;
   const std::function<std::string(int)>& edgeName_;
+  core::LengthUnit unit_;  // of the lengths in its messages
   const FlatBand* const copies_[2];
   const int faces_[2];
   const FlatBand& flat_;  // the copy on face A's panel: where the holes' (s, t) are measured
@@ -350,7 +351,7 @@ void placeAgainBesideEarlierBands(const std::vector<EdgeBand>& bands, const std:
     };
     if (tooNear()) {
       try {
-        result[band.edge] = BandHolePlacer(band, panels, diameter, holesOn, edgeName).place();
+        result[band.edge] = BandHolePlacer(band, panels, diameter, holesOn, edgeName, names.unit).place();
       } catch (const BandTooSmall& small) {
         if (!glueWithoutRoom) {
           NoRoomForHoleError error(small.what, 1, small.scaleNeeded, diameter, names);
@@ -385,7 +386,7 @@ std::vector<BandHoles> placeFastenerHoles(const std::vector<EdgeBand>& bands, co
   context.parallelFor(bands.size(), [&](size_t e) {
     if (bands[e].edge < 0) return;
     try {
-      result[e] = BandHolePlacer(bands[e], panels, diameter, none, edgeName).place();
+      result[e] = BandHolePlacer(bands[e], panels, diameter, none, edgeName, names.unit).place();
     } catch (const BandTooSmall& small) {
       tooSmall[e] = small;
     }

@@ -232,7 +232,7 @@ void splitFans(PolygonMesh& mesh, std::vector<MeshRepair>& repairs) {
 
 }  // namespace
 
-std::string MeshRepair::line() const {
+std::string MeshRepair::line(core::LengthUnit unit) const {
   const bool one = count == 1;
   std::string what;
   if (kind == "weld") {
@@ -264,7 +264,9 @@ std::string MeshRepair::line() const {
   } else {
     what = fmt::format("{}: {}", kind, count);
   }
-  if (moved > 0) what += fmt::format(", moving the surface at most {:.2g} in", moved);
+  // (Two significant digits at least: a mend may move it by a hair.)
+  const int decimals = moved > 0 ? std::max(4, 2 - static_cast<int>(std::floor(std::log10(moved)))) : 4;
+  if (moved > 0) what += fmt::format(", moving the surface at most {}", unit(moved, std::min(decimals, 9)));
   std::string open;
   if (leftOpen > 0) {
     open = fmt::format("; {} side{} of them left open, where no two faces belonged together", leftOpen,

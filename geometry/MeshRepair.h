@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "geometry/MeshAnalysis.h"
 #include "geometry/PolygonMesh.h"
 
@@ -46,7 +47,7 @@ struct MeshRepair {
   double moved = 0;   // a mend of the design (MeshMending.h): the farthest a vertex moved, inches
 
   // One line for people: "split 2 bow-tie vertices (the first: vertex 44)".
-  [[nodiscard]] std::string line() const;
+  [[nodiscard]] std::string line(core::LengthUnit unit = {}) const;
 };
 
 // Repairs the mesh in place (before analyzeMesh); the repairs made, in order

@@ -158,15 +158,15 @@ std::optional<TextBox> fitText(const HersheyFont& font, const std::string& text,
 std::vector<double> alongThenAcross(double angle) { return {angle, angle - std::numbers::pi / 2}; }
 
 std::optional<std::string> unetchedLabelsWarning(const std::vector<std::vector<std::string>>& unfittedOf,
-                                                 const std::string& strip) {
+                                                 const std::string& strip, core::LengthUnit unit) {
   std::vector<std::string> unfitted;
   for (const auto& some : unfittedOf) unfitted.insert(unfitted.end(), some.begin(), some.end());
   if (unfitted.empty()) return std::nullopt;
   std::string some;
   for (size_t i = 0; i < unfitted.size() && i < 3; ++i) some += (i ? ", " : "") + unfitted[i];
-  return fmt::format("{} label{} not etched, too large for {} {} even at {} in: {}{}", unfitted.size(),
+  return fmt::format("{} label{} not etched, too large for {} {} even at {}: {}{}", unfitted.size(),
                      unfitted.size() == 1 ? " is" : "s are", unfitted.size() == 1 ? "its" : "their", strip,
-                     kSmallestLabel, some, unfitted.size() > 3 ? ", ..." : "");
+                     unit(kSmallestLabel, 3), some, unfitted.size() > 3 ? ", ..." : "");
 }
 
 }  // namespace rotafab::geometry

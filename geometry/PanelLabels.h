@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "geometry/HersheyFont.h"
 
 namespace rotafab::geometry {
@@ -53,8 +54,8 @@ std::vector<double> alongThenAcross(double angle);
 
 // The warning for labels that fit nowhere, even at kSmallestLabel (one
 // list per panel, built in parallel): "N labels are not etched, too large
-// for their `strip` even at 0.06 in: ..."; none when every label fits.
+// for their `strip` even at 0.06 in: ..." (the height in `unit`); none when every label fits.
 std::optional<std::string> unetchedLabelsWarning(const std::vector<std::vector<std::string>>& unfittedOf,
-                                                 const std::string& strip);
+                                                 const std::string& strip, core::LengthUnit unit = {});
 
 }  // namespace rotafab::geometry

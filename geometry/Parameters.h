@@ -6,6 +6,9 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+
+#include "core/LengthUnit.h"
 
 namespace rotafab::geometry {
 
@@ -25,12 +28,23 @@ enum class Parameter {
   GlueNarrow,     // glue the bands that have no room for a fastener, rather than refuse
 };
 
-// How messages name a parameter.
-using ParameterNames = std::function<std::string(Parameter)>;
-
 // In words: "structure", "holes", "repair", "coplanar merge angle", "panel count", "structure size", "scale", "fastener
 // diameter", "start face", "ribbon width", "ribbon offset", "faces kept as drawn", "narrow bands glued".
 std::string parameterInWords(Parameter parameter);
+
+// The caller's words for messages: how they name a parameter (`names(Parameter::Size)`),
+// and the unit they give lengths in ("a 3.18 mm fastener").
+struct ParameterNames {
+  ParameterNames() = default;
+  template <typename Naming>
+  requires std::is_invocable_r_v<std::string, Naming, Parameter> ParameterNames(
+      Naming naming, core::LengthUnit unit = {})  // NOLINT: a naming function is its names
+      : name(std::move(naming)), unit(unit) {}
+  std::string operator()(Parameter parameter) const { return name(parameter); }
+
+  std::function<std::string(Parameter)> name = parameterInWords;
+  core::LengthUnit unit;
+};
 
 // A parameter's value that cannot be built with; the message names it as
 // the caller's ParameterNames do: "fastener diameter: the hole diameter must be positive".

@@ -213,19 +213,19 @@ std::vector<char> judgeRoomForHoles(const std::vector<CrossingHoles>& holes,
       some += fmt::format("{}{}", i ? ", " : "", result.glued[i]);
     }
     result.warnings.push_back(fmt::format(
-        "{} crossing{} no room for a {:.3f} in fastener hole {:g} diameter from its panels' outlines, so no "
+        "{} crossing{} no room for a {} fastener hole {:g} diameter from its panels' outlines, so no "
         "hole: glue {} (edge{} {}{})",
-        withoutRoom, withoutRoom == 1 ? " has" : "s have", d, kLeastClearance, withoutRoom == 1 ? "it" : "them",
-        withoutRoom == 1 ? "" : "s", some, result.glued.size() > 5 ? ", ..." : ""));
+        withoutRoom, withoutRoom == 1 ? " has" : "s have", options.names.unit(d, 3), kLeastClearance,
+        withoutRoom == 1 ? "it" : "them", withoutRoom == 1 ? "" : "s", some, result.glued.size() > 5 ? ", ..." : ""));
     withoutRoom = 0;
   }
   if (withoutRoom > 0) {
     std::sort(scales.begin(), scales.end(), std::greater<>());
     scaleNeeded = scales[std::min(mayGlue, scales.size() - 1)];
     NoRoomForHoleError error(
-        fmt::format("edge {}: its crossing has no room for two {:.3f} in holes {:g} diameter from the outlines of "
+        fmt::format("edge {}: its crossing has no room for two {} holes {:g} diameter from the outlines of "
                     "its three panels{}",
-                    first, d, kLeastClearance,
+                    first, options.names.unit(d, 3), kLeastClearance,
                     withoutRoom > 1 ? fmt::format(" (nor have {} other crossings)", withoutRoom - 1) : ""),
         1, scaleNeeded, d, options.names);
     error.bands = withoutRoom;
@@ -233,18 +233,18 @@ std::vector<char> judgeRoomForHoles(const std::vector<CrossingHoles>& holes,
     throw error;
   }
   if (single > 0) {
-    result.warnings.push_back(fmt::format(
-        "{} crossing{} too small for two {:.3f} in holes: one at {} centre, through its three panels; a larger {} "
-        "or a smaller {} gives {} two",
-        single, single == 1 ? " is" : "s are", d, single == 1 ? "its" : "each one's", options.names(Parameter::Size),
-        options.names(Parameter::Fastener), single == 1 ? "it" : "them"));
+    result.warnings.push_back(
+        fmt::format("{} crossing{} too small for two {} holes: one at {} centre, through its three panels; a larger {} "
+                    "or a smaller {} gives {} two",
+                    single, single == 1 ? " is" : "s are", options.names.unit(d, 3), single == 1 ? "its" : "each one's",
+                    options.names(Parameter::Size), options.names(Parameter::Fastener), single == 1 ? "it" : "them"));
   }
   if (narrow > 0) {
-    result.warnings.push_back(fmt::format(
-        "{} crossing{} too narrow for {:.3f} in holes {} diameters from the panels' outlines, down to {:.2f} "
-        "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
-        narrow, narrow == 1 ? " is" : "s are", d, kClearance, narrowest, narrowestEdge, options.names(Parameter::Size),
-        options.names(Parameter::Fastener)));
+    result.warnings.push_back(
+        fmt::format("{} crossing{} too narrow for {} holes {} diameters from the panels' outlines, down to {:.2f} "
+                    "diameters (edge {}); a larger {} or a smaller {} gives them the full clearance",
+                    narrow, narrow == 1 ? " is" : "s are", options.names.unit(d, 3), kClearance, narrowest,
+                    narrowestEdge, options.names(Parameter::Size), options.names(Parameter::Fastener)));
   }
   return glued;
 }
@@ -382,7 +382,8 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
 // in three (refused: nobody could cut and build them) or were cut apart.
 void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf, const std::vector<char>& stillFolded,
                  const PolygonMesh& mesh, const WeaveOptions& options, Structure& result) {
-  if (auto warning = unetchedLabelsWarning(unfittedOf, "ribbon")) result.warnings.push_back(std::move(*warning));
+  if (auto warning = unetchedLabelsWarning(unfittedOf, "ribbon", options.names.unit))
+    result.warnings.push_back(std::move(*warning));
   std::vector<int> overlapping;
   for (size_t k = 0; k < result.panels.size(); ++k) {
     if (stillFolded[k]) overlapping.push_back(result.panels[k].id);
@@ -426,10 +427,10 @@ void judgeRibbons(const WovenRibbons& w, const std::vector<int>& edgeNumber, con
     meanEdge /= static_cast<double>(std::max<size_t>(1, w.regions.size()));
     if (options.shape.offset > kMostOffsetPerEdge * meanEdge) {
       result.warnings.push_back(fmt::format(
-          "{} {:g} in stands the ribbons over and under each crossing {:g} in apart, more than {:.0f}% of the mean "
-          "edge ({:.3g} in): the panels will not lie on each other; half the material's thickness is the default",
-          options.names(Parameter::Offset), options.shape.offset, 2 * options.shape.offset, 200 * kMostOffsetPerEdge,
-          meanEdge));
+          "{} {} stands the ribbons over and under each crossing {} apart, more than {:.0f}% of the mean "
+          "edge ({}): the panels will not lie on each other; half the material's thickness is the default",
+          options.names(Parameter::Offset), options.names.unit(options.shape.offset, 3),
+          options.names.unit(2 * options.shape.offset, 3), 200 * kMostOffsetPerEdge, options.names.unit(meanEdge, 3)));
     }
   }
   if (w.narrowed > 0) {

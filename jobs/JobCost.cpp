@@ -34,12 +34,14 @@ nlohmann::ordered_json costJson(const JobCost& cost) {
   return json;
 }
 
-std::string costLine(const JobCost& cost) {
-  std::string line = fmt::format("{} sheet{} of {} ({:g} x {:g} in)", cost.sheets, cost.sheets == 1 ? "" : "s",
-                                 cost.material, cost.sheetWidth, cost.sheetHeight);
+std::string costLine(const JobCost& cost, core::LengthUnit unit) {
+  std::string line = fmt::format("{} sheet{} of {} ({})", cost.sheets, cost.sheets == 1 ? "" : "s", cost.material,
+                                 unit.size(cost.sheetWidth, cost.sheetHeight, 3));
   if (cost.fasteners > 0) {
-    line += fmt::format(" and {} fastener{} of {:g} in ({:.1f} mm)", cost.fasteners, cost.fasteners == 1 ? "" : "s",
-                        cost.fastenerDiameter, cost.fastenerDiameter * 25.4);
+    // Fasteners are sold by their metric size too: inches give it beside.
+    line += fmt::format(" and {} fastener{} of {}", cost.fasteners, cost.fasteners == 1 ? "" : "s",
+                        unit(cost.fastenerDiameter, 3));
+    if (!unit.metric()) line += fmt::format(" ({:.1f} mm)", cost.fastenerDiameter * 25.4);
   }
   if (!cost.cuttingSeconds.empty()) {
     line += fmt::format("; cutting about {}", core::minutes(cost.totalSeconds()));

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/LengthUnit.h"
+
 #include <string>
 #include <vector>
 
@@ -38,7 +40,8 @@ inline constexpr double kAssemblySecondsPerFastener = 25.0 * 3600 / 2 / 8416;
 nlohmann::ordered_json costJson(const JobCost& cost);
 JobCost costFromJson(const nlohmann::json& json);  // throws nlohmann::json::exception
 // "2 sheets of posterboard (32 x 18 in) and 298 fasteners of 0.125 in (3.2 mm); cutting about 12m 30s;
-// assembling about 1h 10m of one person's time".
-std::string costLine(const JobCost& cost);
+// assembling about 1h 10m of one person's time", the lengths in `unit` (in
+// millimetres: "(812.8 x 457.2 mm) and 298 fasteners of 3.2 mm").
+std::string costLine(const JobCost& cost, core::LengthUnit unit = {});
 
 }  // namespace rotafab::jobs

@@ -160,6 +160,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   job.bed = request.machine.bed;
   job.machine = request.machine.name;
   job.material = request.material.name;
+  job.shownIn = request.shownIn;
   job.formats = request.formats.value_or(defaultFormats(request.machine));
   job.seconds.nesting = lap();
   if (!job.sheets.inRowsNote.empty()) context.note(fmt::format("{}: {}", name, job.sheets.inRowsNote));
@@ -172,7 +173,7 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
   Lap lap;
   context.report({"writing", "", 0, job.sheets.sheets.size()});
   OutputFolder output(folder);
-  job.files = writeSheets(job.sheets, job.formats, output.staging(), context);
+  job.files = writeSheets(job.sheets, job.formats, output.staging(), context, job.shownIn);
   context.check();
   writeFileAtomically(output.staging() / "structure.obj", [&](std::ostream& stream) {
     geometry::writeStructureObj(
@@ -187,7 +188,9 @@ void writeJob(PlannedJob& job, const std::filesystem::path& folder, const core::
                                    {"material", job.material},
                                    {"size", {job.size.x(), job.size.y(), job.size.z()}},
                                    {"stability", stabilityJson(job.stability)},
-                                   {"cost", costJson(job.cost)}};
+                                   {"cost", costJson(job.cost)},
+                                   // The unit manifest.txt, `run` and the page show its lengths in.
+                                   {"display_units", job.shownIn.name()}};
     if (!job.warnings.empty()) more["warnings"] = job.warnings;
     ManifestFiles manifest = manifestFiles(job.structure, job.mesh, job.bed, job.sheets, job.files, more, context);
     writeFileAtomically(output.staging() / "manifest.json", manifest.json);

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "core/WorkContext.h"
 #include "geometry/Parameters.h"
 #include "geometry/Stability.h"
@@ -80,6 +81,8 @@ struct MakeRequest {
   bool rows = false;
   // How messages name the options (the command line: by their flags).
   geometry::ParameterNames names = geometry::parameterInWords;
+  // The unit the summary, manifest.txt, the previews and messages show lengths in.
+  core::LengthUnit shownIn;
 };
 
 struct PhaseSeconds {
@@ -99,6 +102,7 @@ struct PlannedJob {
   SheetPlan sheets;
   SheetFormats formats;
   JobCost cost;
+  core::LengthUnit shownIn;  // the request's: manifest.json's "display_units"
   // What the plan warns of (a band with less clearance, labels that do not
   // fit), as make says it, without the mesh's name: manifest.json's
   // "warnings" and manifest.txt's, before the steps.

@@ -9,6 +9,7 @@
 
 #include "core/UserError.h"
 #include "profiles/Length.h"
+#include "profiles/UserSettings.h"
 
 namespace rotafab::jobs {
 namespace {
@@ -249,6 +250,11 @@ const std::vector<MakeOption>& makeOptionTable() {
                  &M::layout)
           .among({"nest", "rows"})
           .shown(),
+      MakeOption("units", V::Choice,
+                 "Show lengths in mm or in: the summary, manifest.txt, the previews, run and the page (default:\n"
+                 "`units:` in ~/.config/rotafab/config.yaml, else --size's unit, else the bed's); files stay in inches",
+                 &M::units)
+          .among({"mm", "in"}),
       MakeOption("formats", V::Formats,
                  "Sheet files to write, of eps, svg and dxf, e.g. eps,svg,dxf (default: eps,svg, and dxf where the\n"
                  "machine profile's `formats` names it); `rotafab run` and the daemon cut from the SVG",
@@ -469,6 +475,7 @@ MakeRequest requestOf(const MakeOptions& options, const profiles::ProfileCatalog
   request.rows = options.layout == "rows";
   if (!options.formats.empty()) request.formats = formatsOf(options.formats);  // checked by whyNotAValue
   request.names = flagOf;
+  request.shownIn = profiles::shownUnit(options.units, std::nullopt, options.size, request.machine.bed.unit);
   return request;
 }
 

@@ -25,6 +25,7 @@ struct MakeOptions {
   std::string mesh, structure, out, machine = "workshop-32x18", material = "posterboard";
   std::string size, fastener, kerf, holes, repair = "auto", up = "y", order = "kits", layout = "nest";
   std::string offset, cycles = "all";  // the weave's
+  std::string units;                   // mm or in; empty: the caller's setting, else --size's unit
   std::optional<double> width, curve;  // the weave's: fractions, no unit
   std::string formats;                 // empty: the machine profile's (jobs::defaultFormats())
   std::optional<double> scale, tension, mergeCoplanar;

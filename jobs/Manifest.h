@@ -7,9 +7,11 @@
 
 #include <filesystem>
 #include <nlohmann/json_fwd.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "core/WorkContext.h"
 #include "geometry/MeshRepair.h"
 #include "geometry/Remeshing.h"
@@ -56,11 +58,16 @@ nlohmann::ordered_json simplifiedJson(const PanelCount& count);
 // empty), "footprint" (its corners on the ground)}; inches.
 nlohmann::ordered_json stabilityJson(const geometry::Stability& stability);
 
+// The unit the job's lengths are shown in: its "display_units" (an
+// extension; make's --units), else inches.
+core::LengthUnit displayUnitOf(const nlohmann::ordered_json& manifest);
+
 // The assembly steps as text: for each panel in flood-fill order, its sheet,
 // the panels already placed that it joins and the edge numbers to fasten
-// with the fasteners of each; totals at the end. Throws
-// std::invalid_argument naming the first key that is missing or wrong.
-std::string manifestText(const nlohmann::ordered_json& manifest);
+// with the fasteners of each; totals at the end; its lengths in `unit`, else
+// in the manifest's "display_units". Throws std::invalid_argument naming the
+// first key that is missing or wrong.
+std::string manifestText(const nlohmann::ordered_json& manifest, std::optional<core::LengthUnit> unit = std::nullopt);
 
 // manifest.json's text: a line for each member of the top level, and a line
 // for each sheet and each panel (people and grep read it a panel to a line;
@@ -85,6 +92,7 @@ ManifestFiles manifestFiles(const geometry::Structure& structure, const BuiltMes
 // sheet (its SVG file from `folder`, inlined) on a page of its own, with
 // the panels it holds in cutting order. Throws std::invalid_argument as
 // manifestText(), or naming a sheet's SVG file that cannot be read.
-std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder);
+std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder,
+                         std::optional<core::LengthUnit> unit = std::nullopt);
 
 }  // namespace rotafab::jobs

@@ -21,7 +21,8 @@
 
 namespace rotafab::jobs {
 
-std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder) {
+std::string manifestHtml(const nlohmann::ordered_json& manifest, const std::filesystem::path& folder,
+                         std::optional<core::LengthUnit> unit) {
   try {
     std::string html = fmt::format(R"(<!DOCTYPE html>
 <html lang="en">
@@ -46,7 +47,8 @@ section.sheet .cutfile svg #etch path {{ stroke: #a0522d; }}
 <tr><th>step</th><th>panel</th><th>sheet</th><th>joins</th><th>fasteners</th></tr>
 )",
                                    xmlText(headline(manifest)), xmlText(howToJoin(manifest)));
-    for (const std::string& note : buildNotes(manifest)) html += fmt::format("<p>{}</p>\n", xmlText(note));
+    for (const std::string& note : buildNotes(manifest, unit.value_or(displayUnitOf(manifest))))
+      html += fmt::format("<p>{}</p>\n", xmlText(note));
     int total = 0;
     for (const StepLine& step : stepLines(manifest)) {
       total += step.fasteners;

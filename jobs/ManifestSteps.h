@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
+
 namespace rotafab::jobs {
 
 // One assembly step as the builders read it, whatever the structure.
@@ -37,7 +39,8 @@ std::string kitText(const SheetKit& kit);
 std::string howToJoin(const nlohmann::ordered_json& manifest);
 // "band structure, 12 panels on 2 sheets, 30 fasteners".
 std::string headline(const nlohmann::ordered_json& manifest);
-// What the builders should know before they start, one sentence each.
-std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest);
+// What the builders should know before they start, one sentence each, the
+// lengths in `unit`.
+std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest, core::LengthUnit unit);
 
 }  // namespace rotafab::jobs

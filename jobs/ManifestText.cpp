@@ -332,16 +332,22 @@ std::string headline(const nlohmann::ordered_json& manifest) {
 // What the builders should know before they start, from the manifest's
 // optional keys: how the mesh was repaired and remeshed, and whether the
 // structure will stand or must be hung. One sentence each.
-std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
+core::LengthUnit displayUnitOf(const nlohmann::ordered_json& manifest) {
+  const auto shown = manifest.find("display_units");
+  if (shown == manifest.end() || !shown->is_string()) return {};
+  return core::LengthUnit::named(shown->get<std::string>()).value_or(core::LengthUnit());
+}
+
+std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest, core::LengthUnit unit) {
   std::vector<std::string> notes;
   if (manifest.contains("cost"))
-    notes.push_back(fmt::format("It takes {}.", costLine(costFromJson(manifest.at("cost")))));
+    notes.push_back(fmt::format("It takes {}.", costLine(costFromJson(manifest.at("cost")), unit)));
   if (manifest.contains("repairs")) {
     for (const auto& repair : manifest.at("repairs")) {
       geometry::MeshRepair made{repair.at("kind").get<std::string>(), repair.at("count").get<int>(),
                                 repair.at("first").get<std::string>()};
       made.moved = repair.value("moved", 0.0);
-      notes.push_back(fmt::format("The mesh was repaired: {}.", made.line()));
+      notes.push_back(fmt::format("The mesh was repaired: {}.", made.line(unit)));
     }
   }
   if (manifest.contains("simplified")) {
@@ -364,20 +370,22 @@ std::vector<std::string> buildNotes(const nlohmann::ordered_json& manifest) {
     const double margin = stability.at("margin").get<double>();
     if (stability.at("stands").get<bool>()) {
       notes.push_back(
-          fmt::format("It stands: its centre of mass is {:.2f} in inside its footprint.{}", margin, weighs));
+          fmt::format("It stands: its centre of mass is {} inside its footprint.{}", unit(margin, 2), weighs));
     } else {
-      const auto point = [](const nlohmann::ordered_json& p) {
-        return fmt::format("({:.2f}, {:.2f}, {:.2f})", p[0].get<double>(), p[1].get<double>(), p[2].get<double>());
+      const auto point = [unit](const nlohmann::ordered_json& p) {
+        return fmt::format("({}, {}, {})", unit.number(p[0].get<double>()), unit.number(p[1].get<double>()),
+                           unit.number(p[2].get<double>()));
       };
       const auto& hang = stability.at("hang_points");
       const std::string from =
           hang.at(0) == hang.at(1) ? point(hang.at(0)) : point(hang.at(0)) + " and " + point(hang.at(1));
       const std::string falls =
           margin < -geometry::kBalanceInches
-              ? fmt::format("It will tip over: its centre of mass is {:.2f} in outside its footprint.", -margin)
+              ? fmt::format("It will tip over: its centre of mass is {} outside its footprint.", unit(-margin, 2))
               : std::string("It balances on the edge of its footprint, and a touch tips it.");
-      notes.push_back(
-          fmt::format("{} Hang it from {} (inches, as in structure.obj), or weight its base.{}", falls, from, weighs));
+      notes.push_back(fmt::format("{} Hang it from {} ({}, in structure.obj's axes{}), or weight its base.{}", falls,
+                                  from, unit.metric() ? "millimetres" : "inches",
+                                  unit.metric() ? ", whose unit is the inch" : "", weighs));
     }
   }
   return notes;
@@ -425,11 +433,11 @@ std::string kitText(const SheetKit& kit) {
                  : fmt::format("panels of steps {} to {} (not in one run)", kit.first, kit.last);
 }
 
-std::string manifestText(const nlohmann::ordered_json& manifest) {
+std::string manifestText(const nlohmann::ordered_json& manifest, std::optional<core::LengthUnit> unit) {
   try {
     std::string text =
         fmt::format("Assembly manifest: {}\n{}\n", headline(manifest), wrapped(howToJoin(manifest), 104));
-    if (const auto notes = buildNotes(manifest); !notes.empty()) {
+    if (const auto notes = buildNotes(manifest, unit.value_or(displayUnitOf(manifest))); !notes.empty()) {
       for (const std::string& note : notes) text += note + "\n";
       text += "\n";
     }

@@ -100,7 +100,8 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
   std::vector<geometry::MeshRepair> repairs;
   if (request.repair) {
     repairs = geometry::repairMesh(mesh);
-    for (const auto& repair : repairs) context.note(fmt::format("{}: repaired: {}", name, repair.line()));
+    for (const auto& repair : repairs)
+      context.note(fmt::format("{}: repaired: {}", name, repair.line(request.shownIn)));
   }
   geometry::MeshAnalysis analysis = geometry::analyzeMesh(mesh);
   for (const auto& note : analysis.notes) context.note(fmt::format("{}: {}", name, note));

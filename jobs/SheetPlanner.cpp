@@ -159,8 +159,8 @@ SheetFormats formatsOf(const std::string& list) {
 }
 
 std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const SheetFormats& formats,
-                                                  const std::filesystem::path& folder,
-                                                  const core::WorkContext& context) {
+                                                  const std::filesystem::path& folder, const core::WorkContext& context,
+                                                  core::LengthUnit shownIn) {
   std::filesystem::create_directories(folder);
   std::vector<std::vector<std::string>> files(plan.sheets.size());
   // The sheets shared out among the threads: the bunny's 31 sheets are 170 MB
@@ -177,7 +177,8 @@ std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const S
     write(formats.eps, stem + ".eps", writeEps);
     write(formats.svg, stem + ".svg", writeSvg);
     write(formats.dxf, stem + ".dxf", writeDxf);
-    writeFileAtomically(folder / previewFile(sheet.index), [&](std::ostream& out) { writeSvgPreview(sheet, out); });
+    writeFileAtomically(folder / previewFile(sheet.index),
+                        [&](std::ostream& out) { writeSvgPreview(sheet, out, shownIn); });
   });
   return files;
 }

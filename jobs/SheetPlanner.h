@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "core/WorkContext.h"
 #include "geometry/Structure.h"
 #include "jobs/Nesting.h"
@@ -82,10 +83,11 @@ std::string previewFile(int sheet);
 // Writes sheet-001.eps, .svg and .dxf, ... (those `formats` asks for) into `folder` (each atomically),
 // and each sheet's preview (previewFile()), the sheets shared out on the
 // context's executor; returns the file names of each sheet's cut files
-// (not the preview), in order. Throws core::Cancelled.
+// (not the preview, whose caption gives the sheet's size in `shownIn`), in
+// order. Throws core::Cancelled.
 std::vector<std::vector<std::string>> writeSheets(const SheetPlan& plan, const SheetFormats& formats,
-                                                  const std::filesystem::path& folder,
-                                                  const core::WorkContext& context);
+                                                  const std::filesystem::path& folder, const core::WorkContext& context,
+                                                  core::LengthUnit shownIn = {});
 
 // The panels as parts for the planner: outline, fastener holes (circles),
 // labels to etch, folds to score. The parts' order runs over the panels in

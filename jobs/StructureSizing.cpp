@@ -35,6 +35,7 @@ using geometry::Parameter;
 std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, double fastener,
                        double scaleNeeded, std::string_view places = "band", bool estimate = false) {
   const auto& names = request.names;
+  const core::LengthUnit unit = request.shownIn;
   if (!std::isfinite(scaleNeeded)) {
     return fmt::format("use a smaller {} or a larger {}", names(Parameter::Fastener), names(Parameter::Size));
   }
@@ -42,11 +43,11 @@ std::string roomAdvice(const MakeRequest& request, const geometry::PolygonMesh& 
   const double size = request.size ? *request.size : geometry::boundingBoxSize(mesh).maxCoeff();
   const std::string larger = request.scale
                                  ? fmt::format("{} {:.4g}", names(Parameter::Scale), *request.scale * scaleNeeded)
-                                 : fmt::format("{} {:.0f}in", names(Parameter::Size), std::ceil(size * scaleNeeded));
+                                 : fmt::format("{} {}", names(Parameter::Size), unit.value(size * scaleNeeded, 0, 1));
   const double smaller = std::floor(fastener / scaleNeeded * 1000) / 1000;
   const char* verb = estimate ? "may" : "would";
-  return smaller > 0 ? fmt::format("{} {:.3f}in or smaller, or {} or larger, {} give every {} room",
-                                   names(Parameter::Fastener), smaller, larger, verb, places)
+  return smaller > 0 ? fmt::format("{} {} or smaller, or {} or larger, {} give every {} room",
+                                   names(Parameter::Fastener), unit.value(smaller, 3, -1), larger, verb, places)
                      : fmt::format("{} or larger {} give every {} room", larger, verb, places);
 }
 
@@ -97,10 +98,10 @@ bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHol
 
 // The mends, among the repairs of the mesh as built, said, and its counts as built.
 void recordMends(const geometry::Mends& mends, geometry::PolygonMesh& mesh, BuiltMesh& built, const std::string& name,
-                 const core::WorkContext& context) {
+                 core::LengthUnit unit, const core::WorkContext& context) {
   for (const geometry::MeshRepair* made : mends.kinds()) {
     if (made->count == 0) continue;
-    context.note(fmt::format("{}: repaired: {}", name, made->line()));
+    context.note(fmt::format("{}: repaired: {}", name, made->line(unit)));
     built.repairs.push_back(*made);
   }
   const geometry::MeshTopology topology = geometry::analyzeMesh(mesh).topology;
@@ -148,20 +149,21 @@ Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh
     const geometry::GrownStructure grown = geometry::buildBandStructureWithRoom(larger, band, context);
     const double smaller = std::floor(band.fastener / grown.grown * 1000) / 1000;
     const double side = std::ceil(builtSize(grown.structure).maxCoeff());
-    const std::string size = fmt::format("{} {:.0f}in", names(Parameter::Size), side);
+    const core::LengthUnit unit = request.shownIn;
+    const std::string size = fmt::format("{} {}", names(Parameter::Size), unit.value(side, 0, 1));
     const double kerf = request.kerf.value_or(request.material.kerf);
     const bool fastenerBuilds = buildsWith(smaller);
     if (roomOnTheBed(structureParts(grown.structure), request.machine, kerf) < 1) {
       if (fastenerBuilds) {
-        return {fmt::format("{} {:.3f}in or smaller builds it at this size (tried; at {:.0f} in with this "
+        return {fmt::format("{} {} or smaller builds it at this size (tried; at {} with this "
                             "fastener a panel is larger than the bed){}",
-                            names(Parameter::Fastener), smaller, side, glue),
+                            names(Parameter::Fastener), unit.value(smaller, 3, -1), unit(side, 0), glue),
                 true};
       }
-      return {fmt::format("at {:.0f} in every band has room, but a panel is larger than the bed{}", side, glue)};
+      return {fmt::format("at {} every band has room, but a panel is larger than the bed{}", unit(side, 0), glue)};
     }
-    return {fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {:.3f}in at this size{}", size,
-                                         names(Parameter::Fastener), smaller, glue)
+    return {fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {} at this size{}", size,
+                                         names(Parameter::Fastener), unit.value(smaller, 3, -1), glue)
                            : fmt::format("{} or larger builds it as drawn (tried){}", size, glue),
             true};
   } catch (const geometry::NoRoomForHoleError& error) {
@@ -189,6 +191,7 @@ class MendingBuild {
     band_.up = request.up;
     band_.scoreFolds = request.scoreFolds;
     band_.names = request.names;
+    band_.names.unit = request.shownIn;
   }
 
   geometry::Structure build() {
@@ -284,14 +287,15 @@ class MendingBuild {
   }
 
   geometry::Structure finished(geometry::Structure structure) {
-    if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, context_);
+    if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, request_.shownIn, context_);
     if (sizing_.grown > 1) {
-      context_.note(fmt::format(
-          "{}: scaled to a mean edge of {:.2f} in, not {:g} in ({:.0f}% larger, {:.1f} in at its largest side): at "
-          "that size every band has room for its {:.3f} in fastener; {} or {} sets the size",
-          name_, geometry::kMeanEdgeInches * sizing_.grown, geometry::kMeanEdgeInches, 100 * (sizing_.grown - 1),
-          builtSize(structure).maxCoeff(), band_.fastener, request_.names(Parameter::Size),
-          request_.names(Parameter::Scale)));
+      const core::LengthUnit unit = request_.shownIn;
+      context_.note(
+          fmt::format("{}: scaled to a mean edge of {}, not {} ({:.0f}% larger, {} at its largest side): at "
+                      "that size every band has room for its {} fastener; {} or {} sets the size",
+                      name_, unit(geometry::kMeanEdgeInches * sizing_.grown, 2), unit(geometry::kMeanEdgeInches, 2),
+                      100 * (sizing_.grown - 1), unit(builtSize(structure).maxCoeff(), 1), unit(band_.fastener, 3),
+                      request_.names(Parameter::Size), request_.names(Parameter::Scale)));
     }
     return structure;
   }
@@ -303,9 +307,9 @@ class MendingBuild {
       band_.glueBandsWithoutRoom = true;
       geometry::Structure glued = finished(geometry::buildBandStructure(mesh_, band_, context_));
       const size_t n = glued.glued.size();
-      glued.warnings.push_back(fmt::format("{} band{} without room for a {:.3f} in fastener {} glued, as {} asks", n,
-                                           plural(static_cast<int>(n)), band_.fastener, n == 1 ? "is" : "are",
-                                           names(Parameter::GlueNarrow)));
+      glued.warnings.push_back(fmt::format("{} band{} without room for a {} fastener {} glued, as {} asks", n,
+                                           plural(static_cast<int>(n)), request_.shownIn(band_.fastener, 3),
+                                           n == 1 ? "is" : "are", names(Parameter::GlueNarrow)));
       return glued;
     }
     const std::string after = mends_.count() > 0   ? fmt::format(" after {} narrow place{} mended", mends_.count(),
@@ -369,6 +373,7 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
   weave.fastener = request.fastener.value_or(request.material.fastenerDiameter);
   weave.up = request.up;
   weave.names = request.names;
+  weave.names.unit = request.shownIn;
   try {
     if (request.size) {
       const double side = geometry::boundingBoxSize(mesh).maxCoeff();
@@ -403,24 +408,26 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
       // (Still over the bed: the planner's refusal names the panel, with the size advice.)
       if (room < 1) return glued;
       sizing.bedLimited = true;
-      context.note(fmt::format(
-          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the largest size that fits the bed, below the {:.2f} "
-          "in at which every crossing has room for {:.3f} in fastener holes; {} crossing{} without room {} glued; {} "
-          "N, fewer and evener faces, needs less",
-          name, geometry::kMeanEdgeInches * sizing.grown, geometry::kMeanEdgeInches,
-          geometry::kMeanEdgeInches * grownAtFirst, weave.fastener, glued.glued.size(),
-          plural(static_cast<int>(glued.glued.size())), glued.glued.size() == 1 ? "is" : "are",
-          request.names(Parameter::Panels)));
+      const core::LengthUnit unit = request.shownIn;
+      context.note(
+          fmt::format("{}: scaled to a mean edge of {}, not {}, the largest size that fits the bed, below the {} "
+                      "at which every crossing has room for {} fastener holes; {} crossing{} without room {} glued; {} "
+                      "N, fewer and evener faces, needs less",
+                      name, unit(geometry::kMeanEdgeInches * sizing.grown, 2), unit(geometry::kMeanEdgeInches, 2),
+                      unit(geometry::kMeanEdgeInches * grownAtFirst, 2), unit(weave.fastener, 3), glued.glued.size(),
+                      plural(static_cast<int>(glued.glued.size())), glued.glued.size() == 1 ? "is" : "are",
+                      request.names(Parameter::Panels)));
       return glued;
     }
     if (built.grown > 1) {
+      const core::LengthUnit unit = request.shownIn;
       context.note(fmt::format(
-          "{}: scaled to a mean edge of {:.2f} in, not {:g} in, the smallest size at which its crossings have room "
-          "for {:.3f} in fastener holes, all but one in a hundred ({} crossing{} had none at the default size); {} or "
+          "{}: scaled to a mean edge of {}, not {}, the smallest size at which its crossings have room "
+          "for {} fastener holes, all but one in a hundred ({} crossing{} had none at the default size); {} or "
           "{} sets the size",
-          name, geometry::kMeanEdgeInches * built.grown, geometry::kMeanEdgeInches, weave.fastener,
-          built.bandsWithoutRoom, plural(built.bandsWithoutRoom), request.names(Parameter::Size),
-          request.names(Parameter::Scale)));
+          name, unit(geometry::kMeanEdgeInches * built.grown, 2), unit(geometry::kMeanEdgeInches, 2),
+          unit(weave.fastener, 3), built.bandsWithoutRoom, plural(built.bandsWithoutRoom),
+          request.names(Parameter::Size), request.names(Parameter::Scale)));
     }
     return std::move(built.structure);
   } catch (const geometry::NoRoomForHoleError& error) {

@@ -164,7 +164,7 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out) {
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
 }
 
-void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out) {
+void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out, core::LengthUnit shownIn) {
   checkDrawable(sheet);
   fmt::memory_buffer buffer;
   const auto to = std::back_inserter(buffer);
@@ -178,9 +178,10 @@ void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out) {
                  width, formatDecimal(sheet.height + kTitle, kDecimals), formatDecimal(-kTitle, kDecimals));
   const std::string title = sheet.title.empty() ? fmt::format("sheet {}", sheet.index) : sheet.title;
   fmt::format_to(to, "<title>{} (preview, not for cutting)</title>\n", xmlText(title));
-  fmt::format_to(to,
-                 "<text x=\"0\" y=\"-0.25\" font-family=\"sans-serif\" font-size=\"0.45\" fill=\"#222\">{}</text>\n",
-                 xmlText(title));
+  // The caption: which sheet, and the size of the stock it is cut from.
+  fmt::format_to(
+      to, "<text x=\"0\" y=\"-0.25\" font-family=\"sans-serif\" font-size=\"0.45\" fill=\"#222\">{}, {}</text>\n",
+      xmlText(title), shownIn.size(sheet.width, sheet.height, 3));
   fmt::format_to(to,
                  "<rect class=\"material\" x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" fill=\"#f3ead8\" "
                  "stroke=\"#999\" stroke-width=\"0.02\"/>\n",

@@ -26,6 +26,7 @@
 #include <string>
 #include <string_view>
 
+#include "core/LengthUnit.h"
 #include "toolpath/SheetDrawing.h"
 
 namespace rotafab::jobs {
@@ -34,9 +35,9 @@ void writeSvg(const SheetDrawing& sheet, std::ostream& out);
 
 // The same sheet for people to look at (a cutter would burn its wide lines):
 // the material light, cuts 0.02 in wide in dark blue, scores dashed in red,
-// labels dark brown; the title above. Classes, not ids, so that many can
+// labels dark brown; the title and the sheet's size in `shownIn` above. Classes, not ids, so that many can
 // share one HTML page.
-void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out);
+void writeSvgPreview(const SheetDrawing& sheet, std::ostream& out, core::LengthUnit shownIn = {});
 
 // Character data for XML 1.0 (and HTML): markup characters escaped, control
 // characters (not allowed in XML 1.0) and bytes that are not valid UTF-8

@@ -35,7 +35,11 @@ struct Change {
   [[nodiscard]] std::string options(const MakeRequest& request) const {
     std::string said;
     if (panels) said += fmt::format("{} {}", request.names(Parameter::Panels), *panels);
-    if (size) said += fmt::format("{}{} {:.0f}in", said.empty() ? "" : " ", request.names(Parameter::Size), *size);
+    // (The size tried, rounded up: 36 in is 914.4 mm.)
+    if (size) {
+      said += fmt::format("{}{} {}", said.empty() ? "" : " ", request.names(Parameter::Size),
+                          request.shownIn.value(*size, 2, 1));
+    }
     return said;
   }
 };
@@ -151,7 +155,7 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
   if (!refused.advice.empty()) said += "; " + refused.advice;
   if (tries == 0) return said;
   std::vector<std::string> ranges;
-  if (largestSize) ranges.push_back(fmt::format("sizes up to {:.0f} in", *largestSize));
+  if (largestSize) ranges.push_back(fmt::format("sizes up to {}", request.shownIn(*largestSize, 0)));
   if (fewestPanels) ranges.push_back(fmt::format("down to {} panels", *fewestPanels));
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   return said + fmt::format("; nothing tried built it ({} tries in {:.0f} s{}: {})", tries, took,

@@ -56,14 +56,18 @@ const ColourSetting& MachineProfile::settingFor(Operation operation) const {
   return *std::find_if(colours.begin(), colours.end(), [&](const ColourSetting& c) { return c.name == colour; });
 }
 
+std::string frameLight(double framePower) {
+  return framePower > 0 ? fmt::format("laser at {:g}% power", framePower) : "laser off";
+}
+
 MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   const ProfileReader reader(file);
   const YAML::Node root = reader.load();
   requireKind(reader, root, "machine");
-  reader.keys(
-      root, "",
-      {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations", "motion", "formats"},
-      {"name", "bed", "driver", "connection", "colours"});
+  reader.keys(root, "",
+              {"kind", "name", "description", "bed", "driver", "connection", "colours", "operations", "motion",
+               "formats", "frame_power"},
+              {"name", "bed", "driver", "connection", "colours"});
   MachineProfile machine;
   machine.source = file;
   machine.name = reader.text(root["name"], "name");
@@ -110,6 +114,16 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   }
   machine.connection = reader.text(root["connection"], "connection");
   checkConnection(reader, root["connection"], machine.driver, machine.connection);
+  if (const YAML::Node power = root["frame_power"]) {
+    // A marking power to see the frame by (a diode's dot), never one that cuts.
+    if (machine.driver != "grbl") {
+      reader.fail(power, "frame_power",
+                  machine.driver == "m2nano"
+                      ? "the M2 Nano's power is set by the knob on the machine: it frames with the laser off"
+                      : "a print driver does not frame");
+    }
+    machine.framePower = reader.number(power, "frame_power", 0, kMostFramePower);
+  }
 
   const YAML::Node colours = root["colours"];
   if (!colours.IsMap() || colours.size() == 0) reader.fail(colours, "colours", "expected a table of colours (fig. 65)");

@@ -61,11 +61,21 @@ struct MachineProfile {
   // (docs/CONTRACT.md, "make"), as its software wants them: "dxf"
   // (`formats: [dxf]`).
   std::vector<std::string> formats;
+  // Percent of full power the head traces a sheet's box at, to be seen
+  // (`frame_power`, GRBL only); 0, the default: with the laser off.
+  double framePower = 0;
   std::filesystem::path source;
 
   // The colour table row that `operation` is drawn in.
   [[nodiscard]] const ColourSetting& settingFor(Operation operation) const;
 };
+
+// The most `frame_power` may be: a mark to see, never a cut.
+inline constexpr double kMostFramePower = 5;
+
+// How a frame at `framePower` percent lights the laser, for people: "laser
+// off", "laser at 1% power".
+std::string frameLight(double framePower);
 
 struct PowerSpeed {
   std::optional<double> power;  // percent; unset: the machine's colour table

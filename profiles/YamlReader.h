@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "profiles/Length.h"
 #include "profiles/Profiles.h"
 
@@ -75,6 +76,14 @@ class YamlReader {
   std::string text(const YAML::Node& node, const std::string& key) const {
     if (!node.IsScalar()) fail(node, key, "expected text");
     return node.Scalar();
+  }
+
+  // The unit lengths are shown to people in (`units: mm`): mm or in.
+  core::LengthUnit shownUnit(const YAML::Node& node, const std::string& key) const {
+    const std::string name = text(node, key);
+    const auto unit = core::LengthUnit::named(name);
+    if (!unit) fail(node, key, fmt::format("{}: expected mm or in", name));
+    return *unit;
   }
 
   double number(const YAML::Node& node, const std::string& key, double low, double high) const {

@@ -109,7 +109,7 @@ JobProfileNames jobProfileNames(const std::filesystem::path& target) {
   if (!std::filesystem::exists(manifest, error)) return {};
   const auto read = readManifestSheets(manifest);
   if (!read) return {};
-  return {read->machine, read->material, manifest};
+  return {read->machine, read->material, core::LengthUnit::named(read->displayUnits.value_or("")), manifest};
 }
 
 CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, const JobProfileNames& madeFor,
@@ -168,21 +168,19 @@ CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, con
   return cutting;
 }
 
-std::string stockOf(const profiles::MaterialProfile& material, double width, double height, std::string_view unit) {
-  const double perInch = profiles::unitsPerInch(unit);
-  return fmt::format("{} ({}), {:.4g} x {:.4g} {}", material.name,
-                     profiles::formatLength(material.thickness, material.units.thickness), width * perInch,
-                     height * perInch, unit);
+std::string stockOf(const profiles::MaterialProfile& material, double width, double height, core::LengthUnit unit) {
+  return fmt::format("{} ({}), {}", material.name, unit(material.thickness, 3), unit.size(width, height, 3));
 }
 
-void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine) {
+void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine,
+                       core::LengthUnit unit) {
   for (const JobSheet& sheet : sheets) {
     if (sheet.drawing.width > machine.bed.width + 1e-6 || sheet.drawing.height > machine.bed.height + 1e-6) {
       throw core::UserError(
-          fmt::format("{}: the sheet is {:.4g} x {:.4g} in, larger than the bed of {} ({:.4g} x {:.4g} in); "
+          fmt::format("{}: the sheet is {}, larger than the bed of {} ({}); "
                       "make it for this machine (`rotafab make ... --machine {}`)",
-                      sheet.file.string(), sheet.drawing.width, sheet.drawing.height, machine.name, machine.bed.width,
-                      machine.bed.height, machine.name));
+                      sheet.file.string(), unit.size(sheet.drawing.width, sheet.drawing.height, 3), machine.name,
+                      unit.size(machine.bed.width, machine.bed.height, 3), machine.name));
     }
   }
 }

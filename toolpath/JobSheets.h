@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/LengthUnit.h"
 #include "profiles/Profiles.h"
 #include "toolpath/SheetDrawing.h"
 
@@ -36,7 +37,8 @@ std::vector<JobSheet> readJobSheets(const std::filesystem::path& folder,
 // sheets with no manifest, have neither.
 struct JobProfileNames {
   std::optional<std::string> machine, material;
-  std::filesystem::path manifest;  // where they were read, for messages
+  std::optional<core::LengthUnit> shownIn;  // its lengths' unit for people ("display_units"), where it says it
+  std::filesystem::path manifest;           // where they were read, for messages
 };
 JobProfileNames jobProfileNames(const std::filesystem::path& target);
 
@@ -58,12 +60,14 @@ CuttingProfiles cuttingProfiles(const profiles::ProfileCatalogue& catalogue, con
                                 std::optional<std::string_view> driver);
 
 // What the operator loads for each sheet of a job, for people: the
-// material, its thickness and the sheet's size (`width` x `height` inches,
-// shown in `unit`, the machine profile's), "posterboard (0.8 mm), 32 x 18
-// in".
-std::string stockOf(const profiles::MaterialProfile& material, double width, double height, std::string_view unit);
+// material, its thickness and the sheet's size (`width` x `height` inches),
+// shown in `unit`: "posterboard (0.031 in), 32 x 18 in", "plywood-3mm (3 mm),
+// 400 x 400 mm".
+std::string stockOf(const profiles::MaterialProfile& material, double width, double height, core::LengthUnit unit);
 
-// Throws core::UserError naming the first sheet larger than the machine's bed.
-void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine);
+// Throws core::UserError naming the first sheet larger than the machine's
+// bed, the sizes in `unit`.
+void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine,
+                       core::LengthUnit unit = {});
 
 }  // namespace rotafab::jobs

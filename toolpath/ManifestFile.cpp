@@ -102,6 +102,8 @@ std::optional<ManifestSheets> readManifestSheets(const std::filesystem::path& ma
   // (Manifests before these keys name neither.)
   if (std::string_view name; manifest["machine"].get(name) == simdjson::SUCCESS) read.machine = std::string(name);
   if (std::string_view name; manifest["material"].get(name) == simdjson::SUCCESS) read.material = std::string(name);
+  if (std::string_view name; manifest["display_units"].get(name) == simdjson::SUCCESS)
+    read.displayUnits = std::string(name);
   return read;
 }
 

@@ -33,6 +33,8 @@ struct ManifestSheets {
   // where the manifest says them: what it is cut with unless the operator
   // says otherwise.
   std::optional<std::string> machine, material;
+  // The unit the job's lengths are shown in ("mm" or "in", make's --units), where it says it.
+  std::optional<std::string> displayUnits;
 };
 // A sheet's kit as the operator and the builders read it: "steps 174-352;
 // once cut, steps 1-352 can be done" (`run`: its first and last step, when

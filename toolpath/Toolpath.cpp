@@ -215,6 +215,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
   toolpath.sheet = sheet.index;
   toolpath.width = sheet.width;
   toolpath.height = sheet.height;
+  toolpath.framePower = machine.framePower;
   // A closed cut inside another closed cut is an inner cut (a hole, or a cut
   // in a hole of a part): its part is not yet free when it is cut.
   std::vector<const DrawnPath*> cuts;

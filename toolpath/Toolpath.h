@@ -51,6 +51,7 @@ struct Toolpath {
   double burnLength = 0;    // inches, all passes
   double travelLength = 0;  // inches, from the origin through every stroke and back
   double seconds = 0;       // estimated: see estimateSeconds()
+  double framePower = 0;    // percent the box is traced at (the machine's frame_power); 0: laser off
 };
 
 // How the machine of `profile` moves, by its `motion` (GRBL's defaults when it

@@ -59,6 +59,46 @@ bool validListen(const std::string& address) {
   return std::stoi(port) < 65536;
 }
 
+// The devices a configuration lists (`devices:`), each checked.
+std::vector<DeviceConfig> readDevices(const profiles::YamlReader& reader, const YAML::Node& devices) {
+  if (!devices.IsSequence()) reader.fail(devices, "devices", "expected a list of {name, machine, uri, auto_start}");
+  std::vector<DeviceConfig> read;
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const std::string key = fmt::format("devices[{}]", i);
+    reader.keys(devices[i], key, {"name", "machine", "uri", "material", "auto_start"}, {"name", "uri"});
+    DeviceConfig device;
+    device.name = reader.text(devices[i]["name"], key + ".name");
+    if (device.name.empty() || device.name.find_first_of(" /?#") != std::string::npos) {
+      reader.fail(devices[i]["name"], key + ".name", "expected a name without spaces or slashes, such as laser1");
+    }
+    for (const DeviceConfig& other : read) {
+      if (other.name == device.name) reader.fail(devices[i]["name"], key + ".name", "another device has this name");
+    }
+    device.uri = reader.text(devices[i]["uri"], key + ".uri");
+    device.machine = devices[i]["machine"] ? reader.text(devices[i]["machine"], key + ".machine") : "";
+    if (devices[i]["material"]) device.material = reader.text(devices[i]["material"], key + ".material");
+    if (devices[i]["auto_start"]) device.autoStart = reader.boolean(devices[i]["auto_start"], key + ".auto_start");
+    read.push_back(std::move(device));
+  }
+  return read;
+}
+
+// The limits of requests and plans, and the unit lengths are shown in.
+void readLimits(const profiles::YamlReader& reader, const YAML::Node& root, DaemonConfig& config) {
+  if (root["upload_limit"]) {
+    config.uploadLimit = static_cast<size_t>(reader.integer(root["upload_limit"], "upload_limit", 1, 1 << 30));
+  }
+  if (root["connection_limit"]) {
+    config.connectionLimit =
+        static_cast<size_t>(reader.integer(root["connection_limit"], "connection_limit", 1, 10000));
+  }
+  if (root["header_timeout"]) config.headerTimeout = reader.number(root["header_timeout"], "header_timeout", 0.1, 3600);
+  if (root["body_timeout"]) config.bodyTimeout = reader.number(root["body_timeout"], "body_timeout", 0.1, 86400);
+  if (root["plan_timeout"]) config.planTimeout = reader.number(root["plan_timeout"], "plan_timeout", 1, 7 * 86400);
+  if (root["planners"]) config.planners = static_cast<unsigned>(reader.integer(root["planners"], "planners", 1, 64));
+  if (root["units"]) config.units = reader.shownUnit(root["units"], "units");
+}
+
 }  // namespace
 
 // The Unix socket for `rotafab`, and loopback TCP for a browser (the workshop page).
@@ -91,7 +131,7 @@ DaemonConfig loadConfig(const fs::path& file) {
     const auto keys = reader.keys(
         root, "",
         {"state_dir", "store", "host", "spool", "lease", "listen", "tokens", "origins", "devices", "upload_limit",
-         "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout", "notify"},
+         "connection_limit", "planners", "header_timeout", "body_timeout", "plan_timeout", "notify", "units"},
         {});
     bool listenGiven = false;
     if (root["state_dir"]) config.stateDir = expanded(reader.text(root["state_dir"], "state_dir"));
@@ -196,39 +236,8 @@ DaemonConfig loadConfig(const fs::path& file) {
         config.origins.push_back(origin);
       }
     }
-    if (const YAML::Node devices = root["devices"]) {
-      if (!devices.IsSequence()) reader.fail(devices, "devices", "expected a list of {name, machine, uri, auto_start}");
-      config.devices.clear();
-      for (size_t i = 0; i < devices.size(); ++i) {
-        const std::string key = fmt::format("devices[{}]", i);
-        reader.keys(devices[i], key, {"name", "machine", "uri", "material", "auto_start"}, {"name", "uri"});
-        DeviceConfig device;
-        device.name = reader.text(devices[i]["name"], key + ".name");
-        if (device.name.empty() || device.name.find_first_of(" /?#") != std::string::npos) {
-          reader.fail(devices[i]["name"], key + ".name", "expected a name without spaces or slashes, such as laser1");
-        }
-        for (const DeviceConfig& other : config.devices) {
-          if (other.name == device.name) reader.fail(devices[i]["name"], key + ".name", "another device has this name");
-        }
-        device.uri = reader.text(devices[i]["uri"], key + ".uri");
-        device.machine = devices[i]["machine"] ? reader.text(devices[i]["machine"], key + ".machine") : "";
-        if (devices[i]["material"]) device.material = reader.text(devices[i]["material"], key + ".material");
-        if (devices[i]["auto_start"]) device.autoStart = reader.boolean(devices[i]["auto_start"], key + ".auto_start");
-        config.devices.push_back(std::move(device));
-      }
-    }
-    if (root["upload_limit"]) {
-      config.uploadLimit = static_cast<size_t>(reader.integer(root["upload_limit"], "upload_limit", 1, 1 << 30));
-    }
-    if (root["connection_limit"]) {
-      config.connectionLimit =
-          static_cast<size_t>(reader.integer(root["connection_limit"], "connection_limit", 1, 10000));
-    }
-    if (root["header_timeout"])
-      config.headerTimeout = reader.number(root["header_timeout"], "header_timeout", 0.1, 3600);
-    if (root["body_timeout"]) config.bodyTimeout = reader.number(root["body_timeout"], "body_timeout", 0.1, 86400);
-    if (root["plan_timeout"]) config.planTimeout = reader.number(root["plan_timeout"], "plan_timeout", 1, 7 * 86400);
-    if (root["planners"]) config.planners = static_cast<unsigned>(reader.integer(root["planners"], "planners", 1, 64));
+    if (const YAML::Node devices = root["devices"]) config.devices = readDevices(reader, devices);
+    readLimits(reader, root, config);
     if (!listenGiven && root["state_dir"]) config.listen = defaultListen(config.stateDir);
     // A listener beyond this machine needs a token to let anyone in.
     for (size_t i = 0; i < config.listen.size(); ++i) {

@@ -12,6 +12,7 @@
 #include <vector>
 #include "daemon/service/NotifyConfig.h"
 
+#include "core/LengthUnit.h"
 #include "core/ProgramFolders.h"
 
 namespace rotafab::service {
@@ -67,6 +68,9 @@ struct DaemonConfig {
   unsigned planners = 1;      // jobs planned at once (each on every core)
   double planTimeout = 3600;  // seconds a plan may take before its job fails
   NotifyConfig notify;        // webhooks and an MQTT broker told of the operator's events
+  // The unit the page and `rotafab status` show a job's lengths in, unless
+  // the job says its own (make's --units): `units: mm` or `in`.
+  std::optional<core::LengthUnit> units;
 };
 
 using core::defaultSocket;  // (core/ProgramFolders.h: the command line finds the socket too)

@@ -199,6 +199,7 @@ Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const
     jobChanged(job);
     json answer = jobJson(job);
     answer["framing_sheet"] = cut.sheet;
+    answer["frame_light"] = profiles::frameLight(devices[cut.device].machine.framePower);
     return {202, answer};
   }
   if (holdsDevice(job.state) || job.state == JobState::Queued || job.state == JobState::Planning ||
@@ -211,7 +212,9 @@ Reply Service::Impl::frameJob(const JobRecord& job, const json& arguments, const
   refuseUnlessItFrames(device.config);
   store->addEvent(id, "frame", fmt::format("{} asked for a frame of sheet {} on {}", who, sheet, device.config.name));
   launchCut(job, device, sheet, 0, true);
-  return {202, jobJson(store->job(id).value())};
+  json answer = jobJson(store->job(id).value());
+  answer["frame_light"] = profiles::frameLight(device.machine.framePower);
+  return {202, answer};
 }
 
 Reply Service::Impl::nextSheet(const JobRecord& job, const std::string& who) {

@@ -210,7 +210,7 @@ void Service::Impl::runCut(JobId id, const std::shared_ptr<RunControl>& control,
         }
         return waitForOperator(id, control, sheet.sheet, fmt::format("sheet {} to be loaded", sheet.sheet));
       };
-      events.framing = [this, id] {
+      events.framing = [this, id](const jobs::Toolpath&) {
         onStrand([this, id] {
           if (auto c = cuts.find(id); c != cuts.end()) {
             c->second->between = true;
@@ -327,10 +327,14 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
       JobChange change;
       change.sheet = job.sheets;
       change.stroke = job.strokes;
+      // In the job's unit (its summary's "units"), else the daemon's.
+      const json jobSummary = json::parse(job.summary.empty() ? "{}" : job.summary, nullptr, false);
+      const core::LengthUnit unit = core::LengthUnit::named(jobSummary.is_object() ? jobSummary.value("units", "") : "")
+                                        .value_or(config.units.value_or(core::LengthUnit()));
       ended = record(
           id, JobState::Done,
-          fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {:.1f} in burnt", device.config.name,
-                      summary.sheets, summary.sheets == 1 ? "" : "s", cut->firstSheet, summary.strokes, summary.burnt),
+          fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {} burnt", device.config.name, summary.sheets,
+                      summary.sheets == 1 ? "" : "s", cut->firstSheet, summary.strokes, unit(summary.burnt, 1)),
           change, true);
     } else if (failure) {
       // (Not the device's fault: a sheet or a profile; the device stays idle.)
@@ -385,18 +389,23 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
 void Service::Impl::frameEnded(JobId id, const Cut& cut, Device& device,
                                const std::optional<devices::DeviceFault>& fault,
                                const std::optional<std::string>& failure) {
-  // The job stays as it was, and the device: a frame moves the head with the laser off.
+  // The job stays as it was, and the device: a frame moves the head (the laser off, or at its frame_power).
   device.state = cut.stateBefore, device.message = cut.messageBefore;
-  std::string said = fmt::format("sheet {} framed on {} (laser off)", cut.sheet, device.config.name);
+  const std::string light = profiles::frameLight(device.machine.framePower);
+  std::string said = fmt::format("sheet {} framed on {} ({})", cut.sheet, device.config.name, light);
   if (failure) said = fmt::format("sheet {} not framed: {}", cut.sheet, *failure);
+  // (A frame at a marking power lit the laser: what is true of it now, as after a cut.)
+  const auto laserAfter = [&] {
+    return device.machine.framePower > 0 ? devices::laserStateAfter(*fault) : std::string("the laser was not lit");
+  };
   if (fault && fault->kind == devices::FaultKind::Cancelled) {
-    said = fmt::format("framing sheet {} stopped{}; the laser was not lit", cut.sheet,
-                       cut.cancelledBy.empty() ? "" : " by " + cut.cancelledBy);
+    said = fmt::format("framing sheet {} stopped{}; {}", cut.sheet,
+                       cut.cancelledBy.empty() ? "" : " by " + cut.cancelledBy, laserAfter());
   } else if (fault) {
     device.state = "fault";
     device.message = fault->what();
-    said = fmt::format("framing sheet {} failed: {} ({}); the laser was not lit", cut.sheet, fault->what(),
-                       devices::faultName(fault->kind));
+    said = fmt::format("framing sheet {} failed: {} ({}); {}", cut.sheet, fault->what(),
+                       devices::faultName(fault->kind), laserAfter());
   }
   log->info("job {}: {}", id, said);
   try {

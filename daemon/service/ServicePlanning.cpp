@@ -1,5 +1,7 @@
 #include "daemon/service/ServiceImpl.h"
 
+#include "profiles/UserSettings.h"
+
 namespace rotafab::service {
 
 std::string inSubmittersWords(std::string message, const fs::path& folder, const fs::path& submitted) {
@@ -55,13 +57,14 @@ void addKits(const jobs::ManifestSheets& listed, json& summary) {
 }
 
 // What the job is cut on and with, and what the operator loads for each
-// sheet ("posterboard (0.8 mm), 32 x 18 in"): the page and `rotafab
-// status` say it.
+// sheet ("posterboard (0.031 in), 32 x 18 in"), in the unit the job's
+// lengths are shown in ("units"): the page and `rotafab status` say it.
 void addStock(const profiles::MachineProfile& machine, const profiles::MaterialProfile& material, double width,
-              double height, json& summary) {
+              double height, core::LengthUnit unit, json& summary) {
   summary["machine"] = machine.name;
   summary["material"] = material.name;
-  summary["stock"] = jobs::stockOf(material, width, height, machine.bed.unit);
+  summary["stock"] = jobs::stockOf(material, width, height, unit);
+  summary["units"] = unit.name();
 }
 
 }  // namespace
@@ -218,8 +221,12 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
                                  const profiles::MaterialProfile& material) const {
   json summary;
   std::vector<jobs::JobSheet> planned;
+  // The daemon's setting, else the job's own unit, else the machine's bed's
+  // (as `run` takes the user's setting before the job's).
+  core::LengthUnit unit = profiles::shownUnit("", config.units, "", machine.bed.unit);
   if (const auto listed = jobs::readManifestSheets(folder / "manifest.json")) {
     planned = jobs::readJobSheets(folder, listed->svgSheets);
+    if (listed->displayUnits && !config.units) unit = core::LengthUnit::named(*listed->displayUnits).value_or(unit);
     if (listed->panels) summary["panels"] = *listed->panels;
     if (listed->cost) summary["cost"] = json::parse(*listed->cost);
     addKits(*listed, summary);
@@ -230,12 +237,12 @@ json Service::Impl::planOfFolder(const fs::path& folder, const profiles::Machine
     if (manifest.contains("panels") && manifest["panels"].is_array()) summary["panels"] = manifest["panels"].size();
     if (manifest.contains("cost")) summary["cost"] = manifest["cost"];
   }
-  jobs::checkSheetsFitBed(planned, machine);
+  jobs::checkSheetsFitBed(planned, machine, unit);
   summary["sheets"] = static_cast<int>(planned.size());
   // (The sheets' own size: a folder made for a smaller bed is cut on sheets of its size.)
   addStock(machine, cuttingMaterial(folder, material),
            planned.empty() ? machine.bed.width : planned.front().drawing.width,
-           planned.empty() ? machine.bed.height : planned.front().drawing.height, summary);
+           planned.empty() ? machine.bed.height : planned.front().drawing.height, unit, summary);
   return summary;
 }
 
@@ -314,6 +321,8 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
       }
       options.machine = machine.name;
       if (!materialGiven) options.material = material.name;
+      // --units, else the daemon's (else requestOf() takes --size's unit, else the machine's).
+      if (options.units.empty() && config.units) options.units = std::string(config.units->name());
       jobs::MakeRequest request = jobs::requestOf(options, catalogue);
       // The daemon cuts from the SVG: it is written whatever --formats says.
       request.formats = request.formats.value_or(jobs::defaultFormats(machine));
@@ -350,7 +359,7 @@ void Service::Impl::plan(const JobRecord& job, const profiles::MachineProfile& m
       summary.erase("stability");  // manifest.json has it; the queue shows what a cut needs
       summary["cost"] = jobs::costJson(planned.cost);
       summary["folder"] = plannedName;
-      addStock(machine, request.material, machine.bed.width, machine.bed.height, summary);
+      addStock(machine, request.material, machine.bed.width, machine.bed.height, request.shownIn, summary);
       if (const auto listed = jobs::readManifestSheets(folder / plannedName / "manifest.json"))
         addKits(*listed, summary);
       // What the plan said on the way, for the people at the machine (the page shows them).

@@ -67,7 +67,9 @@ json Service::Impl::deviceJson(const Device& device) const {
            {"machine", device.machine.name},
            {"material", device.material.name},
            {"auto_start", device.config.autoStart},
-           {"state", device.state}};
+           {"state", device.state},
+           // How its frames light the laser: "laser off", or its machine's marking power.
+           {"frame_light", profiles::frameLight(device.machine.framePower)}};
   if (!device.message.empty()) out["message"] = device.message;
   if (!device.checked.empty()) out["checked"] = device.checked;
   out["job"] = device.job ? json(*device.job) : json(nullptr);

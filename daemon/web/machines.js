@@ -28,7 +28,7 @@ export function renderDevices() {
       waitingJob(device) ? element('p', { class: 'waiting' },
         `waiting for ${waitingJob(device).waiting_for || `sheet ${waitingJob(device).sheet + 1} to be loaded`}`) : null,
       progress && progress.phase === 'framing'
-        ? element('p', { class: 'waiting' }, `framing sheet ${progress.sheet} (laser off)`) : null,
+        ? element('p', { class: 'waiting' }, `framing sheet ${progress.sheet} (${device.frame_light || 'laser off'})`) : null,
       fraction !== null
         ? element('progress', { max: '1', value: String(fraction), 'data-percent': String(Math.round(fraction * 100)) })
         : null,

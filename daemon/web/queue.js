@@ -75,13 +75,13 @@ function actionsOf(job) {
         buttons.push(element('span', { class: 'unable' }, `framing sheet ${job.framing_sheet}…`));
       } else {
         act('Start', 'start', {}, { class: 'primary' });
-        act('Frame', 'frame', { sheet: 1 }, { title: 'Trace sheet 1’s box with the laser off, to check where it is' });
+        act('Frame', 'frame', { sheet: 1 }, { title: 'Trace sheet 1’s box, to check where it is' });
       }
       break;
     case 'running':
       if (job.waiting_for_next) {
         act(framedWaiting(job) ? 'In place: cut' : 'Next sheet loaded', 'next', {}, { class: 'primary' });
-        act('Frame', 'frame', {}, { title: `Trace sheet ${job.waiting_sheet}’s box with the laser off` });
+        act('Frame', 'frame', {}, { title: `Trace sheet ${job.waiting_sheet}’s box` });
       }
       act('Pause', 'pause');
       break;
@@ -98,7 +98,7 @@ function actionsOf(job) {
       }
       if (!unable && !job.device_missing) {
         act('Frame', 'frame', { sheet: job.sheet },
-          { title: `Trace sheet ${job.sheet}’s box with the laser off, to check where it is` });
+          { title: `Trace sheet ${job.sheet}’s box, to check where it is` });
       }
       act('Resume from sheet…', 'resume', () => {
         const goesOn = job.stroke > 0 && job.stroke < job.strokes;

@@ -4,7 +4,7 @@
 import { api, attempt } from './api.js';
 import { $, element } from './dom.js';
 import { state } from './state.js';
-import { duration } from './words.js';
+import { duration, length } from './words.js';
 
 $('sheets-job-select').addEventListener('change', () => {
   const id = Number($('sheets-job-select').value);
@@ -70,7 +70,7 @@ async function drawSheet(jobId, sheet) {
   svg.append(flip);
   $('sheet-view').replaceChildren(svg);
   $('sheet-info').textContent =
-    `Sheet ${sheet}: ${path.strokes.length} strokes, ${path.burn_length.toFixed(0)} in burnt, about ${duration(path.seconds)} to cut.`;
+    `Sheet ${sheet}: ${path.strokes.length} strokes, ${length(path.burn_length, state.jobs.find((known) => known.id === jobId))} burnt, about ${duration(path.seconds)} to cut.`;
   const legend = $('sheet-legend');
   legend.replaceChildren();
   for (const [operation, colour] of Object.entries(path.colours)) {

@@ -33,6 +33,7 @@ $('submit-form').addEventListener('submit', (event) => {
     if ($('opt-size').value.trim()) options.size = $('opt-size').value.trim();
     if ($('opt-panels').value.trim()) options.panels = $('opt-panels').value.trim();
     if ($('opt-material').value.trim()) options.material = $('opt-material').value.trim();
+    if ($('opt-units').value) options.units = $('opt-units').value;
     const form = new FormData();
     form.append('file', file, file.name);
     form.append('options', JSON.stringify(options));

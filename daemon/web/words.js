@@ -1,7 +1,14 @@
-// How a job's numbers read on the page: durations, sheets cut, and the
+// How a job's numbers read on the page: lengths, durations, sheets cut, and the
 // time left (scaled to the device's own pace).
 
 import { state } from './state.js';
+
+// A length in inches as the job shows its lengths (its summary's "units",
+// make's --units or the daemon's `units:`): "1005 in", "25527 mm".
+export function length(inches, job) {
+  const units = job && job.summary && job.summary.units === 'mm' ? 'mm' : 'in';
+  return units === 'mm' ? `${(inches * 25.4).toFixed(0)} mm` : `${inches.toFixed(0)} in`;
+}
 
 export function duration(seconds) {
   if (seconds === undefined || seconds === null || !isFinite(seconds)) return '–';

@@ -38,6 +38,9 @@ DeviceFault errorFault(const std::string& device, const std::string& command, co
 // a USB serial link garbles a byte now and then, and a report or an `ok`
 // lost to it is not a fault by itself (a lost `ok` is found otherwise).
 constexpr int kGarbledRun = 3;
+// The feed a marking frame is traced at, mm/min: quick to follow by eye, and
+// with the power a few percent, a dot that marks nothing.
+constexpr int kFrameFeed = 3000;
 
 // What the controller said, shown safely: printable ASCII, at most 40 bytes.
 std::string shown(const std::string& line) {
@@ -305,20 +308,32 @@ void GrblDriver::waitIdle(Millis silence, const core::Cancellation* cancel, Mill
   }
 }
 
-void GrblDriver::frame(const jobs::Toolpath& toolpath) {
+void GrblDriver::frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) {
   if (!link_) connect();
   const auto box = toolpathBounds(toolpath);
   const auto mm = [](double inches) { return jobs::formatDecimal(inches * kMillimetresPerInch, 3); };
+  // At the machine's marking power, where its profile gives one (a dot to
+  // see by), else with the laser off.
+  const bool marking = toolpath.framePower > 0;
   try {
-    // Laser off (M5) for the whole trace; G0 is never lit in laser mode anyway.
     send("M5 S0");
     send("G21");
     send("G90");
-    for (const auto& [x, y] :
-         {std::pair{box[0], box[1]}, {box[2], box[1]}, {box[2], box[3]}, {box[0], box[3]}, {box[0], box[1]}}) {
-      send(fmt::format("G0 X{} Y{}", mm(x), mm(y)));
+    // M4 before any motion: GRBL acknowledges M3/M4/M5 only once its planner
+    // has drained. In laser mode G0 is never lit and M4 scales the power with
+    // the speed, so the laser is dark at the corners and while it stands.
+    if (marking) {
+      send(fmt::format("M4 S{}", jobs::formatDecimal(toolpath.framePower / 100 * gcodeOptions().maxSpindle, 1)));
     }
-    waitIdle(timeouts_.answer, nullptr);
+    const std::pair<double, double> corners[] = {
+        {box[0], box[1]}, {box[2], box[1]}, {box[2], box[3]}, {box[0], box[3]}, {box[0], box[1]}};
+    send(fmt::format("G0 X{} Y{}", mm(corners[0].first), mm(corners[0].second)));
+    for (size_t c = 1; c < std::size(corners); ++c) {
+      send(marking ? fmt::format("G1 X{} Y{} F{}", mm(corners[c].first), mm(corners[c].second), kFrameFeed)
+                   : fmt::format("G0 X{} Y{}", mm(corners[c].first), mm(corners[c].second)));
+    }
+    waitIdle(timeouts_.answer, &cancel);
+    if (marking) send("M5 S0");  // (the planner is empty: acknowledged at once)
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }

@@ -37,7 +37,7 @@ class GrblDriver : public Device {
   GrblDriver(std::function<std::unique_ptr<Link>()> open, GrblTimeouts timeouts = {}, double timeScale = 1.0);
   std::string connect() override;
   void home() override;
-  void frame(const jobs::Toolpath& toolpath) override;
+  void frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const core::Cancellation& cancel) override;
   // Send-and-wait instead of character counting: one line at a time, each

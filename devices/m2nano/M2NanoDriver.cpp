@@ -213,14 +213,14 @@ void M2NanoDriver::home() {
   }
 }
 
-void M2NanoDriver::frame(const jobs::Toolpath& toolpath) {
+void M2NanoDriver::frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) {
   if (!link_) connect();
   try {
     const double mmPerSecond = 30;  // slow enough to follow with the eye
-    sendLines(frameLines(toolpath, mmPerSecond), nullptr);
+    sendLines(frameLines(toolpath, mmPerSecond), &cancel);
     const auto box = jobs::toolpathBounds(toolpath);
     const double seconds = (2 * (box[2] - box[0] + box[3] - box[1]) + box[2] + box[3]) * 25.4 / mmPerSecond;
-    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * seconds * 1000)), nullptr);
+    waitFinished(Millis(60000 + static_cast<long>(timeouts_.finishSlack * seconds * 1000)), &cancel);
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }

@@ -38,7 +38,7 @@ class M2NanoDriver : public Device {
   M2NanoDriver(std::function<std::unique_ptr<UsbLink>()> open, M2NanoTimeouts timeouts = {});
   std::string connect() override;
   void home() override;
-  void frame(const jobs::Toolpath& toolpath) override;
+  void frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const core::Cancellation& cancel) override;
   // A hold is wanted from pause() until resume(); run() holds at the next

@@ -129,22 +129,25 @@ void serveDevice(Device& device, int input, int output) {
       } else if (op == "home") {
         device.home();
         pipe.writeLine(reply(id).dump());
-      } else if (op == "frame") {
-        device.frame(toolpathOf(request.at("toolpath")));
-        pipe.writeLine(reply(id).dump());
-      } else if (op == "run") {
+      } else if (op == "frame" || op == "run") {
+        // Each cancelled by its own `cancel` request: a frame too may light
+        // the laser (a machine's frame_power).
         const jobs::Toolpath toolpath = toolpathOf(request.at("toolpath"));
         const auto cancel = runs.start(id);
         struct Finished {
           Runs& runs;
           ~Finished() { runs.finish(); }
         } finished{runs};
-        device.run(
-            toolpath,
-            [&](const Progress& p) {
-              pipe.writeLine(nlohmann::json{{"progress", toJson(p)}, {"id", id}}.dump());
-            },
-            *cancel);
+        if (op == "frame") {
+          device.frame(toolpath, *cancel);
+        } else {
+          device.run(
+              toolpath,
+              [&](const Progress& p) {
+                pipe.writeLine(nlohmann::json{{"progress", toJson(p)}, {"id", id}}.dump());
+              },
+              *cancel);
+        }
         pipe.writeLine(reply(id).dump());
       } else if (op == "status") {
         const DeviceStatus status = device.status();

@@ -157,8 +157,8 @@ std::string RemoteDevice::connect() {
 
 void RemoteDevice::home() { call({{"op", "home"}}, timeouts_.home); }
 
-void RemoteDevice::frame(const jobs::Toolpath& toolpath) {
-  call({{"op", "frame"}, {"toolpath", toJson(toolpath)}}, timeouts_.home);
+void RemoteDevice::frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) {
+  call({{"op", "frame"}, {"toolpath", toJson(toolpath)}}, timeouts_.home, nullptr, &cancel);
 }
 
 void RemoteDevice::run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,

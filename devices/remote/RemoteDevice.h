@@ -41,7 +41,7 @@ class RemoteDevice : public Device {
 
   std::string connect() override;
   void home() override;
-  void frame(const jobs::Toolpath& toolpath) override;
+  void frame(const jobs::Toolpath& toolpath, const core::Cancellation& cancel) override;
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const core::Cancellation& cancel) override;
   void pause() override;

@@ -14,9 +14,9 @@ nlohmann::json toJson(const jobs::Toolpath& toolpath) {
                        {"pass", stroke.pass},
                        {"points", std::move(points)}});
   }
-  return {{"sheet", toolpath.sheet},       {"width", toolpath.width},     {"height", toolpath.height},
-          {"strokes", std::move(strokes)}, {"burn", toolpath.burnLength}, {"travel", toolpath.travelLength},
-          {"seconds", toolpath.seconds}};
+  return {{"sheet", toolpath.sheet},       {"width", toolpath.width},           {"height", toolpath.height},
+          {"strokes", std::move(strokes)}, {"burn", toolpath.burnLength},       {"travel", toolpath.travelLength},
+          {"seconds", toolpath.seconds},   {"frame_power", toolpath.framePower}};
 }
 
 jobs::Toolpath toolpathOf(const nlohmann::json& json) {
@@ -39,6 +39,7 @@ jobs::Toolpath toolpathOf(const nlohmann::json& json) {
   toolpath.burnLength = json.at("burn").get<double>();
   toolpath.travelLength = json.at("travel").get<double>();
   toolpath.seconds = json.at("seconds").get<double>();
+  toolpath.framePower = json.value("frame_power", 0.0);  // (a helper of before: dark frames)
   return toolpath;
 }
 

@@ -25,7 +25,7 @@ class SpoolDevice : public Device {
   SpoolDevice(std::filesystem::path folder, std::string printer, std::map<jobs::Operation, jobs::Rgb> colours);
   std::string connect() override;
   void home() override {}
-  void frame(const jobs::Toolpath&) override {}
+  void frame(const jobs::Toolpath&, const core::Cancellation&) override {}
   void run(const jobs::Toolpath& toolpath, const std::function<void(const Progress&)>& progress,
            const core::Cancellation& cancel) override;
   void pause() override {}

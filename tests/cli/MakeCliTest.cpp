@@ -713,7 +713,7 @@ TEST(MakeCli, JsonSummaryAndErrors) {
   const CommandResult badStart =
       run(kCli + " make " + mesh + " --structure band --start 32 --out " + quoted(dir.path() / "bad"));
   EXPECT_EQ(badStart.err.find("tried"), std::string::npos) << badStart.err;
-  fails(mesh + " --structure band --size 20in --fastener 2in", 1, "no room for a 2.000 in fastener hole");
+  fails(mesh + " --structure band --size 20in --fastener 2in", 1, "no room for a 2 in fastener hole");
   // With no size given, the ball grows by at most 10%; a fastener no band
   // has room for is not mended away (the ball would be another shape): the
   // error gives the size that was tried, and the fastener at this size, and
@@ -951,9 +951,63 @@ TEST(MakeCli, SizeIsTheLargestSideOfTheStructureBuilt) {
     const auto size = nlohmann::json::parse(readFile(out / "manifest.json")).at("size");
     EXPECT_NEAR(std::max({size[0].get<double>(), size[1].get<double>(), size[2].get<double>()}), 10, 0.1);
     if (mesh.filename() == "cube.obj") {
-      EXPECT_NE(made.out.find("built, 10.0 x 10.0 x 10.0 in"), std::string::npos) << made.out;
+      EXPECT_NE(made.out.find("built, 10 x 10 x 10 in"), std::string::npos) << made.out;
     }
   }
+}
+
+// A metric user reads millimetres (docs/CONTRACT.md, "Units and scale"):
+// --units, else the user's config.yaml, else the unit --size is written in,
+// else the machine's; manifest.json stays in inches and says which unit the
+// people's files show.
+TEST(MakeCli, LengthsAreShownInTheUnitTheUserWorksIn) {
+  TempDir dir;
+  const std::string cube = quoted(kSource / "examples/cube.obj");
+  const auto out = dir.path() / "metric";
+  const CommandResult metric =
+      run(kCli + " make " + cube + " --structure band --size 150mm --time 0 --out " + quoted(out));
+  ASSERT_EQ(metric.status, 0) << metric.err;
+  EXPECT_NE(metric.out.find("built, 150 x 150 x 150 mm; stands: its centre of mass is 28.8 mm inside"),
+            std::string::npos)
+      << metric.out;
+  EXPECT_NE(metric.out.find("1 sheet of posterboard (812.8 x 457.2 mm) and 24 fasteners of 3.18 mm;"),
+            std::string::npos)
+      << metric.out;
+  EXPECT_NE(metric.err.find("nesting 6 panels on 812.8 x 457.2 mm beds"), std::string::npos) << metric.err;
+  const std::string text = readFile(out / "manifest.txt");
+  EXPECT_NE(text.find("It takes 1 sheet of posterboard (812.8 x 457.2 mm)"), std::string::npos) << text;
+  EXPECT_NE(text.find("28.8 mm inside its footprint"), std::string::npos) << text;
+  EXPECT_NE(readFile(out / "sheet-001.preview.svg").find("cube (band) - sheet 1 of 1, 812.8 x 457.2 mm</text>"),
+            std::string::npos);
+  const auto manifest = nlohmann::json::parse(readFile(out / "manifest.json"));
+  EXPECT_EQ(manifest.at("units"), "in");
+  EXPECT_EQ(manifest.at("display_units"), "mm");
+  EXPECT_EQ(manifest.at("bed").at("width"), 32);
+  // The manifest in the other unit, asked.
+  const CommandResult inches = run(kCli + " manifest " + quoted(out) + " --units in");
+  EXPECT_NE(inches.out.find("It takes 1 sheet of posterboard (32 x 18 in) and 24 fasteners of 0.125 in (3.2 mm)"),
+            std::string::npos)
+      << inches.out;
+
+  // The user's setting outweighs --size's unit; --units outweighs both.
+  const auto config = dir.path() / "config";
+  std::filesystem::create_directories(config / "rotafab");
+  dir.write("config/rotafab/config.yaml", "units: mm\n");
+  const std::string withConfig = "XDG_CONFIG_HOME=" + quoted(config) + " " + kCli + " make " + cube +
+                                 " --structure band --size 10in --time 0 --out ";
+  const CommandResult preferred = run(withConfig + quoted(dir.path() / "preferred"));
+  EXPECT_NE(preferred.out.find("built, 254 x 254 x 254 mm"), std::string::npos) << preferred.out;
+  const CommandResult given = run(withConfig + quoted(dir.path() / "given") + " --units in");
+  EXPECT_NE(given.out.find("built, 10 x 10 x 10 in"), std::string::npos) << given.out;
+  // A setting that is not a unit: one line naming the file, the line and the key.
+  dir.write("config/rotafab/config.yaml", "units: feet\n");
+  const CommandResult bad = run(withConfig + quoted(dir.path() / "bad"));
+  EXPECT_EQ(bad.status, 1);
+  EXPECT_EQ(bad.err, "error: " + (config / "rotafab/config.yaml").string() + ":1:8: units: feet: expected mm or in\n");
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "bad"));
+  // With --units given, the settings are not needed, nor read.
+  const CommandResult past = run(withConfig + quoted(dir.path() / "past") + " --units in");
+  EXPECT_EQ(past.status, 0) << past.err;
 }
 
 // Will it stand? The summary and the manifest say so. The bunny's centre of

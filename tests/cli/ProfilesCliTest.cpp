@@ -17,7 +17,7 @@ TEST(ProfilesCli, ChecksFilesAndListsTheSearchPath) {
   EXPECT_EQ(refused.status, 1);
   EXPECT_EQ(refused.err, "error: " + bad.string() +
                              ":4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, "
-                             "connection, colours, operations, motion, formats)\n");
+                             "connection, colours, operations, motion, formats, frame_power)\n");
   EXPECT_EQ(refused.out, "") << "nothing on standard output before, or instead of, the error";
   // --check FILE is the same; a bed in millimetres without its unit is named with the fix.
   const auto metric =

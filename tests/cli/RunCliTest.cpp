@@ -131,6 +131,16 @@ TEST(RunCli, AJobIsCutWithTheMachineAndMaterialItWasMadeFor) {
   ASSERT_EQ(cut.status, 0) << cut.err;
   EXPECT_NE(cut.err.find("run: sheet 1 (1 of 1), plywood-3mm (3 mm), 400 x 400 mm: 168 strokes"), std::string::npos)
       << cut.err;
+  // In the job's unit (the bed's, millimetres, as none was asked), or the one asked.
+  EXPECT_NE(cut.err.find(" mm to burn, about "), std::string::npos) << cut.err;
+  EXPECT_NE(cut.out.find(" mm burnt, in "), std::string::npos) << cut.out;
+  const CommandResult inches =
+      run(kCli + " run " + quoted(job) + " --sheet 1 --device 'sim:grbl?speed=2000' --units in");
+  ASSERT_EQ(inches.status, 0) << inches.err;
+  EXPECT_NE(inches.err.find("run: sheet 1 (1 of 1), plywood-3mm (0.118 in), 15.748 x 15.748 in: 168 strokes, "),
+            std::string::npos)
+      << inches.err;
+  EXPECT_NE(inches.out.find(" in burnt, in "), std::string::npos) << inches.out;
   // No --device: the machine profile's connection (a dry run does not open it).
   const CommandResult profiled = dryRun("", "profiled.gcode");
   ASSERT_EQ(profiled.status, 0) << profiled.err;

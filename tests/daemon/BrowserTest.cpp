@@ -81,6 +81,8 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
   // Drop the cube (the file input the drop box stands for), band, submit.
   browser.setFiles("#mesh-file", {kSource / "examples/cube.obj"});
   browser.evaluate("document.getElementById('opt-structure').value = 'band'");
+  // In inches, although the machine's bed is in millimetres (its default).
+  browser.evaluate("document.getElementById('opt-units').value = 'in'");
   click(browser, "#submit-button");
   ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"]')", 10s));
   ASSERT_TRUE(browser.waitFor("document.querySelector('tr[data-job=\"1\"][data-state=\"ready\"]')", 60s))
@@ -135,6 +137,11 @@ TEST(Browser, ACubeDroppedOnThePageIsPlannedCutAndAssembledStepByStep) {
   EXPECT_LT(highlighted.back().get<int>(), job["strokes"].get<int>());
   EXPECT_EQ(browser.evaluate("document.querySelector('#sheet-view polyline[data-current]')"), nullptr);
 
+  // Its lengths in the unit asked, the page's and the daemon's alike.
+  EXPECT_EQ(job["summary"].value("units", ""), "in") << job.dump();
+  EXPECT_NE(browser.evaluate("document.getElementById('sheet-info').textContent").get<std::string>().find(" in burnt,"),
+            std::string::npos);
+  EXPECT_NE(job["summary"].value("stock", "").find("15.748 x 15.748 in"), std::string::npos) << job.dump();
   // The sheet as it was burnt: every stroke drawn, all of them cut.
   EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline').length"), job["strokes"]);
   EXPECT_EQ(browser.evaluate("document.querySelectorAll('#sheet-view polyline.done').length"), job["strokes"]);

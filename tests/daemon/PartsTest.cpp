@@ -78,7 +78,9 @@ TEST(DaemonConfig, EveryKeyIsOptionalAndAMistakeNamesItsLineAndColumn) {
       "statedir: /tmp\n",
       "1:1: statedir: unknown key (expected one of: state_dir, store, host, spool, lease, listen, tokens, "
       "origins, devices, upload_limit, connection_limit, planners, header_timeout, body_timeout, plan_timeout, "
-      "notify)");
+      "notify, units)");
+  expectRefused("units: cm\n", "1:8: units: cm: expected mm or in");
+  EXPECT_EQ(loadConfig(dir.write("units.yaml", "units: mm\n")).units, core::LengthUnit::millimetres());
   expectRefused("notify: {webhooks: [https://hooks.example/x]}\n",
                 "1:21: notify.webhooks[0]: expected http://HOST[:PORT][/PATH], found 'https://hooks.example/x' (TLS "
                 "is not supported: a receiver on the lab's network, or a relay beside the daemon)");

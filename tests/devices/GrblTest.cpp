@@ -32,6 +32,7 @@ namespace rotafab::devices {
 namespace {
 
 using jobs::Point2;
+using namespace std::chrono_literals;
 
 // A sheet: an etched label, a scored fold, and two parts with a hole each.
 jobs::SheetDrawing sheet() {
@@ -372,7 +373,7 @@ TEST(Grbl, UnpluggedMidJobIsADisconnect) {
 TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
   Rig rig(40);
   auto& [simulator, driver, path] = rig;
-  driver->frame(path);
+  driver->frame(path, core::Cancellation());
   const auto record = simulator.record();
   const std::vector<std::string> framed(record.lines.end() - 8, record.lines.end());
   const auto box = jobs::toolpathBounds(path);
@@ -383,6 +384,54 @@ TEST(Grbl, FrameTracesTheBoxWithTheLaserOff) {
                                       "G0X" + mm(box[0]) + "Y" + mm(box[3]), "G0X" + mm(box[0]) + "Y" + mm(box[1])}));
   EXPECT_EQ(record.litSeconds, 0);
   EXPECT_EQ(record.state, "Idle");
+}
+
+// Where the machine profile gives a marking power (frame_power), the box is
+// traced lit at that power, S10 of $30=1000 for 1%, by G1 in laser mode
+// (dark at the corners), and the laser is off after it.
+TEST(Grbl, FrameAtTheProfilesMarkingPowerLightsOnlyTheTrace) {
+  Rig rig(40);
+  auto& [simulator, driver, path] = rig;
+  path.framePower = 1;
+  driver->frame(path, core::Cancellation());
+  const auto record = simulator.record();
+  const std::vector<std::string> framed(record.lines.end() - 10, record.lines.end());
+  const auto box = jobs::toolpathBounds(path);
+  const auto mm = [](double inches) { return jobs::formatDecimal(inches * 25.4, 3); };
+  EXPECT_EQ(framed, (std::vector<std::string>{"M5S0", "G21", "G90", "M4S10", "G0X" + mm(box[0]) + "Y" + mm(box[1]),
+                                              "G1X" + mm(box[2]) + "Y" + mm(box[1]) + "F3000",
+                                              "G1X" + mm(box[2]) + "Y" + mm(box[3]) + "F3000",
+                                              "G1X" + mm(box[0]) + "Y" + mm(box[3]) + "F3000",
+                                              "G1X" + mm(box[0]) + "Y" + mm(box[1]) + "F3000", "M5S0"}));
+  EXPECT_GT(record.litSeconds, 0);
+  EXPECT_FALSE(record.laserOn);
+  EXPECT_FALSE(record.spindleEnabled);
+  EXPECT_EQ(record.state, "Idle");
+}
+
+// A lit frame is a job of its own: a cancel stops it at once, in real time,
+// with the laser off and confirmed (GRBL's hold, reset and M5).
+TEST(Grbl, ALitFrameStopsAtOnceOnACancelWithTheLaserOff) {
+  Rig rig(1);
+  auto& [simulator, driver, path] = rig;
+  path.framePower = 1;
+  core::Cancellation cancel;
+  std::thread canceller([&] {
+    for (int i = 0; i < 500 && !simulator.record().laserOn; ++i) std::this_thread::sleep_for(10ms);
+    cancel.cancel();
+  });
+  const auto started = std::chrono::steady_clock::now();
+  try {
+    driver->frame(path, cancel);
+    ADD_FAILURE() << "the frame ran to its end";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Cancelled) << fault.what();
+    EXPECT_TRUE(fault.laserOffConfirmed);
+  }
+  canceller.join();
+  EXPECT_LT(std::chrono::steady_clock::now() - started, 10s) << "tracing the box takes 16 s at 3000 mm/min";
+  EXPECT_GT(simulator.record().litSeconds, 0) << "the frame was lit before the cancel";
+  EXPECT_FALSE(simulator.record().laserOn);
 }
 
 // A hold from another thread stops the machine (and its laser) mid-job; a

@@ -313,7 +313,7 @@ TEST(WeaveStructure, AFastenerTooLargeForTwoHolesGivesOneAndTooLargeForOneGrowsT
   const Structure one = wovenStructure(truncatedIcosahedron(), options);
   EXPECT_EQ(one.fasteners, 90);
   ASSERT_FALSE(one.warnings.empty());
-  EXPECT_NE(one.warnings.front().find("90 crossings are too small for two 0.500 in holes"), std::string::npos)
+  EXPECT_NE(one.warnings.front().find("90 crossings are too small for two 0.5 in holes"), std::string::npos)
       << one.warnings.front();
   for (const Panel& panel : one.panels) EXPECT_EQ(panel.holes.size(), 3U);
 

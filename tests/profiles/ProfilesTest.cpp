@@ -132,7 +132,19 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
   const std::vector<Case> cases = {
       {"unknown key", replaced(good, "driver: spool", "drivr: spool"),
        "p.yaml:4:1: drivr: unknown key (expected one of: kind, name, description, bed, driver, connection, colours, "
-       "operations, motion, formats)"},
+       "operations, motion, formats, frame_power)"},
+      // A frame to see by: a few percent on a GRBL machine, never a cut; a spool and the M2 Nano have none.
+      {"frame power of a print driver", replaced(good, "driver: spool\n", "driver: spool\nframe_power: 1\n"),
+       "p.yaml:5:14: frame_power: a print driver does not frame"},
+      {"frame power that could cut",
+       replaced(good, "driver: spool\nconnection: spool:out\n",
+                "driver: grbl\nconnection: grbl:///dev/ttyUSB0\nframe_power: 20\n"),
+       "p.yaml:6:14: frame_power: must be between 0 and 5, not 20"},
+      {"frame power of the M2 Nano",
+       replaced(good, "driver: spool\nconnection: spool:out\n",
+                "driver: m2nano\nconnection: m2nano://usb/1a86:5512\nframe_power: 1\n"),
+       "p.yaml:6:14: frame_power: the M2 Nano's power is set by the knob on the machine: it frames with the laser "
+       "off"},
       {"unknown sheet format", replaced(good, "driver: spool", "formats: [dxf, pdf]\ndriver: spool"),
        "p.yaml:4:16: formats[1]: expected eps, svg or dxf, found 'pdf'"},
       {"formats not a list", replaced(good, "driver: spool", "formats: dxf\ndriver: spool"),

@@ -362,7 +362,7 @@ TEST(M2Nano, AStopTheBoardRunsInItsTurnIsConfirmedOnlyOnceRun) {
 TEST(M2Nano, FramingTracesTheBoxWithTheLaserOff) {
   Rig rig(40);
   const jobs::Toolpath path = toolpath();
-  rig.driver.frame(path);
+  rig.driver.frame(path, core::Cancellation());
   const auto record = rig.simulator.record();
   EXPECT_TRUE(burns(record.trace).empty());
   const auto box = jobs::toolpathBounds(path);
