@@ -265,7 +265,7 @@ std::string MeshRepair::line(core::LengthUnit unit) const {
     what = fmt::format("{}: {}", kind, count);
   }
   // (Two significant digits at least: a mend may move it by a hair.)
-  const int decimals = moved > 0 ? std::max(4, 2 - static_cast<int>(std::floor(std::log10(moved)))) : 4;
+  const int decimals = moved > 0 ? std::max(2, 2 - static_cast<int>(std::floor(std::log10(moved)))) : 2;
   if (moved > 0) what += fmt::format(", moving the surface at most {}", unit(moved, std::min(decimals, 9)));
   std::string open;
   if (leftOpen > 0) {
