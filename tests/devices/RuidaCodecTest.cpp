@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+#include <stdexcept>
+#include <string>
+
 namespace rotafab::devices::ruida {
 namespace {
 
@@ -128,6 +132,24 @@ TEST(RuidaJob, AToolpathIsEncodedAndDecodedStrokeForStroke) {
   Bytes changed = stream;
   changed[changed.size() - 20] ^= 0x01;
   EXPECT_FALSE(decodeJob(changed, toolpath.height).sumHolds);
+}
+
+// A simulator decodes whatever arrives: torn, cut short or random streams
+// are read without a crash (the sanitizers' pass checks every read), and a
+// command cut short is named.
+TEST(RuidaJob, AnyStreamIsDecodedOrRefusedByName) {
+  std::mt19937 random(7);
+  std::uniform_int_distribution<int> byte(0, 255), length(0, 64);
+  for (int i = 0; i < 2000; ++i) {
+    Bytes stream(static_cast<size_t>(length(random)));
+    for (uint8_t& b : stream) b = static_cast<uint8_t>(byte(random));
+    try {
+      (void)decodeJob(stream, 10);
+    } catch (const std::invalid_argument& error) {
+      EXPECT_NE(std::string(error.what()).find("command "), std::string::npos) << error.what();
+    }
+  }
+  EXPECT_THROW(decodeJob(Bytes{0x88, 0x00, 0x01}, 10), std::invalid_argument);
 }
 
 }  // namespace
