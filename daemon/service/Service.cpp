@@ -43,17 +43,21 @@ JobRecord Service::Impl::jobOrThrow(JobId id) {
   return *job;
 }
 
+std::string summaryText(const JobRecord& job, const char* key) {
+  if (job.summary.empty()) return "";
+  const json summary = json::parse(job.summary, nullptr, false);
+  if (!summary.is_object() || !summary.contains(key) || !summary[key].is_string()) return "";
+  return summary[key].get<std::string>();
+}
+
 fs::path Service::Impl::plannedFolder(const JobRecord& job) const {
   const fs::path folder = spool->pathOf(job.spool);
   if (job.kind == JobKind::Planned) return folder;
   // On a shared store each plan has a folder of its own, named in its
   // summary: a plan a stalled host finishes late never overwrites the one
   // made since by another host.
-  const json summary = json::parse(job.summary.empty() ? "{}" : job.summary, nullptr, false);
-  if (summary.is_object() && summary.contains("folder") && summary["folder"].is_string()) {
-    const std::string name = summary["folder"];
-    if (name.starts_with("planned") && name.find('/') == std::string::npos) return folder / name;
-  }
+  const std::string name = summaryText(job, "folder");
+  if (name.starts_with("planned") && name.find('/') == std::string::npos) return folder / name;
   return folder / "planned";
 }
 

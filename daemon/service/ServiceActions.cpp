@@ -280,11 +280,7 @@ Reply Service::Impl::moveToDevice(const JobRecord& job, const std::string& name,
   const std::optional<Target> target = deviceFor(name, job.options, why);
   if (!target) throw ApiError(409, why);
   // The machine its sheets were planned for, where they were.
-  std::string planned;
-  if (!job.summary.empty()) {
-    const json summary = json::parse(job.summary, nullptr, false);
-    if (summary.is_object()) planned = summary.value("machine", "");
-  }
+  const std::string planned = summaryText(job, "machine");
   if (!planned.empty() && planned != target->machine.name) {
     if (job.state != JobState::Ready || job.kind != JobKind::Mesh) {
       refuse(job, fmt::format(", its sheets planned for {}{}; {} is a {}: a device of {} can cut them", planned,

@@ -149,10 +149,7 @@ devices::SheetGo Service::Impl::waitForOperator(JobId id, const std::shared_ptr<
       jobChanged(job);
       // The operator is needed at the machine: a sheet to load, or a framed one to check.
       json extra = {{"waiting_for", what}, {"waiting_sheet", sheet}};
-      if (job.summary.find("\"stock\"") != std::string::npos) {
-        const json summary = json::parse(job.summary, nullptr, false);
-        if (summary.is_object() && summary.contains("stock")) extra["stock"] = summary["stock"];
-      }
+      if (const std::string stock = summaryText(job, "stock"); !stock.empty()) extra["stock"] = stock;
       notify(job, what.find("framed") == std::string::npos ? "load_sheet" : "sheet_framed", extra);
     } catch (const std::exception& error) {
       storeTrouble(fmt::format("job {}", id), error);
@@ -328,9 +325,8 @@ void Service::Impl::cutEnded(JobId id, const std::optional<devices::DeviceFault>
       change.sheet = job.sheets;
       change.stroke = job.strokes;
       // In the job's unit (its summary's "units"), else the daemon's.
-      const json jobSummary = json::parse(job.summary.empty() ? "{}" : job.summary, nullptr, false);
-      const core::LengthUnit unit = core::LengthUnit::named(jobSummary.is_object() ? jobSummary.value("units", "") : "")
-                                        .value_or(config.units.value_or(core::LengthUnit()));
+      const core::LengthUnit unit =
+          core::LengthUnit::named(summaryText(job, "units")).value_or(config.units.value_or(core::LengthUnit()));
       ended = record(
           id, JobState::Done,
           fmt::format("cut on {}: {} sheet{} from sheet {}, {} strokes, {} burnt", device.config.name, summary.sheets,

@@ -72,6 +72,10 @@ std::string sheetWhere(int sheet, int sheets, int64_t stroke, int64_t strokes);
 std::string goOnSaid(int sheet, int64_t cut, int64_t strokes);
 
 // Between a running job's driver thread and the strand.
+// A text of a job's summary (its "stock", "machine", "units", "folder"),
+// empty where it has none.
+std::string summaryText(const JobRecord& job, const char* key);
+
 struct RunControl {
   core::Cancellation cancel;
   std::atomic<bool> shutdown{false};
