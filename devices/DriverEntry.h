@@ -33,6 +33,10 @@ class DeviceAddress {
 // What a device is opened with besides its address.
 struct DeviceSetup {
   std::map<jobs::Operation, jobs::Rgb> colours;  // the machine profile's colour per operation (the spool draws in them)
+  // The machine profile's motion, for a controller that cannot be asked
+  // for its own (a Ruida's are on its panel), and its bed, inches.
+  jobs::MotionLimits motion;
+  double bedWidth = 0, bedHeight = 0;
 };
 
 // A USB device a driver drives: vendor and product (no product: any of the vendor's).

@@ -7,14 +7,16 @@
 #include "devices/UriParts.h"
 #include "devices/grbl/GrblDriver.h"
 #include "devices/m2nano/M2NanoDriver.h"
+#include "devices/ruida/RuidaDriver.h"
 #include "devices/sim/SimEntries.h"
 #include "devices/spool/SpoolDevice.h"
 
 namespace rotafab::devices {
 
 const std::vector<const DriverEntry*>& drivers() {
-  static const std::vector<const DriverEntry*> all{&grbl::entry(), &m2nano::entry(), &spool::entry(), &sim::grblEntry(),
-                                                   &sim::m2nanoEntry()};
+  static const std::vector<const DriverEntry*> all{&grbl::entry(),    &m2nano::entry(),  &ruida::entry(),
+                                                   &spool::entry(),   &sim::grblEntry(), &sim::m2nanoEntry(),
+                                                   &sim::ruidaEntry()};
   return all;
 }
 

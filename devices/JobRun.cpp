@@ -6,12 +6,19 @@
 
 namespace rotafab::devices {
 
+DeviceSetup deviceSetupFor(const profiles::MachineProfile& machine) {
+  DeviceSetup setup;
+  for (profiles::Operation operation : profiles::kAllOperations) {
+    setup.colours[operation] = machine.settingFor(operation).rgb;
+  }
+  setup.motion = jobs::profileMotion(machine);
+  setup.bedWidth = machine.bed.width, setup.bedHeight = machine.bed.height;
+  return setup;
+}
+
 JobRun::JobRun(JobRunSetup setup) : setup_(std::move(setup)) {
   const DriverEntry& driver = *setup_.device.driver;
-  DeviceSetup deviceSetup;
-  for (profiles::Operation operation : profiles::kAllOperations) {
-    deviceSetup.colours[operation] = setup_.machine.settingFor(operation).rgb;
-  }
+  const DeviceSetup deviceSetup = deviceSetupFor(setup_.machine);
   // Nothing of the job is sent before run(): a fault here leaves the laser as it was.
   try {
     device_ = driver.open(*setup_.device.address, deviceSetup);

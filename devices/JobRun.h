@@ -66,6 +66,9 @@ struct RunSummary {
   double estimated = 0;  // seconds, real time
 };
 
+// What a device of `machine` is opened with.
+DeviceSetup deviceSetupFor(const profiles::MachineProfile& machine);
+
 class JobRun {
  public:
   // Throws std::invalid_argument (an operation with no usable setting) and

@@ -109,13 +109,16 @@ OperationSettings operationSettings(const MachineProfile& machine, const Materia
                                     Operation operation) {
   const ColourSetting& row = machine.settingFor(operation);
   OperationSettings settings{row.power, row.speed, row.passes};
+  std::optional<double> minPower = row.minPower;
   if (const auto overrides = material.machines.find(machine.name); overrides != material.machines.end()) {
     if (const auto it = overrides->second.find(operation); it != overrides->second.end()) {
       settings.power = it->second.power.value_or(settings.power);
       settings.speed = it->second.speed.value_or(settings.speed);
       settings.passes = it->second.passes.value_or(settings.passes);
+      if (it->second.minPower) minPower = it->second.minPower;
     }
   }
+  settings.minPower = std::min(minPower.value_or(settings.power), settings.power);
   return settings;
 }
 

@@ -37,7 +37,10 @@ LaserMode laserMode(const ProfileReader& reader, const YAML::Node& node, const s
 void checkConnection(const ProfileReader& reader, const YAML::Node& node, const std::string& driver,
                      const std::string& uri) {
   const std::map<std::string, std::vector<std::string>> schemes{
-      {"spool", {"spool:"}}, {"grbl", {"grbl://", "grbl+tcp://", "sim:grbl"}}, {"m2nano", {"m2nano://", "sim:m2nano"}}};
+      {"spool", {"spool:"}},
+      {"grbl", {"grbl://", "grbl+tcp://", "sim:grbl"}},
+      {"m2nano", {"m2nano://", "sim:m2nano"}},
+      {"ruida", {"ruida://", "ruida+serial://", "sim:ruida"}}};
   for (const auto& scheme : schemes.at(driver))
     if (uri.starts_with(scheme)) return;
   reader.fail(
@@ -109,8 +112,10 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
   }
 
   machine.driver = reader.text(root["driver"], "driver");
-  if (machine.driver != "spool" && machine.driver != "grbl" && machine.driver != "m2nano") {
-    reader.fail(root["driver"], "driver", fmt::format("expected spool, grbl or m2nano, found '{}'", machine.driver));
+  if (machine.driver != "spool" && machine.driver != "grbl" && machine.driver != "m2nano" &&
+      machine.driver != "ruida") {
+    reader.fail(root["driver"], "driver",
+                fmt::format("expected spool, grbl, m2nano or ruida, found '{}'", machine.driver));
   }
   machine.connection = reader.text(root["connection"], "connection");
   checkConnection(reader, root["connection"], machine.driver, machine.connection);
@@ -120,7 +125,9 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
       reader.fail(power, "frame_power",
                   machine.driver == "m2nano"
                       ? "the M2 Nano's power is set by the knob on the machine: it frames with the laser off"
-                      : "a print driver does not frame");
+                  : machine.driver == "ruida" ? "a Ruida controller frames with the laser off (a CO2 laser's "
+                                                "lowest power already burns)"
+                                              : "a print driver does not frame");
     }
     machine.framePower = reader.number(power, "frame_power", 0, kMostFramePower);
   }
@@ -135,10 +142,13 @@ MachineProfile loadMachineProfile(const std::filesystem::path& file) {
     setting.name = entry.first.as<std::string>("");
     const std::string at = "colours." + setting.name;
     const YAML::Node row = entry.second;
-    reader.keys(row, at, {"rgb", "mode", "power", "speed", "ppi", "passes", "z_axis"}, {"rgb"});
+    reader.keys(row, at, {"rgb", "mode", "power", "min_power", "speed", "ppi", "passes", "z_axis"}, {"rgb"});
     setting.rgb = reader.rgb(row["rgb"], at + ".rgb");
     if (row["mode"]) setting.mode = laserMode(reader, row["mode"], at + ".mode");
     if (row["power"]) setting.power = reader.number(row["power"], at + ".power", 0.0, 100.0);
+    if (row["min_power"]) {
+      setting.minPower = reader.number(row["min_power"], at + ".min_power", 0.0, setting.power);
+    }
     if (row["speed"]) setting.speed = reader.number(row["speed"], at + ".speed", 0.1, 100.0);
     if (row["ppi"]) setting.ppi = reader.integer(row["ppi"], at + ".ppi", 1, 10000);
     if (row["passes"]) setting.passes = reader.integer(row["passes"], at + ".passes", 1, 100);
@@ -229,9 +239,12 @@ MaterialProfile loadMaterialProfile(const std::filesystem::path& file) {
         const std::string operation = operationEntry.first.as<std::string>("");
         const std::string key = at + "." + operation;
         const YAML::Node row = operationEntry.second;
-        reader.keys(row, key, {"power", "speed", "passes"}, {});
+        reader.keys(row, key, {"power", "min_power", "speed", "passes"}, {});
         PowerSpeed setting;
         if (row["power"]) setting.power = reader.number(row["power"], key + ".power", 0.0, 100.0);
+        if (row["min_power"]) {
+          setting.minPower = reader.number(row["min_power"], key + ".min_power", 0.0, setting.power.value_or(100.0));
+        }
         if (row["speed"]) setting.speed = reader.number(row["speed"], key + ".speed", 0.1, 100.0);
         if (row["passes"]) setting.passes = reader.integer(row["passes"], key + ".passes", 1, 100);
         overrides[*operationNamed(operation)] = setting;

@@ -29,7 +29,10 @@ struct ColourSetting {
   std::string name;  // "blue"
   Rgb rgb;
   LaserMode mode = LaserMode::Vector;
-  double power = 50.0;   // percent
+  double power = 50.0;  // percent
+  // Percent at the slowest, where the head slows into a corner (a Ruida
+  // controller ramps between it and `power`); unset: `power` throughout.
+  std::optional<double> minPower;
   double speed = 100.0;  // percent of the machine's maximum
   int ppi = 500;         // pulses per inch
   int passes = 1;
@@ -79,6 +82,7 @@ std::string frameLight(double framePower);
 
 struct PowerSpeed {
   std::optional<double> power;  // percent; unset: the machine's colour table
+  std::optional<double> minPower;
   std::optional<double> speed;
   std::optional<int> passes;
 };
@@ -109,6 +113,7 @@ struct OperationSettings {
   double power = 0;  // percent
   double speed = 0;  // percent of the machine's maximum
   int passes = 1;
+  double minPower = 0;  // percent, at most `power` (ColourSetting::minPower)
   friend bool operator==(const OperationSettings&, const OperationSettings&) = default;
 };
 OperationSettings operationSettings(const MachineProfile& machine, const MaterialProfile& material,

@@ -175,7 +175,10 @@ std::string stockOf(const profiles::MaterialProfile& material, double width, dou
 void checkSheetsFitBed(const std::vector<JobSheet>& sheets, const profiles::MachineProfile& machine,
                        core::LengthUnit unit) {
   for (const JobSheet& sheet : sheets) {
-    if (sheet.drawing.width > machine.bed.width + 1e-6 || sheet.drawing.height > machine.bed.height + 1e-6) {
+    // The sheet's SVG gives its size to 1e-4 in: a 700 mm bed is written 27.5591 in, 27.559055 in rounded up.
+    constexpr double kWrittenPrecision = 1e-4;
+    if (sheet.drawing.width > machine.bed.width + kWrittenPrecision ||
+        sheet.drawing.height > machine.bed.height + kWrittenPrecision) {
       throw core::UserError(
           fmt::format("{}: the sheet is {}, larger than the bed of {} ({}); "
                       "make it for this machine (`rotafab make ... --machine {}`)",

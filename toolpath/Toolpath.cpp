@@ -257,7 +257,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
   for (auto& [stage, candidates] : stages) {
     const Operation operation = stage.rank == 0 ? Operation::Etch : stage.rank == 1 ? Operation::Score : Operation::Cut;
     const profiles::ColourSetting& setting = machine.settingFor(operation);
-    const auto [power, speed, passes] = profiles::operationSettings(machine, material, operation);
+    const auto [power, speed, passes, minPower] = profiles::operationSettings(machine, material, operation);
     if (!(speed > 0) || passes < 1) {
       throw std::invalid_argument(fmt::format("{}: the {} setting ({}) has speed {}% and {} passes; nothing to run",
                                               machine.name, profiles::operationName(operation), setting.name, speed,
@@ -267,7 +267,7 @@ Toolpath planToolpath(const SheetDrawing& sheet, const profiles::MachineProfile&
     for (int pass = 1; pass <= passes; ++pass) {
       for (const auto& points : ordered) {
         toolpath.strokes.push_back({operation, stage.rank == 2 && stage.depth < 0, std::clamp(power / 100, 0.0, 1.0),
-                                    speed / 100 * limits.maxSpeed, pass, points});
+                                    speed / 100 * limits.maxSpeed, pass, points, std::clamp(minPower / 100, 0.0, 1.0)});
       }
     }
   }

@@ -260,11 +260,7 @@ void Service::Impl::checkDevices() {
       std::string state = "idle", message;
       try {
         devices::ParsedUri parsed = devices::parseDeviceUri(uri);
-        devices::DeviceSetup setup;
-        for (profiles::Operation operation : profiles::kAllOperations) {
-          setup.colours[operation] = machine.settingFor(operation).rgb;
-        }
-        auto device = parsed.driver->open(*parsed.address, setup);
+        auto device = parsed.driver->open(*parsed.address, devices::deviceSetupFor(machine));
         const std::string identity = device->connect();
         const bool off = device->stopSafely();
         device->disconnect();

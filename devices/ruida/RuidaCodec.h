@@ -15,6 +15,9 @@ namespace rotafab::devices::ruida {
 
 using Bytes = std::vector<uint8_t>;
 
+// Lengths on the wire are micrometres.
+inline constexpr double kMicrometresPerInch = 25400;
+
 // The magic number most controllers scramble with; the 634XG's is 0x11.
 inline constexpr uint8_t kDefaultMagic = 0x88;
 

@@ -10,6 +10,9 @@
 // become the controller's micrometres from the bed's top-left corner, y
 // down, where a Ruida machine's origin is.
 
+#include <array>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "devices/ruida/RuidaCodec.h"
@@ -23,6 +26,34 @@ struct RuidaJobOptions {
 
 // The job's logical bytes, ending with the end of file (0xD7).
 Bytes jobStream(const jobs::Toolpath& toolpath, const RuidaJobOptions& options = {});
+
+// A job of moves alone (laser off) around the box of the toolpath's
+// strokes: the sheet's frame.
+Bytes frameStream(const jobs::Toolpath& toolpath);
+
+// A controller's reading of a job, one whole command at a time (as it
+// arrives): each move or cut as a step, in the controller's micrometres,
+// with the power and speed it is made at.
+struct JobStep {
+  long fromX = 0, fromY = 0, toX = 0, toY = 0;
+  bool lit = false;
+  double power = 0;  // 0..1, for a cut
+  double speed = 0;  // micrometres a second (the layer's; a move goes at the machine's own)
+};
+class JobReader {
+ public:
+  // Throws std::invalid_argument naming the command when it is cut short.
+  std::optional<JobStep> read(const Bytes& command);
+  [[nodiscard]] bool ended() const { return ended_; }        // the end of file (0xD7) was read
+  [[nodiscard]] bool sumHolds() const { return sumHolds_; }  // its file sum (E5 05) matches the bytes before it
+
+ private:
+  std::array<std::pair<double, double>, 256> layers_{};  // power, speed
+  double power_ = 0, speed_ = 0;
+  long x_ = 0, y_ = 0;
+  long sum_ = 0;
+  bool ended_ = false, sumHolds_ = false;
+};
 
 // What a controller would do with a stream: each run of cuts as a stroke
 // with the laser lit at its layer's power and speed, in the sheet's

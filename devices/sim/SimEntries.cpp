@@ -1,6 +1,9 @@
 #include "devices/sim/SimEntries.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
 
 #include <cstdio>
 
@@ -9,7 +12,9 @@
 #include "devices/grbl/GrblDriver.h"
 #include "devices/m2nano/Lhymicro.h"
 #include "devices/remote/RemoteDevice.h"
+#include "devices/ruida/RuidaDriver.h"
 #include "devices/sim/GrblSimulator.h"
+#include "devices/sim/RuidaSimulator.h"
 
 namespace rotafab::devices::sim {
 namespace {
@@ -32,16 +37,24 @@ struct SimAddress : DeviceAddress {
   int latencyMs = 0;
 };
 
-// The faults a simulated GRBL can be told to have, for a drill of what the
-// operator sees (and for the command line's tests).
-constexpr const char* kGrblFaults = "stall, noise, garbage, alarm, silence or unplug";
+// The faults a simulator can be told to have, for a drill of what the
+// operator sees (and for the command line's tests), and what `after` counts.
+struct SimFaults {
+  std::vector<std::string_view> kinds;
+  std::string_view counted;
+};
+const SimFaults kGrblFaults{{"stall", "noise", "garbage", "alarm", "silence", "unplug"}, "LINES"};
+const SimFaults kRuidaFaults{{"drop", "corrupt", "silence"}, "PACKETS"};
+const SimFaults kNoFaults{};
 
-// sim:NAME[?speed=N][&fault=KIND[&after=LINES]][&witness=FILE][&cuts=FILE][&latency=MS]
-std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
+// sim:NAME[?speed=N][&fault=KIND[&after=COUNT]][&witness=FILE][&cuts=FILE][&latency=MS]
+std::unique_ptr<SimAddress> parseSim(const std::string& uri, const SimFaults& simFaults) {
   auto parsed = std::make_unique<SimAddress>(uri);
   std::string query = splitQuery(uri).second;
+  const bool faults = !simFaults.kinds.empty();
   const std::string takes =
-      faults ? fmt::format("speed=N, fault=KIND ({}), after=LINES, witness=FILE, cuts=FILE and latency=MS", kGrblFaults)
+      faults ? fmt::format("speed=N, fault=KIND ({}), after={}, witness=FILE, cuts=FILE and latency=MS",
+                           fmt::join(simFaults.kinds, ", "), simFaults.counted)
              : "speed=N, a positive number";
   while (!query.empty()) {
     const size_t end = query.find('&');
@@ -55,8 +68,7 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, bool faults) {
       if (!speed || !(*speed > 0)) throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
       parsed->speed = *speed;
     } else if (faults && key == "fault" &&
-               (value == "stall" || value == "noise" || value == "garbage" || value == "alarm" || value == "silence" ||
-                value == "unplug")) {
+               std::find(simFaults.kinds.begin(), simFaults.kinds.end(), value) != simFaults.kinds.end()) {
       parsed->fault = value;
     } else if (faults && key == "after" && wholeNumber<size_t>(value)) {
       parsed->after = *wholeNumber<size_t>(value);
@@ -87,6 +99,28 @@ void rehearse(const SimAddress& address, GrblSimulator& simulator) {
   });
 }
 
+// Appended and closed at once: what is written survives a kill of the process.
+void appendLine(const std::string& file, const std::string& line) {
+  if (FILE* out = std::fopen(file.c_str(), "a")) {
+    std::fputs(line.c_str(), out);
+    std::fclose(out);
+  }
+}
+
+// What writes the simulated laser's every change to `file` ("on", "off"); nothing for no file.
+std::function<void(bool)> laserWitness(const std::string& file) {
+  if (file.empty()) return {};
+  return [file](bool lit) { appendLine(file, lit ? "on\n" : "off\n"); };
+}
+
+// What writes a line for each lit move finished to `file`: what was cut, as it was cut.
+std::function<void(const std::array<double, 4>&)> cutWitness(const std::string& file) {
+  if (file.empty()) return {};
+  return [file](const std::array<double, 4>& move) {
+    appendLine(file, fmt::format("{:.3f} {:.3f} {:.3f} {:.3f}\n", move[0], move[1], move[2], move[3]));
+  };
+}
+
 bool isSim(std::string_view uri, std::string_view name) {
   const std::string scheme = "sim:" + std::string(name);
   return uri == scheme || uri.starts_with(scheme + "?");
@@ -110,31 +144,15 @@ class SimGrblEntry : public DriverEntry {
   [[nodiscard]] bool simulated() const override { return true; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "grbl"); }
   [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
-    return parseSim(uri, true);
+    return parseSim(uri, kGrblFaults);
   }
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup&) const override {
     const auto& sim = dynamic_cast<const SimAddress&>(address);
     GrblSimulatorOptions options;
     options.timeScale = sim.speed;
     options.replyLatency = std::chrono::milliseconds(sim.latencyMs);
-    if (!sim.witness.empty()) {
-      options.laserChanged = [file = sim.witness](bool lit) {
-        // Appended and closed at once: what is written survives a kill of the process.
-        if (FILE* out = std::fopen(file.c_str(), "a")) {
-          std::fputs(lit ? "on\n" : "off\n", out);
-          std::fclose(out);
-        }
-      };
-    }
-    if (!sim.cutWitness.empty()) {
-      options.litMoveFinished = [file = sim.cutWitness](const std::array<double, 4>& move) {
-        // A line for each lit move finished: what was cut, as it was cut.
-        if (FILE* out = std::fopen(file.c_str(), "a")) {
-          std::fputs(fmt::format("{:.3f} {:.3f} {:.3f} {:.3f}\n", move[0], move[1], move[2], move[3]).c_str(), out);
-          std::fclose(out);
-        }
-      };
-    }
+    options.laserChanged = laserWitness(sim.witness);
+    options.litMoveFinished = cutWitness(sim.cutWitness);
     auto simulator = std::make_unique<GrblSimulator>(options);
     rehearse(sim, *simulator);
     return std::make_unique<SimulatedGrbl>(std::move(simulator), options.timeScale);
@@ -168,14 +186,62 @@ class SimM2NanoEntry : public DriverEntry {
   [[nodiscard]] bool simulated() const override { return true; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "m2nano"); }
   [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
-    return parseSim(uri, false);
+    return parseSim(uri, kNoFaults);
   }
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup&) const override {
     return std::make_unique<SimulatedM2Nano>(dynamic_cast<const SimAddress&>(address).speed);
   }
 };
 
+// A Ruida driver that owns the controller it talks to, on loopback UDP.
+class SimulatedRuida : public ruida::RuidaDriver {
+ public:
+  SimulatedRuida(std::unique_ptr<RuidaSimulator> simulator, const jobs::MotionLimits& motion, double speed)
+      : RuidaDriver(
+            [port = simulator->port()] {
+              return ruida::udpChannel(DatagramLink::open("127.0.0.1", port, 0), ruida::kDefaultMagic);
+            },
+            ruida::kDefaultMagic, motion, {}, speed),
+        simulator_(std::move(simulator)) {}
+
+ private:
+  std::unique_ptr<RuidaSimulator> simulator_;
+};
+
+class SimRuidaEntry : public DriverEntry {
+ public:
+  [[nodiscard]] std::string_view name() const override { return "ruida"; }
+  [[nodiscard]] std::string_view scheme() const override { return "sim:ruida"; }
+  [[nodiscard]] bool simulated() const override { return true; }
+  [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "ruida"); }
+  [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
+    auto parsed = parseSim(uri, kRuidaFaults);
+    if (parsed->latencyMs > 0) throw uriError(uri, "latency=MS: sim:ruida answers at once");
+    return parsed;
+  }
+  [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup& setup) const override {
+    const auto& sim = dynamic_cast<const SimAddress&>(address);
+    RuidaSimulatorOptions options;
+    options.timeScale = sim.speed;
+    if (setup.bedWidth > 0 && setup.bedHeight > 0) {  // the machine's bed, as its controller would report it
+      options.bedWidth = setup.bedWidth * 25.4, options.bedHeight = setup.bedHeight * 25.4;
+    }
+    if (sim.fault == "drop") options.fault = RuidaFault::Drop;
+    if (sim.fault == "corrupt") options.fault = RuidaFault::Corrupt;
+    if (sim.fault == "silence") options.fault = RuidaFault::Silence;
+    options.after = sim.after;
+    options.laserChanged = laserWitness(sim.witness);
+    options.cutFinished = cutWitness(sim.cutWitness);
+    return std::make_unique<SimulatedRuida>(std::make_unique<RuidaSimulator>(options), setup.motion, sim.speed);
+  }
+};
+
 }  // namespace
+
+const DriverEntry& ruidaEntry() {
+  static const SimRuidaEntry entry;
+  return entry;
+}
 
 const DriverEntry& grblEntry() {
   static const SimGrblEntry entry;

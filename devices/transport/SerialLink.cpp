@@ -50,6 +50,18 @@ class AsioLink : public Link {
     }
   }
 
+  std::optional<std::string> readSome(Millis timeout) override {
+    if (!pending_.empty()) return std::exchange(pending_, {});
+    if (!stream_->is_open()) throw DeviceFault(FaultKind::Disconnected, name_ + ": the port is closed");
+    char buffer[512];
+    std::optional<boost::system::error_code> result;
+    size_t got = 0;
+    stream_->async_read_some(asio::buffer(buffer),
+                             [&](const boost::system::error_code& error, size_t n) { result = error, got = n; });
+    if (!runFor(*io_, result, timeout, nullptr)) return std::nullopt;
+    return std::string(buffer, got);
+  }
+
   void close() override {
     boost::system::error_code ignored;
     if (stream_ && stream_->is_open()) stream_->close(ignored);

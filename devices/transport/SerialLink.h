@@ -26,6 +26,9 @@ class Link {
   virtual void write(const std::string& bytes, Millis timeout) = 0;
   // One line without its line ending ("\r\n" or "\n"); nothing when `timeout` passes first.
   virtual std::optional<std::string> readLine(Millis timeout) = 0;
+  // The bytes that have come, as they came (a binary protocol's); nothing
+  // when `timeout` passes first.
+  virtual std::optional<std::string> readSome(Millis timeout) = 0;
   virtual void close() = 0;
   [[nodiscard]] virtual std::string name() const = 0;
 };

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -33,6 +34,8 @@ std::filesystem::path madeCube(const std::string& options) {
 // For the GRBL machine's bed, and for the K40's (M2 Nano).
 std::filesystem::path cubeJob() { return madeCube("--machine grbl-diode-400"); }
 std::filesystem::path k40Job() { return madeCube("--machine k40-m2nano --size 4in"); }
+// And for a CO2 laser on a Ruida controller.
+std::filesystem::path ruidaJob() { return madeCube("--machine ruida-co2-60w --material plywood-3mm --size 150mm"); }
 
 TEST(RunCli, CutsAMakeOutputOnTheSimulatedGrblToTheEnd) {
   const CommandResult r = run(kCli + " run " + quoted(cubeJob()) + " --device 'sim:grbl?speed=200'");
@@ -325,6 +328,52 @@ TEST(RunCli, InterruptStopsTheJobWithTheLaserOff) {
   // (In real time: a fast simulator may have ended the sheet before the signal.)
   interruptMidJob(cubeJob(), "'sim:grbl?speed=1'");
   interruptMidJob(k40Job(), "'sim:m2nano?speed=1'");
+  interruptMidJob(ruidaJob(), "'sim:ruida?speed=1'");
+}
+
+// A sheet cut on the simulated Ruida over loopback UDP, and its .rd file
+// read by a decoder written from the public descriptions alone: the file
+// holds exactly the cuts the controller made.
+TEST(RunCli, CutsASheetOnTheSimulatedRuidaAsItsRdFileSays) {
+  TempDir dir;
+  const auto cuts = dir.path() / "cuts", rd = dir.path() / "sheet.rd";
+  const CommandResult r =
+      run(kCli + " run " + quoted(ruidaJob()) + " --sheet 1 --device 'sim:ruida?speed=500&cuts=" + cuts.string() + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("Ruida controller (card 0x65106510, bed 700 x 500 mm) on ruida://127.0.0.1:"), std::string::npos)
+      << r.err;
+  EXPECT_NE(r.out.find("1 sheet cut on sim:ruida?speed=500&cuts="), std::string::npos) << r.out;
+  // A dry run opens nothing: no controller answers at 192.0.2.1 (TEST-NET-1).
+  const CommandResult dry =
+      run(kCli + " run " + quoted(ruidaJob()) + " --sheet 1 --device ruida://192.0.2.1 --dry-run --out " + quoted(rd));
+  ASSERT_EQ(dry.status, 0) << dry.err;
+  EXPECT_NE(dry.out.find("as RDWorks saves it (.rd, magic 0x88)"), std::string::npos) << dry.out;
+  const CommandResult decoded =
+      run("/usr/bin/python3 " + quoted(kSource / "tests/support/ruida_decode.py") + " " + quoted(rd));
+  ASSERT_EQ(decoded.status, 0) << decoded.err;
+  std::istringstream fromFile(decoded.out), fromController(readFile(cuts));
+  size_t count = 0;
+  for (std::string a, b; std::getline(fromController, a);) {
+    ASSERT_TRUE(std::getline(fromFile, b)) << "the controller cut more than the file holds";
+    EXPECT_EQ(b.substr(0, a.size()), a) << "cut " << count;
+    ++count;
+  }
+  EXPECT_GT(count, 100u);
+  std::string more;
+  EXPECT_FALSE(std::getline(fromFile, more)) << "the file holds more than was cut: " << more;
+}
+
+// A controller that stops answering mid-job (switched off): exit status 3
+// within seconds, naming the controller, and saying the laser was not confirmed off.
+TEST(RunCli, ARuidaThatStopsAnsweringEndsTheRunWithStatus3) {
+  const auto start = std::chrono::steady_clock::now();
+  const CommandResult r =
+      run(kCli + " run " + quoted(ruidaJob()) + " --sheet 1 --device 'sim:ruida?speed=50&fault=silence&after=12'");
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(15));
+  EXPECT_EQ(r.status, 3) << r.err;
+  EXPECT_NE(r.err.find("the controller stopped answering"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the controller did not confirm the laser off: switch it off at the machine"), std::string::npos)
+      << r.err;
 }
 
 TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {

@@ -179,7 +179,7 @@ TEST(Profiles, EveryInvalidMachineIsRefusedWithItsPlace) {
       {"wrong kind", replaced(good, "kind: machine", "kind: material"),
        "p.yaml:1:7: kind: expected 'machine', found 'material'"},
       {"unknown driver", replaced(good, "driver: spool", "driver: lasersaur"),
-       "p.yaml:4:9: driver: expected spool, grbl or m2nano, found 'lasersaur'"},
+       "p.yaml:4:9: driver: expected spool, grbl, m2nano or ruida, found 'lasersaur'"},
       {"connection for another driver", replaced(good, "connection: spool:out", "connection: grbl:///dev/ttyUSB0"),
        "p.yaml:5:13: connection: 'grbl:///dev/ttyUSB0' is not a spool device URI (expected spool:)"},
       {"speed without a unit",

@@ -1,0 +1,300 @@
+// The Ruida driver against the simulated controller on loopback UDP: the
+// real driver through the real transport, packets checked, acknowledged,
+// lost and corrupted; a sheet cut as its toolpath says; and every fault,
+// cancel and stop ending with the controller's laser off and no hang.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include <fstream>
+#include <sstream>
+
+#include "devices/ruida/RuidaDriver.h"
+#include "devices/sim/RuidaSimulator.h"
+#include "profiles/Profiles.h"
+#include "support/TestSupport.h"
+#include "toolpath/SheetDrawing.h"
+
+namespace rotafab::devices {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+// A sheet: an etched label, a scored fold, and two parts with a hole each.
+jobs::Toolpath sheet() {
+  jobs::SheetDrawing s;
+  s.width = 700 / 25.4, s.height = 500 / 25.4, s.margin = 0.2;
+  for (auto op : profiles::kAllOperations) s.colours[op] = {0, 0, 0};
+  s.paths.push_back({jobs::Operation::Etch, {{1, 1}, {1.5, 1.2}, {2, 1}}, false});
+  s.paths.push_back({jobs::Operation::Score, {{1, 3}, {4, 3}}, false});
+  for (double x : {1.0, 16.0}) {
+    s.paths.push_back({jobs::Operation::Cut, {{x + 1, 5}, {x + 2, 5}, {x + 2, 6}, {x + 1, 6}}, true});
+    s.paths.push_back({jobs::Operation::Cut, {{x, 4}, {x + 4, 4}, {x + 4, 8}, {x, 8}}, true});
+  }
+  // Enough small parts for the job to take several packets.
+  for (int i = 0; i < 120; ++i) {
+    const double x = 1 + (i % 60) * 0.5, y = 10 + (i / 60) * 0.5;
+    s.paths.push_back({jobs::Operation::Cut, {{x, y}, {x + 0.3, y}, {x + 0.3, y + 0.3}, {x, y + 0.3}}, true});
+  }
+  const auto machine =
+      profiles::loadMachineProfile(std::string(ROTAFAB_SOURCE_DIR) + "/profiles/machines/ruida-co2-60w.yaml");
+  return jobs::planToolpath(s, machine, profiles::MaterialProfile{}, jobs::profileMotion(machine));
+}
+
+ruida::RuidaTimeouts quick() {
+  ruida::RuidaTimeouts t;
+  t.reply = 200ms;
+  t.sends = 5;
+  t.poll = 20ms;
+  t.stop = 2000ms;
+  return t;
+}
+
+struct Rig {
+  explicit Rig(sim::RuidaSimulatorOptions options)
+      : simulator(std::move(options)),
+        driver(
+            [port = simulator.port()] {
+              return ruida::udpChannel(DatagramLink::open("127.0.0.1", port, 0), ruida::kDefaultMagic, quick());
+            },
+            ruida::kDefaultMagic, {}, quick(), 1) {}
+  sim::RuidaSimulator simulator;
+  ruida::RuidaDriver driver;
+};
+
+sim::RuidaSimulatorOptions fast() {
+  sim::RuidaSimulatorOptions options;
+  options.timeScale = 500;
+  options.bedWidth = 700, options.bedHeight = 500;
+  return options;
+}
+
+// The cuts the toolpath asks for, in the controller's millimetres (top-left origin, y down).
+std::vector<std::array<double, 4>> wanted(const jobs::Toolpath& toolpath) {
+  std::vector<std::array<double, 4>> cuts;
+  for (const jobs::ToolpathStroke& stroke : toolpath.strokes) {
+    for (size_t i = 1; i < stroke.points.size(); ++i) {
+      const jobs::Point2 a = stroke.points[i - 1], b = stroke.points[i];
+      cuts.push_back({a.x() * 25.4, (toolpath.height - a.y()) * 25.4, b.x() * 25.4, (toolpath.height - b.y()) * 25.4});
+    }
+  }
+  return cuts;
+}
+
+void expectCutAsAsked(const sim::RuidaSimulator& simulator, const jobs::Toolpath& toolpath) {
+  const auto want = wanted(toolpath);
+  const auto got = simulator.cuts();
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) {
+    EXPECT_NEAR(got[i].x0, want[i][0], 0.001) << i;
+    EXPECT_NEAR(got[i].y0, want[i][1], 0.001) << i;
+    EXPECT_NEAR(got[i].x1, want[i][2], 0.001) << i;
+    EXPECT_NEAR(got[i].y1, want[i][3], 0.001) << i;
+  }
+  EXPECT_TRUE(simulator.errors().empty()) << simulator.errors().front();
+}
+
+TEST(Ruida, ASheetIsCutOverLoopbackUdpAsItsToolpathSays) {
+  Rig rig(fast());
+  const std::string identity = rig.driver.connect();
+  EXPECT_NE(identity.find("Ruida controller (card 0x65106510, bed 700 x 500 mm) on ruida://127.0.0.1:"),
+            std::string::npos)
+      << identity;
+  const jobs::Toolpath toolpath = sheet();
+  Progress last;
+  rig.driver.run(
+      toolpath, [&](const Progress& p) { last = p; }, core::Cancellation());
+  EXPECT_EQ(last.strokesCut, toolpath.strokes.size());
+  EXPECT_EQ(last.bytesAcknowledged, last.bytesTotal);
+  expectCutAsAsked(rig.simulator, toolpath);
+  // Each cut at its stroke's power.
+  EXPECT_NEAR(rig.simulator.cuts().back().power, toolpath.strokes.back().power, 0.001);
+  EXPECT_FALSE(rig.simulator.laserOn());
+  EXPECT_FALSE(rig.simulator.jobRuns());
+  EXPECT_EQ(rig.driver.resends(), 0u);
+  EXPECT_EQ(rig.driver.status().state, "Idle");
+}
+
+TEST(Ruida, ALostPacketIsSentAgain) {
+  auto options = fast();
+  options.fault = sim::RuidaFault::Drop;
+  options.after = 5;  // the job's first packet, after the connection's three reads and a status read
+  Rig rig(options);
+  const jobs::Toolpath toolpath = sheet();
+  rig.driver.run(toolpath, {}, core::Cancellation());
+  EXPECT_GE(rig.driver.resends(), 1u);
+  expectCutAsAsked(rig.simulator, toolpath);
+}
+
+TEST(Ruida, APacketWhoseChecksumFailsIsRefusedAndSentAgain) {
+  auto options = fast();
+  options.fault = sim::RuidaFault::Corrupt;
+  options.after = 6;  // the job's second packet
+  Rig rig(options);
+  const jobs::Toolpath toolpath = sheet();
+  rig.driver.run(toolpath, {}, core::Cancellation());
+  EXPECT_EQ(rig.simulator.naks(), 1u);
+  EXPECT_GE(rig.driver.resends(), 1u);
+  expectCutAsAsked(rig.simulator, toolpath);
+}
+
+// Switched off mid-job: a Timeout naming the controller and the packet,
+// in seconds; the driver cannot confirm the laser off, and says so.
+TEST(Ruida, AControllerThatStopsAnsweringIsATimeoutNotAHang) {
+  auto options = fast();
+  options.timeScale = 1;
+  options.fault = sim::RuidaFault::Silence;
+  options.after = 8;
+  Rig rig(options);
+  const auto start = Clock::now();
+  try {
+    rig.driver.run(sheet(), {}, core::Cancellation());
+    FAIL() << "no fault";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Timeout);
+    EXPECT_FALSE(fault.laserOffConfirmed);
+    EXPECT_NE(std::string(fault.what()).find("stopped answering"), std::string::npos) << fault.what();
+    EXPECT_NE(std::string(fault.what()).find("ruida://127.0.0.1:"), std::string::npos) << fault.what();
+  }
+  EXPECT_LT(Clock::now() - start, 15s);
+  EXPECT_FALSE(rig.simulator.laserOn());
+}
+
+// A cancel while the laser cuts: the controller's stop, confirmed; nothing more is cut.
+TEST(Ruida, ACancelStopsTheJobWithTheLaserOff) {
+  auto options = fast();
+  options.timeScale = 2;
+  Rig rig(options);
+  core::Cancellation cancel;
+  std::thread canceller([&] {
+    const auto until = Clock::now() + 10s;
+    while (!rig.simulator.laserOn() && Clock::now() < until) std::this_thread::sleep_for(1ms);
+    cancel.cancel();
+  });
+  const jobs::Toolpath toolpath = sheet();
+  try {
+    rig.driver.run(toolpath, {}, cancel);
+    FAIL() << "no fault";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Cancelled);
+    EXPECT_TRUE(fault.laserOffConfirmed);
+  }
+  canceller.join();
+  EXPECT_EQ(rig.simulator.stops(), 1u);
+  EXPECT_FALSE(rig.simulator.laserOn());
+  EXPECT_FALSE(rig.simulator.jobRuns());
+  const size_t cut = rig.simulator.cuts().size();
+  EXPECT_LT(cut, wanted(toolpath).size());
+  std::this_thread::sleep_for(100ms);
+  EXPECT_EQ(rig.simulator.cuts().size(), cut);
+}
+
+TEST(Ruida, APauseHoldsWithTheLaserOffAndAResumeFinishesTheSheet) {
+  auto options = fast();
+  options.timeScale = 100;
+  Rig rig(options);
+  const jobs::Toolpath toolpath = sheet();
+  std::atomic<bool> heldDark{false};
+  std::thread operatorAtTheMachine([&] {
+    const auto until = Clock::now() + 10s;
+    while (!rig.simulator.laserOn() && Clock::now() < until) std::this_thread::sleep_for(1ms);
+    rig.driver.pause();
+    std::this_thread::sleep_for(300ms);
+    const size_t cut = rig.simulator.cuts().size();
+    std::this_thread::sleep_for(200ms);
+    heldDark = !rig.simulator.laserOn() && rig.simulator.jobRuns() && rig.simulator.cuts().size() == cut;
+    rig.driver.resume();
+  });
+  rig.driver.run(toolpath, {}, core::Cancellation());
+  operatorAtTheMachine.join();
+  EXPECT_TRUE(heldDark);
+  EXPECT_EQ(rig.simulator.pauses(), 1u);
+  expectCutAsAsked(rig.simulator, toolpath);
+}
+
+TEST(Ruida, TheFrameTracesTheBoxWithoutLightingTheLaser) {
+  auto options = fast();
+  std::atomic<int> lit{0};
+  options.laserChanged = [&](bool on) { lit += on; };
+  Rig rig(options);
+  const jobs::Toolpath toolpath = sheet();
+  rig.driver.frame(toolpath, core::Cancellation());
+  EXPECT_EQ(lit, 0);
+  EXPECT_TRUE(rig.simulator.cuts().empty());
+  EXPECT_TRUE(rig.simulator.errors().empty());
+  // Back at the box's first corner, the sheet's lowest x and highest y.
+  const auto box = jobs::toolpathBounds(toolpath);
+  const DeviceStatus at = rig.driver.status();
+  EXPECT_NEAR(at.x, box[0], 0.001);
+  EXPECT_NEAR(at.y, box[3], 0.001);
+}
+
+TEST(Ruida, AStopIsConfirmedOnlyByAControllerThatAnswers) {
+  Rig rig(fast());
+  rig.driver.connect();
+  EXPECT_TRUE(rig.driver.stopSafely());
+  EXPECT_EQ(rig.simulator.stops(), 1u);
+  auto options = fast();
+  options.fault = sim::RuidaFault::Silence;
+  options.after = 4;
+  Rig silent(options);
+  silent.driver.connect();
+  const auto start = Clock::now();
+  EXPECT_FALSE(silent.driver.stopSafely());
+  EXPECT_LT(Clock::now() - start, 5s);
+}
+
+// The .rd file of a dry run, read by a decoder written from the public
+// descriptions alone (tests/support/ruida_decode.py, none of the driver's
+// code): every cut of the toolpath, in order, at its power.
+TEST(Ruida, AnIndependentReadingOfTheRdFileCutsTheToolpath) {
+  const jobs::Toolpath toolpath = sheet();
+  ruida::RuidaDriver driver([]() -> std::unique_ptr<ruida::RuidaChannel> { throw std::logic_error("no controller"); },
+                            ruida::kDefaultMagic, {});
+  test::TempDir dir;
+  const auto file = dir.path() / "sheet.rd";
+  std::ofstream(file, std::ios::binary) << driver.program({toolpath});
+  const test::CommandResult decoded = test::run(
+      "/usr/bin/python3 " + test::quoted(std::filesystem::path(ROTAFAB_SOURCE_DIR) / "tests/support/ruida_decode.py") +
+      " " + test::quoted(file));
+  ASSERT_EQ(decoded.status, 0) << decoded.err;
+  std::istringstream lines(decoded.out);
+  std::vector<std::array<double, 5>> cuts;
+  for (std::array<double, 5> cut{}; lines >> cut[0] >> cut[1] >> cut[2] >> cut[3] >> cut[4];) cuts.push_back(cut);
+  const auto want = wanted(toolpath);
+  ASSERT_EQ(cuts.size(), want.size());
+  size_t stroke = 0, within = 0;
+  for (size_t i = 0; i < want.size(); ++i) {
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(cuts[i][k], want[i][k], 0.001) << i;
+    EXPECT_NEAR(cuts[i][4], 100 * toolpath.strokes[stroke].power, 0.01) << i;
+    if (++within == toolpath.strokes[stroke].points.size() - 1) ++stroke, within = 0;
+  }
+}
+
+TEST(Ruida, UrisSayWhatIsWrong) {
+  const auto message = [](const std::string& uri) {
+    try {
+      parseDeviceUri(uri);
+      return std::string("accepted");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+  };
+  EXPECT_EQ(message("ruida://192.168.1.100"), "accepted");
+  EXPECT_EQ(message("ruida://laser.local:50200?magic=0x11&bind=0"), "accepted");
+  EXPECT_EQ(message("ruida+serial:///dev/ttyUSB0?baud=115200"), "accepted");
+  EXPECT_EQ(message("sim:ruida?fault=drop&after=3"), "accepted");
+  EXPECT_NE(message("ruida://").find("no host"), std::string::npos);
+  EXPECT_NE(message("ruida://1.2.3.4?magic=11").find("\"magic=11\": a Ruida URI takes"), std::string::npos);
+  EXPECT_NE(message("ruida://1.2.3.4:99999").find("not a UDP port"), std::string::npos);
+  EXPECT_NE(message("ruida+serial://ttyUSB0").find("absolute path"), std::string::npos);
+  EXPECT_NE(message("sim:ruida?fault=alarm").find("drop, corrupt, silence"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace rotafab::devices
