@@ -20,6 +20,7 @@
 #include <regex>
 #include <set>
 #include <thread>
+#include <tuple>
 
 #include "daemon/DaemonSupport.h"
 #include "daemon/service/DaemonConfig.h"
@@ -759,20 +760,35 @@ TEST(Daemon, ADeviceFaultFailsOnlyItsJobWithTheDevicesOwnMessage) {
   EXPECT_EQ(devices[1]["state"], "idle");
 }
 
-TEST(Daemon, AJobIsPlannedForAndCutOnASimulatedM2Nano) {
+// The daemon drives every kind of controller alike: a K40's M2 Nano over
+// USB and a CO2 laser's Ruida over UDP, each planned for its own machine.
+TEST(Daemon, AJobIsPlannedForAndCutOnASimulatedM2NanoAndASimulatedRuida) {
   TempDir root;
-  Daemon daemon(root.path(), "devices: [{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=50\"}]\n");
+  Daemon daemon(root.path(),
+                "devices: [{name: k40, machine: k40-m2nano, uri: \"sim:m2nano?speed=50\"}, "
+                "{name: co2, machine: ruida-co2-60w, uri: \"sim:ruida?speed=200\"}]\n");
   daemon.start();
-  const json devices = daemon.clientJson("devices --daemon")["devices"];
-  const long long id =
-      daemon.clientJson("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --time 0")["id"];
-  const json ready = daemon.waitForJob(id, [](const json& j) { return state(j) == "ready" || state(j) == "failed"; });
-  ASSERT_EQ(state(ready), "ready") << ready.dump();
-  EXPECT_NE(ready["transitions"][1]["reason"].get<std::string>().find("k40-m2nano"), std::string::npos);
-  ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
-  const json done = daemon.waitForJob(
-      id, [](const json& j) { return state(j) == "done" || state(j) == "failed"; }, 120);
-  EXPECT_EQ(state(done), "done") << done.dump();
+  for (const auto& [device, machine, identity] :
+       {std::tuple{"k40", "k40-m2nano", "Lihuiyu M2 Nano"}, std::tuple{"co2", "ruida-co2-60w", "Ruida controller"}}) {
+    SCOPED_TRACE(device);
+    const long long id = daemon.clientJson("submit " + quoted(kSource / "examples/cube.obj") +
+                                           " --structure band --time 0 --device " + device)["id"];
+    const json ready = daemon.waitForJob(id, [](const json& j) { return state(j) == "ready" || state(j) == "failed"; });
+    ASSERT_EQ(state(ready), "ready") << ready.dump();
+    EXPECT_NE(ready["transitions"][1]["reason"].get<std::string>().find(machine), std::string::npos);
+    ASSERT_EQ(daemon.client(fmt::format("start {}", id)).status, 0);
+    const json done = daemon.waitForJob(
+        id, [](const json& j) { return state(j) == "done" || state(j) == "failed"; }, 120);
+    EXPECT_EQ(state(done), "done") << done.dump();
+    int seen = 0;
+    for (const json& d : daemon.clientJson("devices --daemon")["devices"]) {
+      if (d["name"] == device) {
+        ++seen;
+        EXPECT_NE(d.value("checked", "").find(identity), std::string::npos) << d.dump();
+      }
+    }
+    EXPECT_EQ(seen, 1);
+  }
 }
 
 TEST(Daemon, APlanLongerThanPlanTimeoutIsStoppedAndItsJobFailsSayingSo) {

@@ -10,6 +10,10 @@
 #include <cmath>
 #include <thread>
 
+#include <fcntl.h>
+#include <termios.h>
+#include <unistd.h>
+
 #include <fstream>
 #include <sstream>
 
@@ -274,6 +278,52 @@ TEST(Ruida, AnIndependentReadingOfTheRdFileCutsTheToolpath) {
     EXPECT_NEAR(cuts[i][4], 100 * toolpath.strokes[stroke].power, 0.01) << i;
     if (++within == toolpath.strokes[stroke].points.size() - 1) ++stroke, within = 0;
   }
+}
+
+// The controller's USB port, a serial device (here a pseudo-terminal): the
+// same swizzled stream, without checksums or answers to each packet; a
+// memory read's reply found among bytes from before it.
+TEST(Ruida, OverItsUsbPortTheStreamGoesSwizzledWithoutChecksums) {
+  const int master = ::posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);  // the test never hangs on it
+  ASSERT_GE(master, 0);
+  ASSERT_EQ(::grantpt(master), 0);
+  ASSERT_EQ(::unlockpt(master), 0);
+  const std::string port = ::ptsname(master);
+  const int slave = ::open(port.c_str(), O_RDWR | O_NOCTTY);  // held open, and raw
+  termios raw{};
+  ::tcgetattr(slave, &raw);
+  ::cfmakeraw(&raw);
+  ::tcsetattr(slave, TCSANOW, &raw);
+  const ruida::Swizzle swizzle;
+  auto channel = ruida::serialChannel(openSerialLink(port, 115200), ruida::kDefaultMagic, quick());
+  const auto readWire = [&](size_t count) {
+    ruida::Bytes got;
+    const auto until = Clock::now() + 2s;
+    while (got.size() < count && Clock::now() < until) {
+      uint8_t buffer[64];
+      const ssize_t n = ::read(master, buffer, std::min(sizeof buffer, count - got.size()));
+      if (n > 0) got.insert(got.end(), buffer, buffer + n);
+      if (n <= 0) std::this_thread::sleep_for(1ms);
+    }
+    return swizzle.undo(got);
+  };
+  channel->send({0xD8, 0x02});
+  EXPECT_EQ(readWire(2), (ruida::Bytes{0xD8, 0x02}));
+  std::thread controller([&] {
+    const ruida::Bytes asked = readWire(4);
+    ruida::Bytes reply = {0xCC, 0xDA, 0x01, asked[2], asked[3]};  // a stray byte first
+    ruida::appendU35(reply, 0x65106510);
+    const ruida::Bytes wire = swizzle(reply);
+    EXPECT_EQ(::write(master, wire.data(), wire.size()), static_cast<ssize_t>(wire.size()));
+  });
+  EXPECT_EQ(channel->read(ruida::kMemoryCardId), 0x65106510);
+  controller.join();
+  // Nothing answers: a Timeout naming the port, in the tries' time.
+  const auto start = Clock::now();
+  EXPECT_THROW(channel->read(ruida::kMemoryStatus), DeviceFault);
+  EXPECT_LT(Clock::now() - start, 3s);
+  ::close(slave);
+  ::close(master);
 }
 
 TEST(Ruida, UrisSayWhatIsWrong) {
