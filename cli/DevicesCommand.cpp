@@ -26,6 +26,10 @@ int runDevices(bool json) {
       }
       entry["driver"] = d.driver.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(d.driver);
       entry["uri"] = d.uri.empty() ? nlohmann::ordered_json() : nlohmann::ordered_json(d.uri);
+      if (!d.otherwise.empty()) {
+        entry["otherwise"] = nlohmann::ordered_json::array();
+        for (const auto& [driver, uri] : d.otherwise) entry["otherwise"].push_back({{"driver", driver}, {"uri", uri}});
+      }
       list.push_back(entry);
     }
     std::cout << list.dump() << '\n';
@@ -36,6 +40,8 @@ int runDevices(bool json) {
     if (d.vendor >= 0) fmt::print("  usb {:04x}:{:04x}", d.vendor, d.product);
     if (!d.serial.empty()) fmt::print(" serial {}", d.serial);
     if (!d.uri.empty()) fmt::print("\n    {} driver: --device {}", d.driver, d.uri);
+    for (const auto& [driver, uri] : d.otherwise)
+      fmt::print("\n    or, if it is one, {} driver: --device {}", driver, uri);
     fmt::print("\n");
   }
   if (std::none_of(found.begin(), found.end(), [](const auto& d) { return !d.uri.empty(); })) {

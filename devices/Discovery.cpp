@@ -3,8 +3,10 @@
 #include "devices/DriverEntry.h"
 
 #include <fmt/format.h>
+
 #include <libserialport.h>
 #include <libusb.h>
+#include <algorithm>
 
 namespace rotafab::devices {
 
@@ -19,9 +21,14 @@ std::vector<FoundDevice> findDevices() {
       if (sp_get_port_transport(*port) == SP_TRANSPORT_USB) {
         sp_get_port_usb_vid_pid(*port, &device.vendor, &device.product);
         if (const char* serial = sp_get_port_usb_serial(*port)) device.serial = serial;
-        if (const DriverEntry* driver = driverForUsb(device.vendor, device.product)) {
-          device.uri = driver->uriForSerialPort(device.port);
-          if (!device.uri.empty()) device.driver = driver->name();
+        for (const DriverEntry* driver : driversForUsb(device.vendor, device.product)) {
+          const std::string uri = driver->uriForSerialPort(device.port);
+          if (uri.empty()) continue;
+          if (device.uri.empty()) {
+            device.uri = uri, device.driver = driver->name();
+          } else {
+            device.otherwise.emplace_back(driver->name(), uri);
+          }
         }
       }
       found.push_back(std::move(device));
@@ -36,7 +43,11 @@ std::vector<FoundDevice> findDevices() {
       libusb_device_descriptor descriptor{};
       if (libusb_get_device_descriptor(list[i], &descriptor) != 0) continue;
       // Devices driven over USB itself (a serial adapter's port is listed above).
-      const DriverEntry* driver = driverForUsb(descriptor.idVendor, descriptor.idProduct);
+      const auto fitting = driversForUsb(descriptor.idVendor, descriptor.idProduct);
+      const auto usbDriver = std::find_if(fitting.begin(), fitting.end(), [&](const DriverEntry* d) {
+        return !d->uriForUsbDevice(libusb_get_bus_number(list[i]), libusb_get_device_address(list[i])).empty();
+      });
+      const DriverEntry* driver = usbDriver == fitting.end() ? nullptr : *usbDriver;
       const int bus = libusb_get_bus_number(list[i]), address = libusb_get_device_address(list[i]);
       if (!driver || driver->uriForUsbDevice(bus, address).empty()) continue;
       FoundDevice device;
@@ -49,6 +60,16 @@ std::vector<FoundDevice> findDevices() {
     }
     if (count >= 0) libusb_free_device_list(list, 1);
     libusb_exit(usb);
+  }
+  for (const DriverEntry* driver : drivers()) {
+    for (const auto& [uri, description] : driver->findOnNetwork()) {
+      FoundDevice device;
+      device.port = "network";
+      device.description = description;
+      device.driver = driver->name();
+      device.uri = uri;
+      found.push_back(std::move(device));
+    }
   }
   return found;
 }

@@ -6,6 +6,7 @@
 // DriverEntry.h says) and the URI to give `run`.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rotafab::devices {
@@ -17,9 +18,13 @@ struct FoundDevice {
   std::string serial;             // the USB serial number, when it has one
   std::string driver;             // "grbl", "m2nano", or "" when none fits
   std::string uri;                // for --device, when a driver fits
+  // Other drivers that may fit ("ruida+serial:///dev/ttyUSB0": a Ruida's USB
+  // port is the same FTDI chip as many GRBL boards'), each driver and URI.
+  std::vector<std::pair<std::string, std::string>> otherwise;
 };
 
-// What is plugged in now; never throws (a library that cannot enumerate gives nothing).
+// What is plugged in now, and the controllers that answer on the local
+// network; never throws (a library that cannot enumerate gives nothing).
 std::vector<FoundDevice> findDevices();
 
 }  // namespace rotafab::devices

@@ -62,6 +62,12 @@ class DriverEntry {
   [[nodiscard]] virtual std::string uriForSerialPort(const std::string& /*port*/) const { return {}; }
   [[nodiscard]] virtual std::string uriForUsbDevice(int /*bus*/, int /*address*/) const { return {}; }
   [[nodiscard]] virtual std::string usbDescription() const { return {}; }
+  // For discovery: the devices it finds on the network, each as its URI
+  // and what it is (a moment's wait; nothing when it finds none so).
+  struct NetworkDevice {
+    std::string uri, description;
+  };
+  [[nodiscard]] virtual std::vector<NetworkDevice> findOnNetwork() const { return {}; }
   // Throws std::invalid_argument "URI: what is wrong (e.g. AN EXAMPLE)".
   [[nodiscard]] virtual std::unique_ptr<DeviceAddress> parse(const std::string& uri) const = 0;
   // The device, not connected yet (a simulator starts at once).
@@ -88,7 +94,7 @@ struct ParsedUri {
 // Throws std::invalid_argument naming what is wrong with the URI.
 ParsedUri parseDeviceUri(const std::string& uri);
 
-// The driver of a USB device, or null.
-const DriverEntry* driverForUsb(int vendor, int product);
+// The drivers of a USB device, the likeliest first (one chip may be in several controllers).
+std::vector<const DriverEntry*> driversForUsb(int vendor, int product);
 
 }  // namespace rotafab::devices

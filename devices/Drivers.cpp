@@ -34,13 +34,17 @@ ParsedUri parseDeviceUri(const std::string& uri) {
   throw uriError(uri, "not a device URI this program knows");
 }
 
-const DriverEntry* driverForUsb(int vendor, int product) {
+std::vector<const DriverEntry*> driversForUsb(int vendor, int product) {
+  std::vector<const DriverEntry*> fitting;
   for (const DriverEntry* driver : drivers()) {
     for (const UsbId& id : driver->usbIds()) {
-      if (id.vendor == vendor && (!id.product || *id.product == product)) return driver;
+      if (id.vendor == vendor && (!id.product || *id.product == product)) {
+        fitting.push_back(driver);
+        break;
+      }
     }
   }
-  return nullptr;
+  return fitting;
 }
 
 }  // namespace rotafab::devices

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "devices/UriParts.h"
+#include "devices/ruida/RuidaDiscovery.h"
 #include "devices/ruida/RuidaDriver.h"
 
 namespace rotafab::devices::ruida {
@@ -55,6 +56,20 @@ class RuidaEntry : public DriverEntry {
   [[nodiscard]] std::string_view scheme() const override { return "ruida://"; }
   [[nodiscard]] bool takes(std::string_view uri) const override {
     return uri.starts_with("ruida://") || uri.starts_with("ruida+serial://");
+  }
+
+  // A Ruida's USB port is an FTDI FT232 serial adapter (as many GRBL boards' are).
+  [[nodiscard]] std::vector<UsbId> usbIds() const override { return {{0x0403, 0x6001}}; }
+  [[nodiscard]] std::string uriForSerialPort(const std::string& port) const override {
+    return "ruida+serial://" + port;
+  }
+  // Every controller on the local network that answers a read of its card ID.
+  [[nodiscard]] std::vector<NetworkDevice> findOnNetwork() const override {
+    std::vector<NetworkDevice> found;
+    for (const FoundController& c : probeControllers("255.255.255.255", kControllerPort, kReplyPort, Millis(500))) {
+      found.push_back({"ruida://" + c.address, fmt::format("Ruida controller, card 0x{:08X}", c.card)});
+    }
+    return found;
   }
 
   [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {

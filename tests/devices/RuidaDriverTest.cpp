@@ -17,6 +17,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "devices/ruida/RuidaDiscovery.h"
 #include "devices/ruida/RuidaDriver.h"
 #include "devices/sim/RuidaSimulator.h"
 #include "profiles/Profiles.h"
@@ -324,6 +325,20 @@ TEST(Ruida, OverItsUsbPortTheStreamGoesSwizzledWithoutChecksums) {
   EXPECT_LT(Clock::now() - start, 3s);
   ::close(slave);
   ::close(master);
+}
+
+// `rotafab devices` asks the network (its broadcast address) for card IDs:
+// here the simulated controller's loopback address.
+TEST(Ruida, AControllerOnTheNetworkAnswersTheProbeWithItsCard) {
+  sim::RuidaSimulator simulator(fast());
+  const auto found = ruida::probeControllers("127.0.0.1", simulator.port(), 0, 300ms);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].address, "127.0.0.1");
+  EXPECT_EQ(found[0].card, 0x65106510);
+  const auto start = Clock::now();
+  EXPECT_TRUE(ruida::probeControllers("127.0.0.1", 9, 0, 200ms).empty());  // the discard port: nobody answers
+  EXPECT_LT(Clock::now() - start, 2s);
+  EXPECT_TRUE(ruida::probeControllers("not an address", 50200, 0, 200ms).empty());
 }
 
 TEST(Ruida, UrisSayWhatIsWrong) {
