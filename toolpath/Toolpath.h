@@ -42,7 +42,7 @@ struct ToolpathStroke {
   double speed = 0;            // in/s
   int pass = 1;                // 1-based
   std::vector<Point2> points;  // burnt from the first to the last; a closed path returns to its first point
-  double minPower = 0;         // 0..1, at most `power`: where the head slows (a Ruida's corners)
+  double minPower = -1;        // 0..1, at most `power`: where the head slows (a Ruida's corners); < 0: `power`
 };
 
 struct Toolpath {

@@ -46,6 +46,9 @@ class UdpChannel : public RuidaChannel {
     const Bytes packet = udpPacket(swizzle_(commands));
     const uint8_t ack = swizzle_(kAck), nak = swizzle_(kNak), error = swizzle_(kError);
     int silent = 0, refused = 0;
+    std::optional<uint8_t> unread;  // a one-byte answer this magic does not read
+    // Late answers to earlier packets would be taken for this one's.
+    link_->drain();
     for (;;) {
       link_->send(packet);
       ++packets_;
@@ -53,7 +56,7 @@ class UdpChannel : public RuidaChannel {
       const auto until = Clock::now() + timeouts_.reply;
       for (;;) {
         const auto left = std::chrono::duration_cast<Millis>(until - Clock::now());
-        const auto reply = left.count() > 0 ? link_->receive(left) : std::nullopt;
+        const auto reply = link_->receive(std::max(left, Millis(0)));
         if (!reply) break;
         if (reply->size() == 1) {  // swizzled, without a checksum
           const uint8_t answer = (*reply)[0];
@@ -71,7 +74,8 @@ class UdpChannel : public RuidaChannel {
             nakked = true;
             break;
           }
-          continue;  // a keep-alive (ENQ) or a late answer to an earlier packet
+          if (answer != swizzle_(kEnquire)) unread = answer;
+          continue;  // a keep-alive (ENQ), or an answer in another magic
         }
         if (address) {
           if (const auto value = memoryValue(swizzle_.undo(*reply), *address)) return value;
@@ -79,6 +83,15 @@ class UdpChannel : public RuidaChannel {
       }
       // No answer in time (the packet or its answer lost): send it again, a bounded number of times.
       if (!nakked && ++silent >= timeouts_.sends) {
+        if (unread) {
+          // Each byte is an ACK in exactly one magic: (byte - 1) XOR the ACK with its bits 7 and 0 swapped.
+          const auto swappedAck = static_cast<uint8_t>(Swizzle(0)(kAck) - 1);
+          const auto magic = static_cast<uint8_t>(static_cast<uint8_t>(*unread - 1) ^ swappedAck);
+          throw DeviceFault(FaultKind::Refused,
+                            fmt::format("{}: the controller answers in another magic number than 0x{:02X} (0x{:02X} "
+                                        "is an ACK in 0x{:02X}): add ?magic=0x{:02X} to its URI",
+                                        name(), swizzle_.magic(), *unread, magic, magic));
+        }
         throw DeviceFault(FaultKind::Timeout,
                           fmt::format("{}: the controller stopped answering: no answer to {} in {} sends of {} ms "
                                       "each (packet {})",
@@ -106,9 +119,9 @@ class SerialChannel : public RuidaChannel {
   }
 
   int64_t read(uint16_t address) override {
+    Bytes got;  // kept across tries: a reply may come late, after the next request went
     for (int sent = 1;; ++sent) {
       send(memoryRead(address));
-      Bytes got;
       const auto until = Clock::now() + timeouts_.reply;
       for (;;) {
         const auto left = std::chrono::duration_cast<Millis>(until - Clock::now());
@@ -117,8 +130,9 @@ class SerialChannel : public RuidaChannel {
         const Bytes more = swizzle_.undo(Bytes(some->begin(), some->end()));
         got.insert(got.end(), more.begin(), more.end());
         // The reply starts at its DA; anything before it is from before.
-        while (!got.empty() && got[0] != 0xDA) got.erase(got.begin());
-        if (got.size() >= 9) {
+        for (;;) {
+          while (!got.empty() && got[0] != 0xDA) got.erase(got.begin());
+          if (got.size() < 9) break;
           if (const auto value = memoryValue(got, address)) return *value;
           got.erase(got.begin());
         }

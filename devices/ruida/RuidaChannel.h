@@ -45,7 +45,9 @@ class RuidaChannel {
   // The value at a memory address.
   virtual int64_t read(uint16_t address) = 0;
   [[nodiscard]] virtual std::string name() const = 0;
-  [[nodiscard]] virtual size_t maxPacket() const { return 1472; }
+  // A packet's commands, at most: with its 2-byte sum, 1,472 bytes, a UDP
+  // payload that one 1,500-byte Ethernet frame carries unfragmented.
+  [[nodiscard]] virtual size_t maxPacket() const { return 1470; }
   // Packets sent again (a NAK, or no answer in time), since opened.
   [[nodiscard]] virtual size_t resends() const { return 0; }
   [[nodiscard]] virtual size_t packets() const { return 0; }

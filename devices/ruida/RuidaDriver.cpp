@@ -2,8 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <thread>
+#include <utility>
 
 namespace rotafab::devices::ruida {
 namespace {
@@ -34,14 +37,15 @@ std::string RuidaDriver::connect() {
 }
 
 void RuidaDriver::followHold(bool& held) {
-  if (holdWanted_ != held) {
-    channel_->send(holdWanted_ ? kPause : kResume);
-    held = holdWanted_;
+  const bool wanted = holdWanted_;  // once: a resume may come between two reads
+  if (wanted != held) {
+    channel_->send(wanted ? kPause : kResume);
+    held = wanted;
   }
 }
 
-void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, const std::function<void(size_t, Millis)>& sent,
-                         const core::Cancellation& cancel) {
+void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, bool mustRun,
+                         const std::function<void(size_t, Millis)>& sent, const core::Cancellation& cancel) {
   if (channel_->read(kMemoryStatus) & kStatusJobRuns) {
     throw DeviceFault(FaultKind::Refused, where() +
                                               ": the controller is running a job already (started from its "
@@ -49,6 +53,8 @@ void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, const std::
   }
   holdWanted_ = false;
   bool held = false;
+  const auto headAt = [&] { return std::pair{channel_->read(kMemoryX), channel_->read(kMemoryY)}; };
+  const auto startedAt = headAt();
   const auto cancelled = [&] {
     if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, where() + ": cancelled");
   };
@@ -60,10 +66,13 @@ void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, const std::
     bytes += packet.size();
     if (sent) sent(bytes, Millis(0));
   }
-  // The controller has the whole job; it has cut it when it reports no job
-  // running (having reported one, or after a moment for a job too short to see).
-  const auto lastPacket = Clock::now();
-  auto limit = Millis(60000 + static_cast<long>(3 * machineSeconds / timeScale_ * 1000));
+  // The controller has the whole job; it has run it when it reports no job
+  // running, having reported one or moved the head (a job too short to be
+  // seen running). One that does neither within its estimated time and a
+  // few seconds has not run it.
+  const double expected = std::isfinite(machineSeconds) ? std::max(machineSeconds, 0.0) / timeScale_ : 0;
+  const auto limit = Millis(60000 + static_cast<long>(3 * expected * 1000));
+  const auto grace = Millis(3000 + static_cast<long>(expected * 1000));
   Millis running(0);  // since the last packet, not held
   for (bool seenRunning = false;;) {
     cancelled();
@@ -72,7 +81,14 @@ void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, const std::
     const bool runs = channel_->read(kMemoryStatus) & kStatusJobRuns;
     if (sent) sent(bytes, running);
     seenRunning = seenRunning || runs;
-    if (!runs && !held && (seenRunning || Clock::now() - lastPacket > Millis(1000))) return;
+    if (!runs && !held && (seenRunning || headAt() != startedAt)) return;
+    if (!runs && !held && running > grace) {
+      if (!mustRun) return;  // a frame: nothing of it lights the laser
+      throw DeviceFault(FaultKind::Refused, where() +
+                                                ": the controller took the job but has not run it (no job "
+                                                "running, the head where it was): is it set to keep jobs in "
+                                                "its memory rather than run them?");
+    }
     if (!held && running > limit) {
       throw DeviceFault(
           FaultKind::Stalled,
@@ -105,7 +121,7 @@ void RuidaDriver::frame(const jobs::Toolpath& toolpath, const core::Cancellation
     const auto box = jobs::toolpathBounds(toolpath);
     // The moves go at the controller's own travel speed; 50 mm/s is slow for one.
     const double seconds = (2 * (box[2] - box[0] + box[3] - box[1]) + box[2] + box[3]) * 25.4 / 50;
-    runJob(frameStream(toolpath), seconds, {}, cancel);
+    runJob(frameStream(toolpath), seconds, false, {}, cancel);
   } catch (...) {
     stopAndRethrow([this] { return stopSafely(); });
   }
@@ -125,7 +141,7 @@ void RuidaDriver::run(const jobs::Toolpath& toolpath, const std::function<void(c
     // does not say how far it has got: a stroke counts as cut only once
     // the job has ended (a resume after a stop starts the sheet again).
     runJob(
-        stream, toolpath.seconds,
+        stream, toolpath.seconds, true,
         [&](size_t bytes, Millis running) {
           report.bytesAcknowledged = bytes;
           report.stroke = report.strokes * bytes / std::max<size_t>(stream.size(), 1);

@@ -50,7 +50,8 @@ class RuidaDriver : public Device {
   // Sends a job (frame or sheet) packet by packet, then reads the status
   // until the controller has run it; `tell(bytes sent, time it has run
   // since the last, held times not counted)` after each packet and status read.
-  void runJob(const Bytes& stream, double machineSeconds, const std::function<void(size_t, Millis)>& tell,
+  // A job that must run (a sheet) and is never seen to is a fault; a frame's is not.
+  void runJob(const Bytes& stream, double machineSeconds, bool mustRun, const std::function<void(size_t, Millis)>& tell,
               const core::Cancellation& cancel);
   void followHold(bool& held);
   [[nodiscard]] std::string where() const;

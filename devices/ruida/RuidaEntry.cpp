@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "devices/UriParts.h"
 #include "devices/ruida/RuidaDiscovery.h"
 #include "devices/ruida/RuidaDriver.h"
@@ -82,13 +84,18 @@ class RuidaEntry : public DriverEntry {
       parsed->host = rest;
       return parsed;
     }
-    const auto colon = rest.rfind(':');
-    parsed->host = rest.substr(0, colon);
+    std::string where = rest;
+    if (where.ends_with("/")) where.pop_back();
+    if (where.find('[') != std::string::npos || std::count(where.begin(), where.end(), ':') > 1) {
+      throw ruidaUriError(uri, "Ruida controllers speak IPv4 only: give its IPv4 address or name");
+    }
+    const auto colon = where.rfind(':');
+    parsed->host = where.substr(0, colon);
     if (parsed->host.empty() || parsed->host.find('/') != std::string::npos) {
       throw ruidaUriError(uri, "no host: the controller's IP address or name");
     }
     if (colon != std::string::npos) {
-      const auto port = wholeNumber<unsigned>(rest.substr(colon + 1));
+      const auto port = wholeNumber<unsigned>(where.substr(colon + 1));
       if (!port || *port == 0 || *port > 65535) throw ruidaUriError(uri, "not a UDP port after the host");
       parsed->port = static_cast<uint16_t>(*port);
     }

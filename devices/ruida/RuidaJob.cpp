@@ -38,7 +38,7 @@ struct Layer {
 
 // The power where the head slows: the stroke's, never above its power.
 double minPowerOf(const jobs::ToolpathStroke& stroke) {
-  return stroke.minPower > 0 ? std::min(stroke.minPower, stroke.power) : stroke.power;
+  return stroke.minPower >= 0 ? std::min(stroke.minPower, stroke.power) : stroke.power;
 }
 
 size_t layerOf(std::vector<Layer>& layers, const jobs::ToolpathStroke& stroke) {
@@ -163,6 +163,11 @@ Bytes jobStream(const jobs::Toolpath& toolpath, const RuidaJobOptions& options) 
   std::vector<Layer> layers;
   std::vector<size_t> strokeLayer;
   for (const jobs::ToolpathStroke& stroke : toolpath.strokes) strokeLayer.push_back(layerOf(layers, stroke));
+  // A layer's number is one 7-bit operand byte.
+  if (layers.size() > 0x7F) {
+    throw std::invalid_argument(
+        fmt::format("{} settings of power and speed on one sheet: a Ruida job holds 127 at most", layers.size()));
+  }
   Bytes out;
   const auto command = [&out](std::initializer_list<uint8_t> bytes) { appendCommand(out, bytes); };
   appendHeader(out, boundsOf(toolpath), layers);

@@ -142,6 +142,7 @@ void RuidaSimulator::command(const Bytes& c, const void* from, unsigned fromLeng
         setLaser(false);
         jobStarted_ = jobEnded_ = paused_ = false;
         reader_ = {};
+        pending_.clear();
         return;
       case 0x02:
         ++pauses_;

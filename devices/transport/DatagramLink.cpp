@@ -2,23 +2,42 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 
 namespace rotafab::devices {
+namespace {
 
 namespace asio = boost::asio;
 using asio::ip::udp;
+
+}  // namespace
 
 std::unique_ptr<DatagramLink> DatagramLink::open(const std::string& host, uint16_t port, uint16_t localPort) {
   std::unique_ptr<DatagramLink> link(new DatagramLink);
   link->name_ = fmt::format("{}:{}", host, port);
   link->io_ = std::make_unique<asio::io_context>();
   boost::system::error_code error;
+  // A name looked up within a bound (a dead DNS server or mDNS can take long).
   udp::resolver resolver(*link->io_);
-  const auto found = resolver.resolve(udp::v4(), host, std::to_string(port), error);
-  if (error || found.empty()) {
-    throw DeviceFault(FaultKind::Disconnected, fmt::format("{}: cannot resolve it: {}", link->name_,
-                                                           error ? error.message() : std::string("no IPv4 address")));
+  std::optional<boost::system::error_code> resolved;
+  udp::resolver::results_type found;
+  resolver.async_resolve(udp::v4(), host, std::to_string(port),
+                         [&](const boost::system::error_code& e, udp::resolver::results_type results) {
+                           resolved = e, found = std::move(results);
+                         });
+  link->io_->run_for(std::chrono::seconds(5));
+  if (!resolved) {
+    resolver.cancel();
+    link->io_->restart();
+    link->io_->run();
+    throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the name did not resolve within 5 s", link->name_));
+  }
+  link->io_->restart();
+  if (*resolved || found.empty()) {
+    throw DeviceFault(FaultKind::Disconnected,
+                      fmt::format("{}: cannot resolve it: {}", link->name_,
+                                  *resolved ? resolved->message() : std::string("no IPv4 address")));
   }
   link->peer_ = found.begin()->endpoint();
   link->socket_ = std::make_unique<udp::socket>(*link->io_);
@@ -44,6 +63,15 @@ uint16_t DatagramLink::localPort() const {
   return socket_->local_endpoint(ignored).port();
 }
 
+void DatagramLink::drain() {
+  boost::system::error_code error;
+  std::vector<uint8_t> buffer(65536);
+  while (socket_->available(error) > 0 && !error) {
+    udp::endpoint from;
+    socket_->receive_from(asio::buffer(buffer), from, 0, error);
+  }
+}
+
 void DatagramLink::send(const std::vector<uint8_t>& datagram) {
   boost::system::error_code error;
   socket_->send_to(asio::buffer(datagram), peer_, 0, error);
@@ -55,7 +83,9 @@ std::optional<std::vector<uint8_t>> DatagramLink::receive(Millis timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   for (;;) {
     const auto left = std::chrono::duration_cast<Millis>(deadline - std::chrono::steady_clock::now());
-    if (left.count() <= 0) return std::nullopt;
+    // At the deadline, a datagram already here still counts (this thread may have been kept waiting).
+    boost::system::error_code ignored;
+    if (left.count() <= 0 && socket_->available(ignored) == 0) return std::nullopt;
     std::vector<uint8_t> buffer(65536);
     udp::endpoint from;
     std::optional<boost::system::error_code> result;
@@ -63,7 +93,7 @@ std::optional<std::vector<uint8_t>> DatagramLink::receive(Millis timeout) {
     socket_->async_receive_from(asio::buffer(buffer), from,
                                 [&](const boost::system::error_code& e, size_t n) { result = e, got = n; });
     io_->restart();
-    io_->run_for(left);
+    io_->run_for(std::max(left, Millis(1)));
     if (!result) {
       boost::system::error_code ignored;
       socket_->cancel(ignored);

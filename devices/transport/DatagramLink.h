@@ -30,6 +30,8 @@ class DatagramLink {
   DatagramLink& operator=(const DatagramLink&) = delete;
 
   void send(const std::vector<uint8_t>& datagram);
+  // Drops the datagrams that have come and not been read (late answers to earlier ones).
+  void drain();
   // The next datagram from the peer, or nothing once `timeout` has passed.
   std::optional<std::vector<uint8_t>> receive(Millis timeout);
   // "192.168.1.100:50200"

@@ -366,9 +366,10 @@ TEST(RunCli, CutsASheetOnTheSimulatedRuidaAsItsRdFileSays) {
 // A controller that stops answering mid-job (switched off): exit status 3
 // within seconds, naming the controller, and saying the laser was not confirmed off.
 TEST(RunCli, ARuidaThatStopsAnsweringEndsTheRunWithStatus3) {
+  const auto job = ruidaJob();
   const auto start = std::chrono::steady_clock::now();
   const CommandResult r =
-      run(kCli + " run " + quoted(ruidaJob()) + " --sheet 1 --device 'sim:ruida?speed=50&fault=silence&after=12'");
+      run(kCli + " run " + quoted(job) + " --sheet 1 --device 'sim:ruida?speed=50&fault=silence&after=12'");
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(15));
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("the controller stopped answering"), std::string::npos) << r.err;

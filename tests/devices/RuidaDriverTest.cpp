@@ -53,21 +53,31 @@ jobs::Toolpath sheet() {
 
 ruida::RuidaTimeouts quick() {
   ruida::RuidaTimeouts t;
-  t.reply = 200ms;
-  t.sends = 5;
+  // Long enough not to send a packet again on a loaded machine (under the sanitizers).
+  t.reply = 1000ms;
+  t.sends = 4;
   t.poll = 20ms;
   t.stop = 2000ms;
   return t;
 }
 
+// For a controller that will not answer: the time a test waits for its
+// silence is short (nothing it cuts is compared).
+ruida::RuidaTimeouts impatient() {
+  ruida::RuidaTimeouts t = quick();
+  t.reply = 300ms;
+  t.stop = 1000ms;
+  return t;
+}
+
 struct Rig {
-  explicit Rig(sim::RuidaSimulatorOptions options)
+  explicit Rig(sim::RuidaSimulatorOptions options, ruida::RuidaTimeouts timeouts = quick())
       : simulator(std::move(options)),
         driver(
-            [port = simulator.port()] {
-              return ruida::udpChannel(DatagramLink::open("127.0.0.1", port, 0), ruida::kDefaultMagic, quick());
+            [port = simulator.port(), timeouts] {
+              return ruida::udpChannel(DatagramLink::open("127.0.0.1", port, 0), ruida::kDefaultMagic, timeouts);
             },
-            ruida::kDefaultMagic, {}, quick(), 1) {}
+            ruida::kDefaultMagic, {}, timeouts, 1) {}
   sim::RuidaSimulator simulator;
   ruida::RuidaDriver driver;
 };
@@ -128,7 +138,7 @@ TEST(Ruida, ASheetIsCutOverLoopbackUdpAsItsToolpathSays) {
 TEST(Ruida, ALostPacketIsSentAgain) {
   auto options = fast();
   options.fault = sim::RuidaFault::Drop;
-  options.after = 5;  // the job's first packet, after the connection's three reads and a status read
+  options.after = 7;  // the job's first packet: after the connection's three reads, the status and the head's x and y
   Rig rig(options);
   const jobs::Toolpath toolpath = sheet();
   rig.driver.run(toolpath, {}, core::Cancellation());
@@ -139,7 +149,7 @@ TEST(Ruida, ALostPacketIsSentAgain) {
 TEST(Ruida, APacketWhoseChecksumFailsIsRefusedAndSentAgain) {
   auto options = fast();
   options.fault = sim::RuidaFault::Corrupt;
-  options.after = 6;  // the job's second packet
+  options.after = 8;  // the job's second packet
   Rig rig(options);
   const jobs::Toolpath toolpath = sheet();
   rig.driver.run(toolpath, {}, core::Cancellation());
@@ -154,8 +164,8 @@ TEST(Ruida, AControllerThatStopsAnsweringIsATimeoutNotAHang) {
   auto options = fast();
   options.timeScale = 1;
   options.fault = sim::RuidaFault::Silence;
-  options.after = 8;
-  Rig rig(options);
+  options.after = 9;  // the job's third packet
+  Rig rig(options, impatient());
   const auto start = Clock::now();
   try {
     rig.driver.run(sheet(), {}, core::Cancellation());
@@ -239,6 +249,21 @@ TEST(Ruida, TheFrameTracesTheBoxWithoutLightingTheLaser) {
   EXPECT_NEAR(at.y, box[3], 0.001);
 }
 
+// A 634XG scrambles with 0x11: a driver left at 0x88 reads none of its
+// answers, and says which magic number they are in.
+TEST(Ruida, AControllerOfAnotherMagicNumberIsNamedWithIt) {
+  auto options = fast();
+  options.magic = 0x11;
+  Rig rig(options, impatient());
+  try {
+    rig.driver.connect();
+    FAIL() << "connected";
+  } catch (const DeviceFault& fault) {
+    EXPECT_EQ(fault.kind, FaultKind::Refused);
+    EXPECT_NE(std::string(fault.what()).find("add ?magic=0x11 to its URI"), std::string::npos) << fault.what();
+  }
+}
+
 TEST(Ruida, AStopIsConfirmedOnlyByAControllerThatAnswers) {
   Rig rig(fast());
   rig.driver.connect();
@@ -247,7 +272,7 @@ TEST(Ruida, AStopIsConfirmedOnlyByAControllerThatAnswers) {
   auto options = fast();
   options.fault = sim::RuidaFault::Silence;
   options.after = 4;
-  Rig silent(options);
+  Rig silent(options, impatient());
   silent.driver.connect();
   const auto start = Clock::now();
   EXPECT_FALSE(silent.driver.stopSafely());
@@ -296,7 +321,7 @@ TEST(Ruida, OverItsUsbPortTheStreamGoesSwizzledWithoutChecksums) {
   ::cfmakeraw(&raw);
   ::tcsetattr(slave, TCSANOW, &raw);
   const ruida::Swizzle swizzle;
-  auto channel = ruida::serialChannel(openSerialLink(port, 115200), ruida::kDefaultMagic, quick());
+  auto channel = ruida::serialChannel(openSerialLink(port, 115200), ruida::kDefaultMagic, impatient());
   const auto readWire = [&](size_t count) {
     ruida::Bytes got;
     const auto until = Clock::now() + 2s;
@@ -358,6 +383,9 @@ TEST(Ruida, UrisSayWhatIsWrong) {
   EXPECT_NE(message("ruida://1.2.3.4?magic=11").find("\"magic=11\": a Ruida URI takes"), std::string::npos);
   EXPECT_NE(message("ruida://1.2.3.4:99999").find("not a UDP port"), std::string::npos);
   EXPECT_NE(message("ruida+serial://ttyUSB0").find("absolute path"), std::string::npos);
+  EXPECT_NE(message("ruida://fe80::1").find("IPv4 only"), std::string::npos);
+  EXPECT_NE(message("ruida://[::1]:50200").find("IPv4 only"), std::string::npos);
+  EXPECT_EQ(message("ruida://192.168.1.100/"), "accepted");
   EXPECT_NE(message("sim:ruida?fault=alarm").find("drop, corrupt, silence"), std::string::npos);
 }
 
