@@ -12,7 +12,9 @@
 #include <chrono>
 
 #include "devices/grbl/GrblDriver.h"
+#include "devices/ruida/RuidaDriver.h"
 #include "devices/sim/GrblSimulator.h"
+#include "devices/sim/RuidaSimulator.h"
 
 namespace {
 
@@ -74,6 +76,52 @@ BENCHMARK(BM_GrblStreaming)
     ->UseManualTime()
     ->Iterations(2)
     ->Unit(benchmark::kSecond);
+
+// A sheet of N short strokes sent to the simulated Ruida over loopback UDP
+// (its machine far faster than real): the job's bytes, its packets (one in
+// flight, each acknowledged) and the time from the first packet to the
+// last acknowledgement.
+void BM_RuidaSending(benchmark::State& state) {
+  const jobs::Toolpath path = manyStrokes(static_cast<int>(state.range(0)));
+  size_t bytes = 0, packets = 0;
+  double seconds = 0;
+  for (auto _ : state) {
+    devices::sim::RuidaSimulatorOptions options;
+    options.timeScale = 1e5;
+    devices::sim::RuidaSimulator simulator(options);
+    devices::ruida::RuidaDriver driver(
+        [port = simulator.port()] {
+          return devices::ruida::udpChannel(devices::DatagramLink::open("127.0.0.1", port, 0),
+                                            devices::ruida::kDefaultMagic);
+        },
+        devices::ruida::kDefaultMagic, {});
+    driver.connect();
+    const size_t before = driver.packets();
+    std::chrono::steady_clock::time_point started, sent;
+    const auto progress = [&](const devices::Progress& p) {
+      if (started == std::chrono::steady_clock::time_point()) started = std::chrono::steady_clock::now();
+      if (p.bytesAcknowledged == p.bytesTotal && sent == std::chrono::steady_clock::time_point()) {
+        sent = std::chrono::steady_clock::now();
+        bytes = p.bytesTotal;
+        packets = driver.packets() - before;
+      }
+    };
+    driver.run(path, progress, rotafab::core::Cancellation());
+    const double elapsed = std::chrono::duration<double>(sent - started).count();
+    state.SetIterationTime(elapsed);
+    seconds = elapsed;
+  }
+  state.counters["bytes"] = static_cast<double>(bytes);
+  state.counters["packets"] = static_cast<double>(packets);
+  state.counters["bytes/s"] = static_cast<double>(bytes) / seconds;
+}
+BENCHMARK(BM_RuidaSending)
+    ->Arg(400)
+    ->Arg(4000)
+    ->ArgName("strokes")
+    ->UseManualTime()
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

@@ -45,6 +45,8 @@ class RuidaDriver : public Device {
   [[nodiscard]] std::string describeProgram(const std::vector<jobs::Toolpath>& toolpaths) const override;
 
   [[nodiscard]] size_t resends() const { return channel_ ? channel_->resends() : 0; }
+  // Packets sent (status reads included), since connected.
+  [[nodiscard]] size_t packets() const { return channel_ ? channel_->packets() : 0; }
 
  private:
   // Sends a job (frame or sheet) packet by packet, then reads the status
