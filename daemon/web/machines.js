@@ -24,6 +24,8 @@ export function renderDevices() {
       state.hosts.length ? element('p', { class: 'device-host' }, `on host ${device.host}`) : null,
       element('p', {}, `${device.machine || '?'} · ${device.material || ''} · ${device.uri}`),
       device.message ? element('p', { class: 'device-message' }, device.message) : null,
+      // What the controller said it is when the daemon checked it.
+      device.checked && !device.message ? element('p', { class: 'device-checked' }, device.checked) : null,
       device.job ? element('p', {}, `job ${device.job}` + (cutting ? `, sheet ${progress.sheet} of ${progress.sheets}` : '')) : null,
       waitingJob(device) ? element('p', { class: 'waiting' },
         `waiting for ${waitingJob(device).waiting_for || `sheet ${waitingJob(device).sheet + 1} to be loaded`}`) : null,

@@ -42,9 +42,10 @@ struct SimAddress : DeviceAddress {
 struct SimFaults {
   std::vector<std::string_view> kinds;
   std::string_view counted;
+  bool latency = false;  // whether it can be told to answer late
 };
-const SimFaults kGrblFaults{{"stall", "noise", "garbage", "alarm", "silence", "unplug"}, "LINES"};
-const SimFaults kRuidaFaults{{"drop", "corrupt", "silence"}, "PACKETS"};
+const SimFaults kGrblFaults{{"stall", "noise", "garbage", "alarm", "silence", "unplug"}, "LINES", true};
+const SimFaults kRuidaFaults{{"drop", "corrupt", "silence"}, "PACKETS", false};
 const SimFaults kNoFaults{};
 
 // sim:NAME[?speed=N][&fault=KIND[&after=COUNT]][&witness=FILE][&cuts=FILE][&latency=MS]
@@ -52,9 +53,13 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, const SimFaults& si
   auto parsed = std::make_unique<SimAddress>(uri);
   std::string query = splitQuery(uri).second;
   const bool faults = !simFaults.kinds.empty();
+  std::string kinds;
+  for (size_t k = 0; k < simFaults.kinds.size(); ++k) {
+    kinds += fmt::format("{}{}", k == 0 ? "" : k + 1 == simFaults.kinds.size() ? " or " : ", ", simFaults.kinds[k]);
+  }
   const std::string takes =
-      faults ? fmt::format("speed=N, fault=KIND ({}), after={}, witness=FILE, cuts=FILE and latency=MS",
-                           fmt::join(simFaults.kinds, ", "), simFaults.counted)
+      faults ? fmt::format("speed=N, fault=KIND ({}), after={}, witness=FILE{}", kinds, simFaults.counted,
+                           simFaults.latency ? ", cuts=FILE and latency=MS" : " and cuts=FILE")
              : "speed=N, a positive number";
   while (!query.empty()) {
     const size_t end = query.find('&');
@@ -76,7 +81,8 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, const SimFaults& si
       parsed->witness = value;
     } else if (faults && key == "cuts" && !value.empty()) {
       parsed->cutWitness = value;
-    } else if (faults && key == "latency" && wholeNumber<unsigned>(value) && *wholeNumber<unsigned>(value) <= 10000) {
+    } else if (simFaults.latency && key == "latency" && wholeNumber<unsigned>(value) &&
+               *wholeNumber<unsigned>(value) <= 10000) {
       parsed->latencyMs = static_cast<int>(*wholeNumber<unsigned>(value));
     } else {
       throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));
@@ -215,9 +221,7 @@ class SimRuidaEntry : public DriverEntry {
   [[nodiscard]] bool simulated() const override { return true; }
   [[nodiscard]] bool takes(std::string_view uri) const override { return isSim(uri, "ruida"); }
   [[nodiscard]] std::unique_ptr<DeviceAddress> parse(const std::string& uri) const override {
-    auto parsed = parseSim(uri, kRuidaFaults);
-    if (parsed->latencyMs > 0) throw uriError(uri, "latency=MS: sim:ruida answers at once");
-    return parsed;
+    return parseSim(uri, kRuidaFaults);
   }
   [[nodiscard]] std::unique_ptr<Device> open(const DeviceAddress& address, const DeviceSetup& setup) const override {
     const auto& sim = dynamic_cast<const SimAddress&>(address);

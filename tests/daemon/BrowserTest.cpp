@@ -321,18 +321,29 @@ std::vector<int> queueOrder(const Daemon& daemon) {
 
 TEST(Browser, TheQueueIsReorderedByDraggingItsRowsUpAndDown) {
   TempDir root;
-  // A cutter that is not plugged in: nothing starts while the rows are moved.
+  // A cutter that is not plugged in: nothing starts while the rows are moved;
+  // beside it a fab lab's CO2 laser on its (simulated) Ruida controller.
   Daemon daemon(root.path(),
-                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"grbl:///dev/rotafab-no-such-port\"}]\n");
+                "devices: [{name: laser1, machine: grbl-diode-400, uri: \"grbl:///dev/rotafab-no-such-port\"}, "
+                "{name: co2, machine: ruida-co2-60w, uri: \"sim:ruida\"}]\n");
   daemon.start();
   for (int n = 0; n < 3; ++n) {
-    ASSERT_EQ(
-        daemon.client("submit " + quoted(kSource / "examples/cube.obj") + " --structure band --evaluations 1").status,
-        0);
+    ASSERT_EQ(daemon
+                  .client("submit " + quoted(kSource / "examples/cube.obj") +
+                          " --structure band --evaluations 1 --device laser1")
+                  .status,
+              0);
   }
   testing::Browser browser;
   browser.navigate(loginLink(daemon));
   ASSERT_TRUE(browser.waitFor("document.querySelectorAll('#jobs-body tr').length === 3", 20s));
+  // The Ruida is shown as any cutter: idle, with what its controller said it is.
+  EXPECT_TRUE(
+      browser.waitFor("(d => d && d.textContent.includes('ruida-co2-60w') && "
+                      "d.textContent.includes('Ruida controller (card 0x65106510, bed 700 x 500 mm)'))("
+                      "document.querySelector('.device[data-device=\"co2\"][data-state=\"idle\"]'))",
+                      20s))
+      << browser.evaluate("document.querySelector('#devices') && document.querySelector('#devices').innerText").dump();
   // Each planned job's row says what it is cut with, and on what.
   EXPECT_TRUE(
       browser.waitFor("[...document.querySelectorAll('#jobs-body .cut-with')].map(e => e.textContent).join("

@@ -781,7 +781,9 @@ TEST(Daemon, AJobIsPlannedForAndCutOnASimulatedM2NanoAndASimulatedRuida) {
         id, [](const json& j) { return state(j) == "done" || state(j) == "failed"; }, 120);
     EXPECT_EQ(state(done), "done") << done.dump();
     int seen = 0;
-    for (const json& d : daemon.clientJson("devices --daemon")["devices"]) {
+    const json listed =
+        daemon.clientJson("devices --daemon");  // (a temporary's member would not outlive the loop's start)
+    for (const json& d : listed["devices"]) {
       if (d["name"] == device) {
         ++seen;
         EXPECT_NE(d.value("checked", "").find(identity), std::string::npos) << d.dump();

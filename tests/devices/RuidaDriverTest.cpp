@@ -386,7 +386,11 @@ TEST(Ruida, UrisSayWhatIsWrong) {
   EXPECT_NE(message("ruida://fe80::1").find("IPv4 only"), std::string::npos);
   EXPECT_NE(message("ruida://[::1]:50200").find("IPv4 only"), std::string::npos);
   EXPECT_EQ(message("ruida://192.168.1.100/"), "accepted");
-  EXPECT_NE(message("sim:ruida?fault=alarm").find("drop, corrupt, silence"), std::string::npos);
+  EXPECT_NE(message("sim:ruida?fault=alarm")
+                .find("fault=KIND (drop, corrupt or silence), after=PACKETS, witness=FILE "
+                      "and cuts=FILE"),
+            std::string::npos)
+      << message("sim:ruida?fault=alarm");
 }
 
 }  // namespace
