@@ -255,7 +255,9 @@ void addRunCommand(CLI::App& app, int& status) {
       "grbl+tcp://HOST:23, sim:grbl (a simulated GRBL; "
       "50 times faster than the machine by default; ?speed=1 for real time), m2nano://usb/1a86:5512 (a K40's M2 "
       "Nano board), "
-      "sim:m2nano (a simulated one), spool:DIR[?printer=NAME] (EPS for a print driver, sent to lp)");
+      "sim:m2nano (a simulated one), ruida://IP[?magic=0x11] (a CO2 laser's Ruida controller on the network), "
+      "ruida+serial:///dev/ttyUSB0 (on its USB port), sim:ruida (a simulated one), spool:DIR[?printer=NAME] (EPS "
+      "for a print driver, sent to lp)");
   run->add_option("--sheet", options->sheet, "Only this sheet (1-based)")->check(CLI::PositiveNumber);
   run->add_flag("--frame", options->frame,
                 "Trace each sheet's box with the laser off (or at the machine profile's frame_power), then ask \"cut "

@@ -42,8 +42,9 @@ inline std::pair<std::string, std::string> splitQuery(const std::string& rest) {
 
 // What is wrong with a device URI, with examples of good ones.
 inline std::invalid_argument uriError(const std::string& uri, const std::string& what) {
-  return std::invalid_argument(uri + ": " + what +
-                               " (e.g. grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://192.168.4.1:23, sim:grbl)");
+  return std::invalid_argument(
+      uri + ": " + what +
+      " (e.g. grbl:///dev/ttyUSB0?baud=115200, grbl+tcp://192.168.4.1:23, ruida://192.168.1.100, sim:grbl)");
 }
 
 }  // namespace rotafab::devices
