@@ -8,6 +8,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace rotafab::devices {
 
@@ -38,6 +39,24 @@ inline std::pair<std::string, std::string> splitQuery(const std::string& rest) {
   const auto query = rest.find('?');
   if (query == std::string::npos) return {rest, ""};
   return {rest.substr(0, query), rest.substr(query + 1)};
+}
+
+// One option of a URI's query: "speed=50" is key "speed", value "50".
+struct QueryOption {
+  std::string text, key, value;
+};
+// The options of "a=1&b=2", in order.
+inline std::vector<QueryOption> queryOptions(std::string query) {
+  std::vector<QueryOption> options;
+  while (!query.empty()) {
+    const size_t end = query.find('&');
+    std::string option = query.substr(0, end);
+    query = end == std::string::npos ? "" : query.substr(end + 1);
+    const size_t equals = option.find('=');
+    std::string key = option.substr(0, equals), value = equals == std::string::npos ? "" : option.substr(equals + 1);
+    options.push_back({std::move(option), std::move(key), std::move(value)});
+  }
+  return options;
 }
 
 // What is wrong with a device URI, with examples of good ones.

@@ -36,13 +36,7 @@ class M2NanoEntry : public DriverEntry {
       throw uriError(uri, "the M2 Nano is m2nano://usb/VENDOR:PRODUCT in hex, e.g. m2nano://usb/1a86:5512");
     }
     parsed->match.vendor = *vendor, parsed->match.product = *product;
-    while (!options.empty()) {
-      const auto amp = options.find('&');
-      const std::string option = options.substr(0, amp);
-      options = amp == std::string::npos ? "" : options.substr(amp + 1);
-      const auto equals = option.find('=');
-      const std::string key = option.substr(0, equals),
-                        value = equals == std::string::npos ? "" : option.substr(equals + 1);
+    for (const auto& [option, key, value] : queryOptions(options)) {
       const auto number = wholeNumber<int>(value);
       if ((key != "bus" && key != "address") || !number || *number <= 0) {
         throw uriError(

@@ -29,15 +29,9 @@ std::invalid_argument ruidaUriError(const std::string& uri, const std::string& w
 }
 
 // The options after '?': those both URIs take (magic) and the kind's own.
-void readOptions(const std::string& uri, std::string query, RuidaAddress& address) {
+void readOptions(const std::string& uri, const std::string& query, RuidaAddress& address) {
   const std::string takes = address.serial ? "baud=N and magic=0xNN" : "bind=PORT (0: any free port) and magic=0xNN";
-  while (!query.empty()) {
-    const size_t end = query.find('&');
-    const std::string option = query.substr(0, end);
-    query = end == std::string::npos ? "" : query.substr(end + 1);
-    const size_t equals = option.find('=');
-    const std::string key = option.substr(0, equals),
-                      value = equals == std::string::npos ? "" : option.substr(equals + 1);
+  for (const auto& [option, key, value] : queryOptions(query)) {
     if (key == "magic" && value.starts_with("0x") && wholeNumber<unsigned>(value.substr(2), 16) &&
         *wholeNumber<unsigned>(value.substr(2), 16) <= 0xFF) {
       address.magic = static_cast<uint8_t>(*wholeNumber<unsigned>(value.substr(2), 16));

@@ -61,13 +61,7 @@ std::unique_ptr<SimAddress> parseSim(const std::string& uri, const SimFaults& si
       faults ? fmt::format("speed=N, fault=KIND ({}), after={}, witness=FILE{}", kinds, simFaults.counted,
                            simFaults.latency ? ", cuts=FILE and latency=MS" : " and cuts=FILE")
              : "speed=N, a positive number";
-  while (!query.empty()) {
-    const size_t end = query.find('&');
-    const std::string option = query.substr(0, end);
-    query = end == std::string::npos ? "" : query.substr(end + 1);
-    const size_t equals = option.find('=');
-    const std::string key = option.substr(0, equals),
-                      value = equals == std::string::npos ? "" : option.substr(equals + 1);
+  for (const auto& [option, key, value] : queryOptions(query)) {
     if (key == "speed") {
       const auto speed = wholeNumber<double>(value);
       if (!speed || !(*speed > 0)) throw uriError(uri, fmt::format("\"{}\": the simulator takes {}", option, takes));

@@ -35,15 +35,7 @@ class AsioLink : public Link {
         return line;
       }
       const auto left = std::chrono::duration_cast<Millis>(deadline - std::chrono::steady_clock::now());
-      if (left.count() <= 0) return std::nullopt;
-      if (!stream_->is_open()) throw DeviceFault(FaultKind::Disconnected, name_ + ": the port is closed");
-      char buffer[512];
-      std::optional<boost::system::error_code> result;
-      size_t got = 0;
-      stream_->async_read_some(asio::buffer(buffer),
-                               [&](const boost::system::error_code& error, size_t n) { result = error, got = n; });
-      if (!runFor(*io_, result, left, nullptr)) return std::nullopt;
-      pending_.append(buffer, got);
+      if (left.count() <= 0 || !readMore(left)) return std::nullopt;
       if (pending_.size() > 1 << 16) {
         throw DeviceFault(FaultKind::Protocol, name_ + ": more than 64 KiB without a line ending");
       }
@@ -51,15 +43,8 @@ class AsioLink : public Link {
   }
 
   std::optional<std::string> readSome(Millis timeout) override {
-    if (!pending_.empty()) return std::exchange(pending_, {});
-    if (!stream_->is_open()) throw DeviceFault(FaultKind::Disconnected, name_ + ": the port is closed");
-    char buffer[512];
-    std::optional<boost::system::error_code> result;
-    size_t got = 0;
-    stream_->async_read_some(asio::buffer(buffer),
-                             [&](const boost::system::error_code& error, size_t n) { result = error, got = n; });
-    if (!runFor(*io_, result, timeout, nullptr)) return std::nullopt;
-    return std::string(buffer, got);
+    if (pending_.empty() && !readMore(timeout)) return std::nullopt;
+    return std::exchange(pending_, {});
   }
 
   void close() override {
@@ -70,6 +55,19 @@ class AsioLink : public Link {
   [[nodiscard]] std::string name() const override { return name_; }
 
  private:
+  // Appends what comes within `timeout` to pending_; false when nothing came.
+  bool readMore(Millis timeout) {
+    if (!stream_->is_open()) throw DeviceFault(FaultKind::Disconnected, name_ + ": the port is closed");
+    char buffer[512];
+    std::optional<boost::system::error_code> result;
+    size_t got = 0;
+    stream_->async_read_some(asio::buffer(buffer),
+                             [&](const boost::system::error_code& error, size_t n) { result = error, got = n; });
+    if (!runFor(*io_, result, timeout, nullptr)) return false;
+    pending_.append(buffer, got);
+    return true;
+  }
+
   // Runs `io` until the operation sets `result` or `timeout` passes. Returns
   // false on a read timeout (what = nullptr); throws on a write timeout or an error.
   bool runFor(asio::io_context& io, std::optional<boost::system::error_code>& result, Millis timeout,
