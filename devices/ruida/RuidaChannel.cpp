@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <optional>
 
@@ -18,6 +19,8 @@ Bytes memoryRead(uint16_t address) {
 std::optional<int64_t> memoryValue(const Bytes& reply, uint16_t address) {
   const Bytes want = {0xDA, 0x01, static_cast<uint8_t>(address >> 8), static_cast<uint8_t>(address & 0x7F)};
   if (reply.size() < 9 || !std::equal(want.begin(), want.end(), reply.begin())) return std::nullopt;
+  // Operand bytes are 7-bit: one with its top bit set is a reply cut short.
+  if (std::any_of(reply.begin() + 4, reply.begin() + 9, [](uint8_t b) { return b & 0x80; })) return std::nullopt;
   return readU35(reply.data() + 4);
 }
 
@@ -46,13 +49,16 @@ class UdpChannel : public RuidaChannel {
     const Bytes packet = udpPacket(swizzle_(commands));
     const uint8_t ack = swizzle_(kAck), nak = swizzle_(kNak), error = swizzle_(kError);
     int silent = 0, refused = 0;
-    std::optional<uint8_t> unread;  // a one-byte answer this magic does not read
+    // The first one-byte answer to each send that this magic does not
+    // read: the same each time, it is an ACK in the controller's own magic.
+    std::optional<uint8_t> foreign;
+    bool sameEachTime = true;
     // Late answers to earlier packets would be taken for this one's.
     link_->drain();
     for (;;) {
       link_->send(packet);
       ++packets_;
-      bool nakked = false;
+      bool nakked = false, answered = false;
       const auto until = Clock::now() + timeouts_.reply;
       for (;;) {
         const auto left = std::chrono::duration_cast<Millis>(until - Clock::now());
@@ -74,8 +80,12 @@ class UdpChannel : public RuidaChannel {
             nakked = true;
             break;
           }
-          if (answer != swizzle_(kEnquire)) unread = answer;
-          continue;  // a keep-alive (ENQ), or an answer in another magic
+          if (!answered && answer != swizzle_(kEnquire)) {
+            sameEachTime = sameEachTime && (!foreign || *foreign == answer);
+            foreign = answer;
+          }
+          answered = true;
+          continue;  // a keep-alive (ENQ), a late answer to an earlier packet, or one in another magic
         }
         if (address) {
           if (const auto value = memoryValue(swizzle_.undo(*reply), *address)) return value;
@@ -83,14 +93,14 @@ class UdpChannel : public RuidaChannel {
       }
       // No answer in time (the packet or its answer lost): send it again, a bounded number of times.
       if (!nakked && ++silent >= timeouts_.sends) {
-        if (unread) {
-          // Each byte is an ACK in exactly one magic: (byte - 1) XOR the ACK with its bits 7 and 0 swapped.
+        if (foreign && sameEachTime) {
+          // (byte - 1) XOR the ACK with its bits 7 and 0 swapped: the magic in which `byte` is an ACK.
           const auto swappedAck = static_cast<uint8_t>(Swizzle(0)(kAck) - 1);
-          const auto magic = static_cast<uint8_t>(static_cast<uint8_t>(*unread - 1) ^ swappedAck);
+          const auto magic = static_cast<uint8_t>(static_cast<uint8_t>(*foreign - 1) ^ swappedAck);
           throw DeviceFault(FaultKind::Refused,
-                            fmt::format("{}: the controller answers in another magic number than 0x{:02X} (0x{:02X} "
-                                        "is an ACK in 0x{:02X}): add ?magic=0x{:02X} to its URI",
-                                        name(), swizzle_.magic(), *unread, magic, magic));
+                            fmt::format("{}: the controller answers each packet with 0x{:02X}, which is no answer in "
+                                        "magic number 0x{:02X} but an ACK in 0x{:02X}: add ?magic=0x{:02X} to its URI",
+                                        name(), *foreign, swizzle_.magic(), magic, magic));
         }
         throw DeviceFault(FaultKind::Timeout,
                           fmt::format("{}: the controller stopped answering: no answer to {} in {} sends of {} ms "

@@ -53,11 +53,17 @@ void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, bool mustRu
   }
   holdWanted_ = false;
   bool held = false;
-  const auto headAt = [&] { return std::pair{channel_->read(kMemoryX), channel_->read(kMemoryY)}; };
-  const auto startedAt = headAt();
   const auto cancelled = [&] {
     if (cancel.cancelled()) throw DeviceFault(FaultKind::Cancelled, where() + ": cancelled");
   };
+  const auto headAt = [&] { return std::pair{channel_->read(kMemoryX), channel_->read(kMemoryY)}; };
+  // Where the head stands before the job (a jog from the panel let finish first, for a few seconds).
+  for (const auto until = Clock::now() + Millis(5000);
+       (channel_->read(kMemoryStatus) & kStatusMoving) && Clock::now() < until;) {
+    cancelled();
+    std::this_thread::sleep_for(timeouts_.poll);
+  }
+  const auto startedAt = headAt();
   size_t bytes = 0;
   for (const Bytes& packet : packetsOf(stream, channel_->maxPacket())) {
     cancelled();
@@ -66,28 +72,34 @@ void RuidaDriver::runJob(const Bytes& stream, double machineSeconds, bool mustRu
     bytes += packet.size();
     if (sent) sent(bytes, Millis(0));
   }
-  // The controller has the whole job; it has run it when it reports no job
-  // running, having reported one or moved the head (a job too short to be
-  // seen running). One that does neither within its estimated time and a
-  // few seconds has not run it.
-  const double expected = std::isfinite(machineSeconds) ? std::max(machineSeconds, 0.0) / timeScale_ : 0;
+  // The controller has the whole job; it has run it once it has been seen
+  // at it (a job running, the head moving, or the head moved: a job too
+  // short to be caught running) and is now at rest: no job, the head
+  // still, in the same place at two reads in a row. One not seen at it
+  // within its estimated time and a few seconds has not been seen to run.
+  const double expected =
+      std::isfinite(machineSeconds) ? std::clamp(machineSeconds / timeScale_, 0.0, 1e6) : 0;  // seconds
   const auto limit = Millis(60000 + static_cast<long>(3 * expected * 1000));
   const auto grace = Millis(3000 + static_cast<long>(expected * 1000));
   Millis running(0);  // since the last packet, not held
-  for (bool seenRunning = false;;) {
+  auto lastAt = startedAt;
+  for (bool seen = false;;) {
     cancelled();
     followHold(held);
     const auto before = Clock::now();
-    const bool runs = channel_->read(kMemoryStatus) & kStatusJobRuns;
+    const int64_t word = channel_->read(kMemoryStatus);
+    const bool runs = word & kStatusJobRuns, moving = word & kStatusMoving;
+    const auto at = headAt();
     if (sent) sent(bytes, running);
-    seenRunning = seenRunning || runs;
-    if (!runs && !held && (seenRunning || headAt() != startedAt)) return;
-    if (!runs && !held && running > grace) {
+    seen = seen || runs || moving || at != startedAt;
+    if (seen && !runs && !moving && !held && at == lastAt) return;
+    lastAt = at;
+    if (!seen && !held && running > grace) {
       if (!mustRun) return;  // a frame: nothing of it lights the laser
       throw DeviceFault(FaultKind::Refused, where() +
-                                                ": the controller took the job but has not run it (no job "
-                                                "running, the head where it was): is it set to keep jobs in "
-                                                "its memory rather than run them?");
+                                                ": the controller took the sheet but was not seen to run it (no "
+                                                "job running, the head where it was): look at the machine before "
+                                                "sending it again (is it set to keep jobs in its memory?)");
     }
     if (!held && running > limit) {
       throw DeviceFault(

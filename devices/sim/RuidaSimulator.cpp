@@ -215,7 +215,8 @@ void RuidaSimulator::setLaser(bool lit) {
 int64_t RuidaSimulator::memory(uint16_t address) const {
   switch (address) {
     case ruida::kMemoryStatus:
-      return (jobStarted_ ? ruida::kStatusJobRuns : 0) | (next_ < queue_.size() && !paused_ ? ruida::kStatusMoving : 0);
+      return (jobStarted_ && options_.reportsJobs ? ruida::kStatusJobRuns : 0) |
+             (next_ < queue_.size() && !paused_ ? ruida::kStatusMoving : 0);
     case ruida::kMemoryX:
       return std::lround(x_);
     case ruida::kMemoryY:

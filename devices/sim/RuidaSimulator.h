@@ -36,6 +36,8 @@ struct RuidaSimulatorOptions {
   // (no answer) or corrupted once, or from it on no answer at all (and the
   // job halted, the laser off, as a controller switched off).
   RuidaFault fault = RuidaFault::None;
+  // Whether its status says a job runs (bit 0); off: only the moving head says it.
+  bool reportsJobs = true;
   size_t after = 5;
   std::function<void(bool lit)> laserChanged;
   // Each cut finished: x0, y0, x1, y1 in mm from the machine's origin (top-left, y down).

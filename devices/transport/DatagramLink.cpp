@@ -4,12 +4,50 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
 
 namespace rotafab::devices {
 namespace {
 
 namespace asio = boost::asio;
 using asio::ip::udp;
+
+// The IPv4 address of `host`: an address as it is, a name looked up within
+// 5 s. (getaddrinfo cannot be interrupted: a lookup that takes longer, with
+// a dead DNS server, is left to end on a thread of its own.)
+asio::ip::address_v4 lookUp(const std::string& host, const std::string& name) {
+  boost::system::error_code error;
+  const auto address = asio::ip::make_address_v4(host, error);
+  if (!error) return address;
+  struct Lookup {
+    std::mutex mutex;
+    std::condition_variable done;
+    bool finished = false;
+    std::optional<asio::ip::address_v4> address;
+    std::string error;
+  };
+  auto lookup = std::make_shared<Lookup>();
+  std::thread([lookup, host] {
+    asio::io_context io;
+    udp::resolver resolver(io);
+    boost::system::error_code failed;
+    const auto found = resolver.resolve(udp::v4(), host, "", failed);
+    std::lock_guard lock(lookup->mutex);
+    if (!failed && !found.empty()) lookup->address = found.begin()->endpoint().address().to_v4();
+    lookup->error = failed ? failed.message() : std::string("no IPv4 address");
+    lookup->finished = true;
+    lookup->done.notify_all();
+  }).detach();
+  std::unique_lock lock(lookup->mutex);
+  if (!lookup->done.wait_for(lock, std::chrono::seconds(5), [&] { return lookup->finished; })) {
+    throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the name did not resolve within 5 s", name));
+  }
+  if (!lookup->address)
+    throw DeviceFault(FaultKind::Disconnected, fmt::format("{}: cannot resolve it: {}", name, lookup->error));
+  return *lookup->address;
+}
 
 }  // namespace
 
@@ -18,28 +56,7 @@ std::unique_ptr<DatagramLink> DatagramLink::open(const std::string& host, uint16
   link->name_ = fmt::format("{}:{}", host, port);
   link->io_ = std::make_unique<asio::io_context>();
   boost::system::error_code error;
-  // A name looked up within a bound (a dead DNS server or mDNS can take long).
-  udp::resolver resolver(*link->io_);
-  std::optional<boost::system::error_code> resolved;
-  udp::resolver::results_type found;
-  resolver.async_resolve(udp::v4(), host, std::to_string(port),
-                         [&](const boost::system::error_code& e, udp::resolver::results_type results) {
-                           resolved = e, found = std::move(results);
-                         });
-  link->io_->run_for(std::chrono::seconds(5));
-  if (!resolved) {
-    resolver.cancel();
-    link->io_->restart();
-    link->io_->run();
-    throw DeviceFault(FaultKind::Timeout, fmt::format("{}: the name did not resolve within 5 s", link->name_));
-  }
-  link->io_->restart();
-  if (*resolved || found.empty()) {
-    throw DeviceFault(FaultKind::Disconnected,
-                      fmt::format("{}: cannot resolve it: {}", link->name_,
-                                  *resolved ? resolved->message() : std::string("no IPv4 address")));
-  }
-  link->peer_ = found.begin()->endpoint();
+  link->peer_ = udp::endpoint(lookUp(host, link->name_), port);
   link->socket_ = std::make_unique<udp::socket>(*link->io_);
   link->socket_->open(udp::v4(), error);
   if (!error) link->socket_->bind(udp::endpoint(udp::v4(), localPort), error);
@@ -66,7 +83,7 @@ uint16_t DatagramLink::localPort() const {
 void DatagramLink::drain() {
   boost::system::error_code error;
   std::vector<uint8_t> buffer(65536);
-  while (socket_->available(error) > 0 && !error) {
+  for (int dropped = 0; dropped < 64 && socket_->available(error) > 0 && !error; ++dropped) {
     udp::endpoint from;
     socket_->receive_from(asio::buffer(buffer), from, 0, error);
   }

@@ -367,14 +367,21 @@ TEST(RunCli, CutsASheetOnTheSimulatedRuidaAsItsRdFileSays) {
 // within seconds, naming the controller, and saying the laser was not confirmed off.
 TEST(RunCli, ARuidaThatStopsAnsweringEndsTheRunWithStatus3) {
   const auto job = ruidaJob();
+  TempDir dir;
+  const auto laser = dir.path() / "laser";
   const auto start = std::chrono::steady_clock::now();
   const CommandResult r =
-      run(kCli + " run " + quoted(job) + " --sheet 1 --device 'sim:ruida?speed=50&fault=silence&after=12'");
+      run(kCli + " run " + quoted(job) +
+          " --sheet 1 --device 'sim:ruida?speed=50&fault=silence&after=24&witness=" + laser.string() + "'");
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(15));
   EXPECT_EQ(r.status, 3) << r.err;
   EXPECT_NE(r.err.find("the controller stopped answering"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("the controller did not confirm the laser off: switch it off at the machine"), std::string::npos)
       << r.err;
+  // It had lit the laser, and switched off, the laser went off with it.
+  const std::string changes = readFile(laser);
+  EXPECT_NE(changes.find("on\n"), std::string::npos) << changes;
+  EXPECT_TRUE(changes.ends_with("off\n")) << changes;
 }
 
 TEST(RunCli, ErrorsAreOneLineWithTheirStatus) {

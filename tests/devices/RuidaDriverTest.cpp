@@ -232,6 +232,21 @@ TEST(Ruida, APauseHoldsWithTheLaserOffAndAResumeFinishesTheSheet) {
   expectCutAsAsked(rig.simulator, toolpath);
 }
 
+// A controller whose status never says a job runs: the sheet is done once
+// the head has moved and come to rest, not before (nothing cut twice, no
+// sheet loaded onto one still being cut).
+TEST(Ruida, AControllerThatNeverSaysAJobRunsIsFollowedByItsHead) {
+  auto options = fast();
+  options.reportsJobs = false;
+  Rig rig(options);
+  const jobs::Toolpath toolpath = sheet();
+  rig.driver.run(toolpath, {}, core::Cancellation());
+  expectCutAsAsked(rig.simulator, toolpath);  // all of it, by the time run() returned
+  rig.driver.frame(toolpath, core::Cancellation());
+  rig.driver.frame(toolpath, core::Cancellation());  // from where the last one ended
+  EXPECT_EQ(rig.simulator.cuts().size(), wanted(toolpath).size());
+}
+
 TEST(Ruida, TheFrameTracesTheBoxWithoutLightingTheLaser) {
   auto options = fast();
   std::atomic<int> lit{0};
