@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes the mesh importer (and everything a usable mesh goes through) with
-# libFuzzer for SECONDS (default 60), then the daemon's edge (the HTTP
+# libFuzzer for SECONDS (default 60), and beside it the daemon's edge (the HTTP
 # request's header, the gate, a JSON or multipart body) for HTTP_SECONDS
 # (default 30). Builds build-fuzz/ with clang first.
 # A crash, a sanitizer report, a leak in our code or a 10 s hang fails the run
@@ -48,7 +48,10 @@ fuzz() {
   fi
   echo "fuzz: $target: no crash, leak or hang in ${time} s"
 }
-fuzz fuzz_mesh_import "$seconds" "$corpus" -max_len=65536
+# The two fuzzers run side by side, each on a core of its own (libFuzzer
+# runs one thread): each gets its whole time, and CI waits for the longer.
+fuzz fuzz_mesh_import "$seconds" "$corpus" -max_len=65536 &
+mesh_fuzzer=$!
 
 # The daemon's edge: requests as they arrive (the first byte picks the
 # listener and the size of the body's pieces).
@@ -60,4 +63,9 @@ request events '\x01GET /api/events?session=abc HTTP/1.1\r\nHost: localhost\r\n\
 request action '\x05POST /api/jobs/1/move HTTP/1.1\r\nHost: [::1]:8730\r\nAuthorization: Bearer fuzz-token\r\nOrigin: http://[::1]:8730\r\nContent-Type: application/json\r\nContent-Length: 28\r\n\r\n{"before": 2, "priority": 3}'
 request form '\x00POST /api/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: multipart/form-data; boundary=b\r\nContent-Length: 120\r\n\r\n--b\r\nContent-Disposition: form-data; name="file"; filename="a.obj"\r\n\r\nv 0 0 0\r\n--b\r\nContent-Disposition: form-data; name="options"\r\n\r\n[]\r\n--b--\r\n'
 request chunked '\x02POST /api/jobs/2/resume HTTP/1.1\r\nHost: example\r\nTransfer-Encoding: chunked\r\nContent-Type: application/json\r\n\r\n5\r\n{"a":\r\n0\r\n\r\n'
-fuzz fuzz_http_request "$http_seconds" "$requests" -max_len=16384
+fuzz fuzz_http_request "$http_seconds" "$requests" -max_len=16384 &
+http_fuzzer=$!
+status=0
+wait "$mesh_fuzzer" || status=1
+wait "$http_fuzzer" || status=1
+exit "$status"
