@@ -106,23 +106,8 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   const std::string name = request.mesh.string();
   PlannedJob job;
   job.title = fmt::format("{} ({})", request.mesh.stem().string(), geometry::structureName(request.structure));
-  geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
-  job.seconds.import = lap();
-  context.check();
-
   Sizing sizing;
-  if (request.structure == geometry::StructureKind::Weave) {
-    job.structure = builtWeave(request, mesh, sizing, context);
-  } else {
-    const double side = geometry::boundingBoxSize(mesh).maxCoeff();
-    try {
-      job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
-    } catch (const making::StructureRefused& refused) {
-      // A refusal offers a way out that was built, never a guess.
-      if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
-      throw core::UserError(making::withTriedWayOut(request, refused, side, job.mesh.faces, context));
-    }
-  }
+  geometry::PolygonMesh mesh = making::builtAsAsked(request, job, sizing, context);
   for (const auto& note : job.structure.notes) context.note(fmt::format("{}: {}", name, note));
   for (const auto& warning : job.structure.warnings) {
     context.warn(fmt::format("{}: {}", name, warning));
@@ -130,7 +115,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   }
   job.stability = geometry::structureStability(job.structure, stabilityOptions(request));
   job.size = builtSize(job.structure);
-  job.seconds.geometry = lap();
+  job.seconds.geometry = lap() - job.seconds.import;
 
   PlanOptions plan;
   plan.kerf = request.kerf.value_or(request.material.kerf);

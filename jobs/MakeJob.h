@@ -49,6 +49,9 @@ struct MakeRequest {
   std::optional<double> mergeCoplanar;
   // Remesh to even triangles that give about this many panels (geometry/Remeshing.h).
   std::optional<int> panels;
+  // The faces the remesh aims at, when not `panels`' own: make's second
+  // remesh, aiming off by what the mends of narrow bands took (MakeJob.cpp).
+  std::optional<int> remeshFaces;
   // --repair auto (docs/CONTRACT.md, "Command line"; geometry/MeshRepair.h);
   // false: none, a broken mesh is refused.
   bool repair = true;

@@ -54,6 +54,16 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
 
+// The mesh imported and its structure built, as make builds it (the import
+// and geometry phases; `job`'s mesh counts, structure and import seconds
+// filled in): a band structure built for --panels N whose panels are more
+// than 5% more or fewer than N (its mends collapse faces, creases hold the
+// remesh off its target) is remeshed once more, aiming off by that share.
+// A refusal is a UserError naming a way out that was built (request.adviseWayOut).
+// Returns the mesh as built.
+geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                   const core::WorkContext& context);
+
 // builtStructure()'s refusal: the mesh and the place (`place`: "the edge
 // between vertices 14 and 12: its band ... has no room ..."), and the way out
 // it offers, which `tried` says was built (a size, a fastener) or only

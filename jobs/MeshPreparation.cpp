@@ -55,7 +55,8 @@ PanelCount remeshedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
   PanelCount count;
   count.asked = *request.panels;
   const bool woven = request.structure == geometry::StructureKind::Weave;
-  const int faces = woven ? std::max(1, static_cast<int>(std::lround(count.asked * 2.0 / 3.0))) : count.asked;
+  const int faces = request.remeshFaces.value_or(
+      woven ? std::max(1, static_cast<int>(std::lround(count.asked * 2.0 / 3.0))) : count.asked);
   try {
     count.remeshing = geometry::remeshEvenly(mesh, faces, context);
   } catch (const geometry::InvalidMeshError& error) {

@@ -342,6 +342,69 @@ class MendingBuild {
   int rounds_ = 0;
 };
 
+// The panels of a band structure built for --panels N may differ from N by
+// this share at most: the mends of narrow bands collapse faces, and a panel
+// that would overlap itself is split in two.
+constexpr double kPanelCountTolerance = 0.05;
+
+// The mesh imported and its structure built (the import and geometry phases).
+geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                       const core::WorkContext& context) {
+  const auto began = std::chrono::steady_clock::now();
+  geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
+  job.seconds.import = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  context.check();
+  if (request.structure == geometry::StructureKind::Weave) {
+    job.structure = builtWeave(request, mesh, sizing, context);
+    return mesh;
+  }
+  const double side = geometry::boundingBoxSize(mesh).maxCoeff();
+  try {
+    job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
+  } catch (const StructureRefused& refused) {
+    // A refusal offers a way out that was built, never a guess.
+    if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
+    throw core::UserError(withTriedWayOut(request, refused, side, job.mesh.faces, context));
+  }
+  return mesh;
+}
+
+// A band structure built for --panels N with more than kPanelCountTolerance
+// more or fewer panels than N (mends collapse faces, a remesh held by creases
+// misses its target): remeshed once more, aiming off by the share it missed,
+// and built again; that second build is kept where it comes nearer the
+// count asked, else the first.
+geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                             geometry::PolygonMesh mesh, const core::WorkContext& context) {
+  const auto& count = job.mesh.panelCount;
+  if (request.structure != geometry::StructureKind::Band || !request.panels || request.remeshFaces || !count ||
+      !count->remeshing.remeshed) {
+    return mesh;
+  }
+  const int asked = *request.panels;
+  const auto built = static_cast<int>(job.structure.panels.size());
+  if (built <= 0 || std::abs(built - asked) <= kPanelCountTolerance * asked) return mesh;
+  MakeRequest again = request;
+  // (The remesher's own count is near the target, not on it, where creases hold vertices.)
+  again.remeshFaces = static_cast<int>(std::lround(static_cast<double>(asked) * asked / built));
+  again.adviseWayOut = false;
+  context.note(fmt::format("{}: {} panels as built, not the {} asked: remeshed again, to {} faces",
+                           request.mesh.string(), built, asked, *again.remeshFaces));
+  PlannedJob second;
+  Sizing secondSizing;
+  try {
+    geometry::PolygonMesh secondMesh = importedAndBuilt(again, second, secondSizing, context);
+    const auto secondBuilt = static_cast<int>(second.structure.panels.size());
+    if (std::abs(secondBuilt - asked) >= std::abs(built - asked)) return mesh;
+    job.mesh = std::move(second.mesh);
+    job.structure = std::move(second.structure);
+    sizing = secondSizing;
+    return secondMesh;
+  } catch (const core::UserError&) {
+    return mesh;  // (the first build stands, its count said)
+  }
+}
+
 }  // namespace
 
 geometry::Point3 builtSize(const geometry::Structure& structure) {
@@ -479,6 +542,11 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
   } catch (const geometry::InvalidMeshError& error) {
     throw StructureRefused(request.mesh.string(), error.what(), "", false, false);
   }
+}
+
+geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                   const core::WorkContext& context) {
+  return withThePanelCountAsked(request, job, sizing, importedAndBuilt(request, job, sizing, context), context);
 }
 
 }  // namespace rotafab::jobs::making

@@ -90,13 +90,12 @@ enum class Tried { Builds, OffTheBed, Refused };
 // fastened, every label etched and every panel fits the bed.
 Tried tryBuilding(const MakeRequest& request, const core::WorkContext& quiet, size_t& panels) {
   try {
-    BuiltMesh counts;
-    geometry::PolygonMesh mesh = importedMesh(request, counts, quiet);
+    PlannedJob job;
     Sizing sizing;
-    const geometry::Structure structure = builtStructure(request, mesh, counts, sizing, quiet);
+    builtAsAsked(request, job, sizing, quiet);
     const double kerf = request.kerf.value_or(request.material.kerf);
-    if (roomOnTheBed(structureParts(structure), request.machine, kerf) < 1) return Tried::OffTheBed;
-    panels = structure.panels.size();
+    if (roomOnTheBed(structureParts(job.structure), request.machine, kerf) < 1) return Tried::OffTheBed;
+    panels = job.structure.panels.size();
     return Tried::Builds;
   } catch (const core::Cancelled&) {
     throw;

@@ -17,7 +17,7 @@
 
 namespace rotafab::service {
 
-class UploadForm : private MultipartReader::Parts {
+class UploadForm final : private MultipartReader::Parts {
  public:
   static constexpr size_t kLongestField = 64 * 1024;
 

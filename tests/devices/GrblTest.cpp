@@ -413,7 +413,10 @@ TEST(Grbl, FrameAtTheProfilesMarkingPowerLightsOnlyTheTrace) {
 // with the laser off and confirmed (GRBL's hold, reset and M5).
 TEST(Grbl, ALitFrameStopsAtOnceOnACancelWithTheLaserOff) {
   Rig rig(1);
-  auto& [simulator, driver, path] = rig;
+  // (Not a structured binding: the lambdas below capture them.)
+  sim::GrblSimulator& simulator = rig.simulator;
+  std::unique_ptr<grbl::GrblDriver>& driver = rig.driver;
+  jobs::Toolpath& path = rig.path;
   path.framePower = 1;
   core::Cancellation cancel;
   std::thread canceller([&] {
@@ -438,7 +441,10 @@ TEST(Grbl, ALitFrameStopsAtOnceOnACancelWithTheLaserOff) {
 // resume lets the job run to its end.
 TEST(Grbl, PauseHoldsAndResumeFinishes) {
   Rig rig(40);
-  auto& [simulator, driver, path] = rig;
+  // (Not a structured binding: the lambdas below capture them.)
+  sim::GrblSimulator& simulator = rig.simulator;
+  std::unique_ptr<grbl::GrblDriver>& driver = rig.driver;
+  jobs::Toolpath& path = rig.path;
   core::Cancellation cancel;
   std::exception_ptr failed;
   std::thread job([&] {

@@ -209,7 +209,7 @@ TEST(BandDecomposition, NoBandIsFlippedAtSaddles) {
       saddleBands += atSaddle;
       const Point3& nA = s.decomposition.vertexBands[band.faceA].normal;
       const Point3& nB = s.decomposition.vertexBands[band.faceB].normal;
-      const auto where = [&] {
+      const auto where = [&, &name = name] {
         return fmt::format("{}: band of edge {}{} between faces {} and {}", name, e, atSaddle ? " at a saddle" : "",
                            band.faceA, band.faceB);
       };
