@@ -70,6 +70,37 @@ class Collapser {
     return best;
   }
 
+  // The edges that may give the narrow band of (u, v) its room when they
+  // go, nearest first: its own, every side of the faces beside it, then
+  // every edge at u or v (where a thin tube's ring or a flap's rim keeps
+  // the nearer ones by the link condition); each no longer than `longest`,
+  // so that a collapse moves the surface by half of that at most. Shortest
+  // first within each.
+  [[nodiscard]] std::vector<std::array<int, 2>> collapseCandidates(int u, int v, double longest) const {
+    std::vector<std::array<int, 2>> sides, ring;
+    std::set<std::pair<int, int>> seen{key(u, v)};  // (its own edge, tried first)
+    const auto add = [&](std::vector<std::array<int, 2>>& to, int a, int b) {
+      if (length(a, b) <= longest && seen.insert(key(a, b)).second) to.push_back({a, b});
+    };
+    for (int f : facesOn(u, v)) {
+      const auto& face = mesh_.faces[f];
+      for (size_t i = 0; i < face.size(); ++i) add(sides, face[i], face[(i + 1) % face.size()]);
+    }
+    for (int end : {u, v}) {
+      for (int w : neighbours(end)) add(ring, end, w);
+    }
+    const auto shortestFirst = [&](std::vector<std::array<int, 2>>& edges) {
+      std::stable_sort(edges.begin(), edges.end(),
+                       [&](const auto& p, const auto& q) { return length(p[0], p[1]) < length(q[0], q[1]); });
+    };
+    shortestFirst(sides);
+    shortestFirst(ring);
+    std::vector<std::array<int, 2>> all;
+    all.insert(all.end(), sides.begin(), sides.end());
+    all.insert(all.end(), ring.begin(), ring.end());
+    return all;
+  }
+
   // The shortest side of face f.
   [[nodiscard]] std::array<int, 2> shortestSide(int f) const {
     const auto& face = mesh_.faces[f];
@@ -453,15 +484,17 @@ Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>&
   MeshRepair& repair = mends.collapsed;
   MeshRepair& merged = mends.merged;
   Collapser collapser(mesh);
-  for (const auto& [u, v] : places) {
-    if (u < 0 || v < 0 || u >= mesh.vertexCount() || v >= mesh.vertexCount()) continue;
-    std::vector<std::array<int, 2>> candidates{{u, v}};
-    for (int f : collapser.facesOn(u, v)) candidates.push_back(collapser.shortestSide(f));
-    std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& p, const auto& q) {
-      return collapser.length(p[0], p[1]) < collapser.length(q[0], q[1]);
-    });
-    bool mended = false;
-    for (const auto& [a, b] : candidates) {
+  double sides = 0, sideCount = 0;
+  for (const auto& face : mesh.faces) {
+    for (size_t i = 0; i < face.size(); ++i) {
+      sides += (mesh.positions[face[i]] - mesh.positions[face[(i + 1) % face.size()]]).norm();
+      ++sideCount;
+    }
+  }
+  const double meanEdge = sideCount > 0 ? sides / sideCount : 0;
+  // Collapses the first of `edges` that may go; says whether one did.
+  const auto collapsedOne = [&](const std::vector<std::array<int, 2>>& edges) {
+    for (const auto& [a, b] : edges) {
       const std::optional<Point3> target = collapser.collapsePoint(a, b);
       if (!target) continue;
       if (repair.count == 0) {
@@ -469,16 +502,30 @@ Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>&
       }
       repair.moved = std::max(repair.moved, collapser.collapse(a, b, *target));
       ++repair.count;
-      mended = true;
-      break;
+      return true;
     }
+    return false;
+  };
+  for (const auto& [u, v] : places) {
+    if (u < 0 || v < 0 || u >= mesh.vertexCount() || v >= mesh.vertexCount()) continue;
+    // The shortest that may go of the band's own edge and the shortest side of each face beside it.
+    std::vector<std::array<int, 2>> candidates{{u, v}};
+    for (int f : collapser.facesOn(u, v)) candidates.push_back(collapser.shortestSide(f));
+    std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& p, const auto& q) {
+      return collapser.length(p[0], p[1]) < collapser.length(q[0], q[1]);
+    });
+    bool mended = collapsedOne(candidates);
     if (!mended) mended = flippedNear(collapser, mesh, u, v, mends.flipped);
     if (!mended && merges && collapser.mayMerge(u, v)) {
       if (merged.count == 0)
         merged.first = fmt::format("edge ({}, {})", mesh.sourceVertexIndex(u), mesh.sourceVertexIndex(v));
       collapser.merge(u, v);
       ++merged.count;
+      mended = true;
     }
+    // Last, any edge about the band that may go (a thin tube's ring, a
+    // flap's rim), no longer than the mesh's mean edge.
+    if (!mended) collapsedOne(collapser.collapseCandidates(u, v, meanEdge));
   }
   if (mends.count() > 0) collapser.compact();
   return mends;

@@ -39,6 +39,12 @@ struct Mends {
   void add(const Mends& later);
 };
 
+// Whether `repair` is one of the mends above (a repair of the design, not of a broken mesh).
+inline bool isMend(const MeshRepair& repair) {
+  return repair.kind == "collapse-short-edge" || repair.kind == "flip-narrow-band" ||
+         repair.kind == "merge-narrow-band";
+}
+
 // `--repair auto`'s last repair: each face of zero area (its corners
 // collinear, as CAD programs' STL files have them) collapsed away, the
 // nearer end of its shortest side that may go into the other (so no vertex
@@ -54,8 +60,11 @@ MeshRepair collapseDegenerateFaces(PolygonMesh& mesh);
 // Delaunay triangulation, keeping the vertices where they are); where none
 // widens them (and `merges`), the two faces beside it become one, if they
 // turn from each other by less than 30 degrees (its band is gone: the panel
-// bends there instead). An edge whose vertex an earlier mend of this call
-// moved waits for the next call. Faces left with fewer than three corners
+// bends there instead); where none may, the shortest edge that may go of
+// the faces beside it, then of the edges at its ends (a thin tube's ring or
+// a flap's rim, where the link condition or a face turned over keeps the
+// nearer ones), none longer than the mesh's mean edge. An edge whose
+// vertex an earlier mend of this call moved waits for the next call. Faces left with fewer than three corners
 // go, and vertices no face uses. Returns the mends (count 0: none could be
 // made), each "first" naming the first edge by its vertices in the file's
 // numbering.

@@ -54,10 +54,15 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
 
+// The panels of a band structure built for --panels N may differ from N by
+// this share at most: the mends of narrow bands collapse faces, and a panel
+// that would overlap itself is split in two.
+inline constexpr double kPanelCountTolerance = 0.05;
+
 // The mesh imported and its structure built, as make builds it (the import
 // and geometry phases; `job`'s mesh counts, structure and import seconds
 // filled in): a band structure built for --panels N whose panels are more
-// than 5% more or fewer than N (its mends collapse faces, creases hold the
+// than kPanelCountTolerance more or fewer than N (its mends collapse faces, creases hold the
 // remesh off its target) is remeshed once more, aiming off by that share.
 // A refusal is a UserError naming a way out that was built (request.adviseWayOut).
 // Returns the mesh as built.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -342,31 +343,65 @@ class MendingBuild {
   int rounds_ = 0;
 };
 
-// The panels of a band structure built for --panels N may differ from N by
-// this share at most: the mends of narrow bands collapse faces, and a panel
-// that would overlap itself is split in two.
-constexpr double kPanelCountTolerance = 0.05;
-
-// The mesh imported and its structure built (the import and geometry phases).
-geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+// The mesh imported and its structure built (the import and geometry
+// phases); `side`: the mesh's largest side as imported, at the size asked.
+// A refusal is builtStructure()'s, its way out not yet tried.
+geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& job, Sizing& sizing, double& side,
                                        const core::WorkContext& context) {
   const auto began = std::chrono::steady_clock::now();
   geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
   job.seconds.import = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   context.check();
-  if (request.structure == geometry::StructureKind::Weave) {
-    job.structure = builtWeave(request, mesh, sizing, context);
-    return mesh;
-  }
-  const double side = geometry::boundingBoxSize(mesh).maxCoeff();
-  try {
-    job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
-  } catch (const StructureRefused& refused) {
-    // A refusal offers a way out that was built, never a guess.
-    if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
-    throw core::UserError(withTriedWayOut(request, refused, side, job.mesh.faces, context));
-  }
+  side = geometry::boundingBoxSize(mesh).maxCoeff();
+  job.structure = request.structure == geometry::StructureKind::Weave
+                      ? builtWeave(request, mesh, sizing, context)
+                      : builtStructure(request, mesh, job.mesh, sizing, context);
   return mesh;
+}
+
+// Remeshed to these shares of the faces asked by --panels, in turn, where
+// the even triangles of the count asked leave a band without room that no
+// mend gives it: another sampling of the surface, within
+// kPanelCountTolerance of the count, puts its vertices elsewhere.
+constexpr std::array kNearbyPanelShares{0.97, 1.03, 0.99, 1.01, 0.95, 1.05};
+
+// A band structure refused at --panels N, built of a nearby count of even
+// triangles (kNearbyPanelShares), quietly; the first that builds, said.
+std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                                           const core::WorkContext& context) {
+  if (!request.panels || request.remeshFaces || request.structure != geometry::StructureKind::Band) return {};
+  const core::WorkContext quiet(context.executor(), context.cancellation());
+  for (const double share : kNearbyPanelShares) {
+    context.check();
+    MakeRequest nearby = request;
+    nearby.remeshFaces = static_cast<int>(std::lround(*request.panels * share));
+    nearby.adviseWayOut = false;
+    context.report({"geometry", fmt::format("trying {} even triangles", *nearby.remeshFaces), 0, 0});
+    PlannedJob built;
+    Sizing builtSizing;
+    double side = 0;
+    try {
+      geometry::PolygonMesh mesh = importedAndBuilt(nearby, built, builtSizing, side, quiet);
+      context.note(fmt::format(
+          "{}: remeshed again, aiming at {} faces (got {}): the even triangles aiming at {} left "
+          "a band without room that no mend gave it",
+          request.mesh.string(), *nearby.remeshFaces, built.mesh.panelCount->remeshing.facesAfter, *request.panels));
+      // (Its own notes went nowhere: its mends, said again.)
+      for (const auto& repair : built.mesh.repairs) {
+        if (geometry::isMend(repair)) {
+          context.note(fmt::format("{}: repaired: {}", request.mesh.string(), repair.line(request.shownIn)));
+        }
+      }
+      job.mesh = std::move(built.mesh);
+      job.structure = std::move(built.structure);
+      job.seconds.import = built.seconds.import;
+      sizing = builtSizing;
+      return mesh;
+    } catch (const core::UserError&) {
+      // (Refused too: the next.)
+    }
+  }
+  return {};
 }
 
 // A band structure built for --panels N with more than kPanelCountTolerance
@@ -393,7 +428,8 @@ geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, Planned
   PlannedJob second;
   Sizing secondSizing;
   try {
-    geometry::PolygonMesh secondMesh = importedAndBuilt(again, second, secondSizing, context);
+    double side = 0;
+    geometry::PolygonMesh secondMesh = importedAndBuilt(again, second, secondSizing, side, context);
     const auto secondBuilt = static_cast<int>(second.structure.panels.size());
     if (std::abs(secondBuilt - asked) >= std::abs(built - asked)) return mesh;
     job.mesh = std::move(second.mesh);
@@ -546,7 +582,18 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
 
 geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
                                    const core::WorkContext& context) {
-  return withThePanelCountAsked(request, job, sizing, importedAndBuilt(request, job, sizing, context), context);
+  double side = 0;
+  try {
+    return withThePanelCountAsked(request, job, sizing, importedAndBuilt(request, job, sizing, side, context), context);
+  } catch (const StructureRefused& refused) {
+    if (!refused.sizeMayHelp || !request.adviseWayOut) throw;
+    if (std::optional<geometry::PolygonMesh> mesh = withANearbyPanelCount(request, job, sizing, context)) {
+      return std::move(*mesh);
+    }
+    // A refusal offers a way out that was built, never a guess.
+    if (refused.tried) throw;
+    throw core::UserError(withTriedWayOut(request, refused, side, job.mesh.faces, context));
+  }
 }
 
 }  // namespace rotafab::jobs::making

@@ -1,7 +1,6 @@
 // A refused band structure's way out, tried (MakeSteps.h, withTriedWayOut()).
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <array>
@@ -87,7 +86,8 @@ std::vector<Change> changesToTry(const MakeRequest& request, double side, int fa
 enum class Tried { Builds, OffTheBed, Refused };
 
 // Builds `request` as make would, quietly; Builds if every band is
-// fastened, every label etched and every panel fits the bed.
+// fastened, every label etched, every panel fits the bed and the panels
+// are within kPanelCountTolerance of a panel count asked.
 Tried tryBuilding(const MakeRequest& request, const core::WorkContext& quiet, size_t& panels) {
   try {
     PlannedJob job;
@@ -96,6 +96,11 @@ Tried tryBuilding(const MakeRequest& request, const core::WorkContext& quiet, si
     const double kerf = request.kerf.value_or(request.material.kerf);
     if (roomOnTheBed(structureParts(job.structure), request.machine, kerf) < 1) return Tried::OffTheBed;
     panels = job.structure.panels.size();
+    // (A panel count far from the one it names is not that way out: mends took too many.)
+    if (request.panels &&
+        std::abs(static_cast<double>(panels) - *request.panels) > kPanelCountTolerance * *request.panels) {
+      return Tried::Refused;
+    }
     return Tried::Builds;
   } catch (const core::Cancelled&) {
     throw;
@@ -153,12 +158,12 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
   std::string said = fmt::format("{}: {}", name, refused.place);
   if (!refused.advice.empty()) said += "; " + refused.advice;
   if (tries == 0) return said;
-  std::vector<std::string> ranges;
-  if (largestSize) ranges.push_back(fmt::format("sizes up to {}", request.shownIn(*largestSize, 0)));
-  if (fewestPanels) ranges.push_back(fmt::format("down to {} panels", *fewestPanels));
+  std::string ranges;
+  if (largestSize) ranges = fmt::format("sizes up to {}", request.shownIn(*largestSize, 0));
+  if (fewestPanels) ranges += fmt::format("{}down to {} panels", ranges.empty() ? "" : ", ", *fewestPanels);
   const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   return said + fmt::format("; nothing tried built it ({} tries in {:.0f} s{}: {})", tries, took,
-                            timedOut ? ", the time allowed" : "", fmt::join(ranges, ", "));
+                            timedOut ? ", the time allowed" : "", ranges);
 }
 
 }  // namespace rotafab::jobs::making

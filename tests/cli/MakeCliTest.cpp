@@ -328,16 +328,18 @@ TEST(MakeCli, MeshesOtherProgramsWroteBuildEndToEnd) {
 // and through every invariant of docs/CONTRACT.md's manifest: CGAL's cow (a
 // bow-tie vertex, slivers, and a panel that would overlap itself with a
 // shallow vertex band), elephant (106 holes) and mushroom (open); STLs OpenSCAD and another program wrote; CGAL's
-// L-shaped prism (a panel that overlaps itself at a reflex corner). Each is built at the default size, grown by at most
+// L-shaped prism (a panel that overlaps itself at a reflex corner); CGAL's pig (45 narrow places, some mended only by
+// the last resort, an edge of the ring about the band). Each is built at the default size, grown by at most
 // 10%, its narrow places mended where they are (repairs in manifest.json), no band glued. Those no mend gives room
-// (CGAL's pig, triple torus, "mpi" (polygons far from planar) and anchor (slivers everywhere: too many to mend); the
+// (CGAL's triple torus, "mpi" (polygons far from planar) and anchor (slivers everywhere: too many to mend); the
 // npm teapot) are refused with a size, or a fastener, that was tried, and that builds them as drawn (or, where at that
 // size a panel misses the bed, the size or panel count with which make's own tries built it, mended). The layout in
 // rows, at once: how fast nesting is does not matter here.
 TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
   std::vector<std::string> meshes = {"/usr/share/openscad/testdata/scad/3D/features/import.stl",
-                                     "/usr/share/assimp/models/STL/sphereWithHole.stl", cgalMesh("corner_poly.off")};
-  std::vector<std::string> refused = {cgalMesh("pig.off"), cgalMesh("3torus.off"), cgalMesh("mpi.off"),
+                                     "/usr/share/assimp/models/STL/sphereWithHole.stl", cgalMesh("corner_poly.off"),
+                                     cgalMesh("pig.off")};
+  std::vector<std::string> refused = {cgalMesh("3torus.off"), cgalMesh("mpi.off"),
                                       (kSource / "tests/data/external/teapot.obj").string()};
 #ifndef ROTAFAB_SANITIZED
   // The three of 2,300 to 2,900 faces take a minute or more each under the
@@ -395,7 +397,8 @@ TEST(MakeCli, MeshesFromTheWildBuildWithDefaultOptions) {
       ASSERT_GE(m.at("repairs").size(), 2u);
       EXPECT_EQ(m.at("repairs")[1].at("kind"), "collapse-short-edge");
       EXPECT_GT(m.at("repairs")[1].at("moved").get<double>(), 0);
-      EXPECT_LT(m.at("repairs")[1].at("moved").get<double>(), 2.0) << "a sliver's short edge, not a part of the cow";
+      // (At most about a mean edge, 2 in at the default size: a sliver's edge, not a part of the cow.)
+      EXPECT_LT(m.at("repairs")[1].at("moved").get<double>(), 2.5) << "a sliver's edge, not a part of the cow";
     }
   }
 }
@@ -440,6 +443,13 @@ TEST(MakeCli, CadStlsFacesOfZeroAreaAreRepaired) {
     EXPECT_EQ(followed.err.find("not etched"), std::string::npos) << followed.err;
     const auto m = nlohmann::json::parse(readFile(dir.path() / "followed/manifest.json"));
     EXPECT_EQ(m.at("panels").size(), std::stoul(wayOut[4].str()));
+    if (std::string_view(where).ends_with("wing.stl")) {
+      // Its mends take 14% of the panels of the count asked: remeshed again, aiming off by that share.
+      ASSERT_TRUE(wayOut[2].matched) << asDrawn.err;
+      const double asked = std::stod(wayOut[2].str().substr(std::string("--panels ").size()));
+      EXPECT_NEAR(m.at("panels").size(), asked, 0.05 * asked) << followed.err;
+      EXPECT_NE(followed.err.find("panels as built, not the "), std::string::npos) << followed.err;
+    }
     double side = 0;
     for (const auto& length : m.at("size")) side = std::max(side, length.get<double>());
     EXPECT_NEAR(side, std::stod(wayOut[3].str()), 0.01 * std::stod(wayOut[3].str()));
@@ -456,8 +466,9 @@ TEST(MakeCli, CadStlsFacesOfZeroAreaAreRepaired) {
 // steps say which joins to glue; --keep-faces mends nothing and refuses.
 TEST(MakeCli, NarrowBandsAreGluedOnlyWhenAsked) {
   TempDir dir;
-  const std::string pig = quoted(publicMesh(cgalMesh("pig.off")));
-  const CommandResult glued = run(kCli + " make " + pig + " --structure band --layout rows --glue-narrow --out " +
+  // (CGAL's triple torus: 21 faces, some too narrow at the default size for any mend.)
+  const std::string torus = quoted(publicMesh(cgalMesh("3torus.off")));
+  const CommandResult glued = run(kCli + " make " + torus + " --structure band --layout rows --glue-narrow --out " +
                                   quoted(dir.path() / "glued"));
   ASSERT_EQ(glued.status, 0) << glued.err;
   std::smatch warned;
@@ -477,10 +488,12 @@ TEST(MakeCli, NarrowBandsAreGluedOnlyWhenAsked) {
   const int unlabelled = std::regex_search(glued.err, warned, std::regex(R"((\d+) labels? (is|are) not etched)"))
                              ? std::stoi(warned[1].str())
                              : 0;
-  expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, 0, count);
+  const int split =
+      std::regex_search(glued.err, warned, std::regex(R"((\d+) faces? split in two)")) ? std::stoi(warned[1].str()) : 0;
+  expectSpecPanels(m, m.at("mesh").at("faces"), -1, unlabelled, split, count);
 
-  const CommandResult kept =
-      run(kCli + " make " + pig + " --structure band --layout rows --keep-faces --out " + quoted(dir.path() / "kept"));
+  const CommandResult kept = run(kCli + " make " + torus + " --structure band --layout rows --keep-faces --out " +
+                                 quoted(dir.path() / "kept"));
   EXPECT_EQ(kept.status, 1) << kept.err;
   EXPECT_NE(kept.err.find("(--keep-faces keeps every face)"), std::string::npos) << kept.err;
   EXPECT_EQ(kept.err.find("repaired: collapsed"), std::string::npos) << kept.err;
@@ -888,11 +901,14 @@ TEST(MakeCli, ThePanelCountIsTheOneAsked) {
 }
 
 // A designer's size and panel count, kept: the bunny at 30 in with 1,000
-// panels and CGAL's homer at 36 in with 600 are built at that size (within
-// 1%) with the panels asked (+- 5%), every band fastened (none glued) and
-// every label etched: a number too large for its band moves to the panel's
-// body, turns across the band, or shrinks, and where it fits nowhere the
-// design is mended there (docs/structures.md, "Size"), never left off.
+// panels, CGAL's homer at 36 in with 600 and 800 and its elephant at 36 in
+// with 600 and 800 are built at that size (within 1%) with the panels asked
+// (+- 5%), every band fastened (none glued) and every label etched: a
+// number too large for its band moves to the panel's body, turns across the
+// band, or shrinks, and where it fits nowhere the design is mended there
+// (docs/structures.md, "Size"), never left off. The elephant's thin ears and
+// tusks need the last of the mends (an edge of the ring about the band), and
+// at 600 another sampling of its surface within 5% of the count.
 TEST(MakeCli, ADesignersSizeAndPanelCountAreKeptWithEveryLabelEtched) {
   struct Design {
     std::string mesh;
@@ -901,7 +917,10 @@ TEST(MakeCli, ADesignersSizeAndPanelCountAreKeptWithEveryLabelEtched) {
   };
   std::vector<Design> designs = {{(kSource / "examples/bunny.obj").string(), 1000, 30}};
 #ifndef ROTAFAB_SANITIZED
-  designs.push_back({cgalMesh("homer.off"), 600, 36});
+  for (const auto& [mesh, panels] :
+       {std::pair{"homer.off", 600}, {"homer.off", 800}, {"elephant.off", 600}, {"elephant.off", 800}}) {
+    designs.push_back({cgalMesh(mesh), panels, 36});
+  }
 #endif
   for (const Design& design : designs) {
     SCOPED_TRACE(design.mesh);
