@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "core/Cancellation.h"
 #include "core/Executor.h"
@@ -49,6 +50,11 @@ class WorkContext {
     return WorkContext(executor_, cancellation_, std::move(progress), log_);
   }
 
+  // The same executor, cancellation and progress, with notes and warnings going to `log` instead.
+  [[nodiscard]] WorkContext withLog(std::shared_ptr<spdlog::logger> log) const {
+    return WorkContext(executor_, cancellation_, progress_, std::move(log));
+  }
+
   // parallelFor on the executor, checking the cancellation before each index.
   template <typename Body>
   void parallelFor(size_t count, Body&& body) const {
@@ -62,6 +68,27 @@ class WorkContext {
   Executor& executor_;
   const Cancellation& cancellation_;
   ProgressSink progress_;
+  std::shared_ptr<spdlog::logger> log_;
+};
+
+// What a piece of work says (its notes and warnings), kept to be said
+// later, or never: a try whose result may be thrown away says nothing of
+// itself until it is kept.
+class SaidLater {
+ public:
+  SaidLater();
+  // `from`'s executor and cancellation, its notes and warnings kept here;
+  // its progress too, or none (`progress` false).
+  [[nodiscard]] WorkContext context(const WorkContext& from, bool progress = true) const;
+  // Says what was kept, in the order said, on `to`.
+  void sayOn(const WorkContext& to) const;
+
+ private:
+  struct Said {
+    bool warning;
+    std::string text;
+  };
+  std::shared_ptr<std::vector<Said>> said_;
   std::shared_ptr<spdlog::logger> log_;
 };
 

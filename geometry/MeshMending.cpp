@@ -71,11 +71,12 @@ class Collapser {
   }
 
   // The edges that may give the narrow band of (u, v) its room when they
-  // go, nearest first: its own, every side of the faces beside it, then
-  // every edge at u or v (where a thin tube's ring or a flap's rim keeps
-  // the nearer ones by the link condition); each no longer than `longest`,
-  // so that a collapse moves the surface by half of that at most. Shortest
-  // first within each.
+  // go, besides its own (tried first, elsewhere): every side of the faces
+  // beside it, then every edge at u or v (where a thin tube's ring or a
+  // flap's rim keeps the nearer ones by the link condition); none longer
+  // than `longest`, so that a collapse moves the surface by half of that at
+  // most (the whole of it where one end is on the boundary and stays).
+  // Shortest first within each.
   [[nodiscard]] std::vector<std::array<int, 2>> collapseCandidates(int u, int v, double longest) const {
     std::vector<std::array<int, 2>> sides, ring;
     std::set<std::pair<int, int>> seen{key(u, v)};  // (its own edge, tried first)

@@ -50,7 +50,8 @@ struct MakeRequest {
   // Remesh to even triangles that give about this many panels (geometry/Remeshing.h).
   std::optional<int> panels;
   // The faces the remesh aims at, when not `panels`' own: make's second
-  // remesh, aiming off by what the mends of narrow bands took (MakeJob.cpp).
+  // remesh, aiming off by the share the first build missed, and its nearby
+  // samplings where the first was refused (making::builtAsAsked, MakeSteps.h).
   std::optional<int> remeshFaces;
   // --repair auto (docs/CONTRACT.md, "Command line"; geometry/MeshRepair.h);
   // false: none, a broken mesh is refused.

@@ -61,11 +61,13 @@ inline constexpr double kPanelCountTolerance = 0.05;
 
 // The mesh imported and its structure built, as make builds it (the import
 // and geometry phases; `job`'s mesh counts, structure and import seconds
-// filled in): a band structure built for --panels N whose panels are more
-// than kPanelCountTolerance more or fewer than N (its mends collapse faces, creases hold the
-// remesh off its target) is remeshed once more, aiming off by that share.
-// A refusal is a UserError naming a way out that was built (request.adviseWayOut).
-// Returns the mesh as built.
+// filled in). With --panels N, a band structure whose panels are more than
+// kPanelCountTolerance more or fewer than N (its mends collapse faces,
+// creases hold the remesh off its target) is remeshed once more, aiming off
+// by that share; one refused for bands without room is tried at nearby
+// counts of even triangles, within that share of N, before the refusal. Only
+// the build kept says its notes. A refusal is a UserError naming a way out
+// that was built (request.adviseWayOut). Returns the mesh as built.
 geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
                                    const core::WorkContext& context);
 

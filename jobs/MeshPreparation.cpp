@@ -84,7 +84,9 @@ PanelCount remeshedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
       "{}: remeshed from {} faces to {} even triangles{}, keeping its genus, boundary{} (the surface within {:.2g}% "
       "of its size; the smallest face {:.0f}% of the median's)",
       name, remeshing.facesBefore, remeshing.facesAfter,
-      woven ? fmt::format(" ({} panels asked, one an edge)", count.asked) : fmt::format(" ({} asked)", count.asked),
+      woven                 ? fmt::format(" ({} panels asked, one an edge)", count.asked)
+      : request.remeshFaces ? fmt::format(" ({} asked, aiming at {})", count.asked, faces)
+                            : fmt::format(" ({} asked)", count.asked),
       remeshing.creaseEdges > 0 ? fmt::format(" and {} crease edges", remeshing.creaseEdges) : "",
       diagonal > 0 ? 100 * remeshing.largestMove / diagonal : 0.0, 100 * remeshing.smallestAreaRatio));
   return count;

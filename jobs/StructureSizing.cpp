@@ -11,6 +11,7 @@
 #include <limits>
 #include <optional>
 #include <regex>
+#include <set>
 
 #include "core/UserError.h"
 #include "geometry/BandStructure.h"
@@ -350,7 +351,7 @@ geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& j
                                        const core::WorkContext& context) {
   const auto began = std::chrono::steady_clock::now();
   geometry::PolygonMesh mesh = importedMesh(request, job.mesh, context);
-  job.seconds.import = std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+  job.seconds.import += std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   context.check();
   side = geometry::boundingBoxSize(mesh).maxCoeff();
   job.structure = request.structure == geometry::StructureKind::Weave
@@ -359,86 +360,113 @@ geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& j
   return mesh;
 }
 
+// One more build of `request`'s band structure, its remesh aiming at
+// `faces`, quietly: what it says is kept in `said`. Empty where it is
+// refused. (Its import's seconds are added to `job`'s either way.)
+struct AnotherBuild {
+  PlannedJob job;
+  Sizing sizing;
+  geometry::PolygonMesh mesh;
+  [[nodiscard]] int panels() const { return static_cast<int>(job.structure.panels.size()); }
+};
+std::optional<AnotherBuild> anotherBuild(const MakeRequest& request, int faces, PlannedJob& job,
+                                         const core::SaidLater& said, const core::WorkContext& context) {
+  MakeRequest again = request;
+  again.remeshFaces = faces;
+  again.adviseWayOut = false;
+  AnotherBuild built;
+  try {
+    double side = 0;
+    built.mesh = importedAndBuilt(again, built.job, built.sizing, side, said.context(context, false));
+  } catch (const core::UserError&) {
+    job.seconds.import += built.job.seconds.import;
+    return std::nullopt;
+  }
+  job.seconds.import += built.job.seconds.import;
+  return built;
+}
+
+// `built` kept as the job's: its counts, structure and sizing; what it said, said.
+geometry::PolygonMesh kept(AnotherBuild&& built, const core::SaidLater& said, PlannedJob& job, Sizing& sizing,
+                           const core::WorkContext& context) {
+  said.sayOn(context);
+  job.mesh = std::move(built.job.mesh);
+  job.structure = std::move(built.job.structure);
+  sizing = built.sizing;
+  return std::move(built.mesh);
+}
+
 // Remeshed to these shares of the faces asked by --panels, in turn, where
 // the even triangles of the count asked leave a band without room that no
 // mend gives it: another sampling of the surface, within
-// kPanelCountTolerance of the count, puts its vertices elsewhere.
+// kPanelCountTolerance of the count, puts its vertices elsewhere. No try
+// begins after kNearbySeconds.
 constexpr std::array kNearbyPanelShares{0.97, 1.03, 0.99, 1.01, 0.95, 1.05};
+constexpr double kNearbySeconds = 20;
 
 // A band structure refused at --panels N, built of a nearby count of even
-// triangles (kNearbyPanelShares), quietly; the first that builds, said.
+// triangles (kNearbyPanelShares), each quietly; the first that builds with
+// its panels within kPanelCountTolerance of N is kept, and said.
 std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
                                                            const core::WorkContext& context) {
   if (!request.panels || request.remeshFaces || request.structure != geometry::StructureKind::Band) return {};
-  const core::WorkContext quiet(context.executor(), context.cancellation());
+  const int asked = *request.panels;
+  const auto began = std::chrono::steady_clock::now();
+  std::set<int> tried{asked};
   for (const double share : kNearbyPanelShares) {
     context.check();
-    MakeRequest nearby = request;
-    nearby.remeshFaces = static_cast<int>(std::lround(*request.panels * share));
-    nearby.adviseWayOut = false;
-    context.report({"geometry", fmt::format("trying {} even triangles", *nearby.remeshFaces), 0, 0});
-    PlannedJob built;
-    Sizing builtSizing;
-    double side = 0;
-    try {
-      geometry::PolygonMesh mesh = importedAndBuilt(nearby, built, builtSizing, side, quiet);
-      context.note(fmt::format(
-          "{}: remeshed again, aiming at {} faces (got {}): the even triangles aiming at {} left "
-          "a band without room that no mend gave it",
-          request.mesh.string(), *nearby.remeshFaces, built.mesh.panelCount->remeshing.facesAfter, *request.panels));
-      // (Its own notes went nowhere: its mends, said again.)
-      for (const auto& repair : built.mesh.repairs) {
-        if (geometry::isMend(repair)) {
-          context.note(fmt::format("{}: repaired: {}", request.mesh.string(), repair.line(request.shownIn)));
-        }
-      }
-      job.mesh = std::move(built.mesh);
-      job.structure = std::move(built.structure);
-      job.seconds.import = built.seconds.import;
-      sizing = builtSizing;
-      return mesh;
-    } catch (const core::UserError&) {
-      // (Refused too: the next.)
-    }
+    const auto faces = static_cast<int>(std::lround(asked * share));
+    if (!tried.insert(faces).second) continue;  // (a small count: the same target)
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count() > kNearbySeconds) break;
+    context.report({"geometry", fmt::format("trying {} even triangles", faces), 0, 0});
+    const core::SaidLater said;
+    std::optional<AnotherBuild> built = anotherBuild(request, faces, job, said, context);
+    if (!built || std::abs(built->panels() - asked) > kPanelCountTolerance * asked) continue;
+    context.note(
+        fmt::format("{}: the even triangles aiming at {} left a band without room that no mend gave it: "
+                    "remeshed again, aiming at {} faces",
+                    request.mesh.string(), asked, faces));
+    return kept(std::move(*built), said, job, sizing, context);
   }
-  return {};
+  return std::nullopt;
 }
 
 // A band structure built for --panels N with more than kPanelCountTolerance
 // more or fewer panels than N (mends collapse faces, a remesh held by creases
 // misses its target): remeshed once more, aiming off by the share it missed,
-// and built again; that second build is kept where it comes nearer the
-// count asked, else the first.
+// and built again, quietly; that second build is kept where it comes nearer
+// the count asked, else the first. Says the first build's notes (`first`),
+// or the second's, and which was kept.
 geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
-                                             geometry::PolygonMesh mesh, const core::WorkContext& context) {
+                                             geometry::PolygonMesh mesh, const core::SaidLater& first,
+                                             const core::WorkContext& context) {
   const auto& count = job.mesh.panelCount;
+  const int asked = request.panels.value_or(0);
+  const auto built = static_cast<int>(job.structure.panels.size());
   if (request.structure != geometry::StructureKind::Band || !request.panels || request.remeshFaces || !count ||
-      !count->remeshing.remeshed) {
+      !count->remeshing.remeshed || built <= 0 || std::abs(built - asked) <= kPanelCountTolerance * asked) {
+    first.sayOn(context);
     return mesh;
   }
-  const int asked = *request.panels;
-  const auto built = static_cast<int>(job.structure.panels.size());
-  if (built <= 0 || std::abs(built - asked) <= kPanelCountTolerance * asked) return mesh;
-  MakeRequest again = request;
   // (The remesher's own count is near the target, not on it, where creases hold vertices.)
-  again.remeshFaces = static_cast<int>(std::lround(static_cast<double>(asked) * asked / built));
-  again.adviseWayOut = false;
-  context.note(fmt::format("{}: {} panels as built, not the {} asked: remeshed again, to {} faces",
-                           request.mesh.string(), built, asked, *again.remeshFaces));
-  PlannedJob second;
-  Sizing secondSizing;
-  try {
-    double side = 0;
-    geometry::PolygonMesh secondMesh = importedAndBuilt(again, second, secondSizing, side, context);
-    const auto secondBuilt = static_cast<int>(second.structure.panels.size());
-    if (std::abs(secondBuilt - asked) >= std::abs(built - asked)) return mesh;
-    job.mesh = std::move(second.mesh);
-    job.structure = std::move(second.structure);
-    sizing = secondSizing;
-    return secondMesh;
-  } catch (const core::UserError&) {
-    return mesh;  // (the first build stands, its count said)
+  const auto faces = static_cast<int>(std::lround(static_cast<double>(asked) * asked / built));
+  const core::SaidLater said;
+  std::optional<AnotherBuild> second = anotherBuild(request, faces, job, said, context);
+  const std::string name = request.mesh.string();
+  if (second && std::abs(second->panels() - asked) < std::abs(built - asked)) {
+    context.note(
+        fmt::format("{}: the even triangles aiming at {} gave {} panels as built: remeshed again, aiming at "
+                    "{} faces, which gives {}",
+                    name, asked, built, faces, second->panels()));
+    return kept(std::move(*second), said, job, sizing, context);
   }
+  first.sayOn(context);
+  context.note(
+      fmt::format("{}: {} panels as built, not the {} asked; remeshed again, aiming at {} faces, it {}: "
+                  "these {} kept",
+                  name, built, asked, faces,
+                  second ? fmt::format("gave {}", second->panels()) : std::string("was refused"), built));
+  return mesh;
 }
 
 }  // namespace
@@ -582,18 +610,27 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
 
 geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
                                    const core::WorkContext& context) {
+  // (The first build's notes are said once it is kept, or refused; not those of a build thrown away.)
+  const core::SaidLater first;
   double side = 0;
+  geometry::PolygonMesh mesh;
   try {
-    return withThePanelCountAsked(request, job, sizing, importedAndBuilt(request, job, sizing, side, context), context);
+    mesh = importedAndBuilt(request, job, sizing, side, first.context(context));
   } catch (const StructureRefused& refused) {
-    if (!refused.sizeMayHelp || !request.adviseWayOut) throw;
-    if (std::optional<geometry::PolygonMesh> mesh = withANearbyPanelCount(request, job, sizing, context)) {
-      return std::move(*mesh);
+    if (refused.sizeMayHelp && request.adviseWayOut) {
+      if (std::optional<geometry::PolygonMesh> nearby = withANearbyPanelCount(request, job, sizing, context)) {
+        return std::move(*nearby);
+      }
     }
+    first.sayOn(context);
     // A refusal offers a way out that was built, never a guess.
-    if (refused.tried) throw;
+    if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
     throw core::UserError(withTriedWayOut(request, refused, side, job.mesh.faces, context));
+  } catch (...) {
+    first.sayOn(context);
+    throw;
   }
+  return withThePanelCountAsked(request, job, sizing, std::move(mesh), first, context);
 }
 
 }  // namespace rotafab::jobs::making
