@@ -4,6 +4,7 @@
 // the size asked or chosen (StructureSizing.cpp); the pipeline itself is
 // MakeJob.cpp. Not an interface of its own: MakeJob.h is.
 
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -58,6 +59,9 @@ geometry::Structure builtStructure(const MakeRequest& request, geometry::Polygon
 // this share at most: the mends of narrow bands collapse faces, and a panel
 // that would overlap itself is split in two.
 inline constexpr double kPanelCountTolerance = 0.05;
+inline bool withinPanelCountTolerance(double panels, int asked) {
+  return std::abs(panels - asked) <= kPanelCountTolerance * asked;
+}
 
 // The mesh imported and its structure built, as make builds it (the import
 // and geometry phases; `job`'s mesh counts, structure and import seconds

@@ -375,14 +375,15 @@ std::optional<AnotherBuild> anotherBuild(const MakeRequest& request, int faces, 
   again.remeshFaces = faces;
   again.adviseWayOut = false;
   AnotherBuild built;
+  bool refused = false;
   try {
     double side = 0;
     built.mesh = importedAndBuilt(again, built.job, built.sizing, side, said.context(context, false));
   } catch (const core::UserError&) {
-    job.seconds.import += built.job.seconds.import;
-    return std::nullopt;
+    refused = true;
   }
   job.seconds.import += built.job.seconds.import;
+  if (refused) return std::nullopt;
   return built;
 }
 
@@ -421,7 +422,7 @@ std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& re
     context.report({"geometry", fmt::format("trying {} even triangles", faces), 0, 0});
     const core::SaidLater said;
     std::optional<AnotherBuild> built = anotherBuild(request, faces, job, said, context);
-    if (!built || std::abs(built->panels() - asked) > kPanelCountTolerance * asked) continue;
+    if (!built || !withinPanelCountTolerance(built->panels(), asked)) continue;
     context.note(
         fmt::format("{}: the even triangles aiming at {} left a band without room that no mend gave it: "
                     "remeshed again, aiming at {} faces",
@@ -444,7 +445,7 @@ geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, Planned
   const int asked = request.panels.value_or(0);
   const auto built = static_cast<int>(job.structure.panels.size());
   if (request.structure != geometry::StructureKind::Band || !request.panels || request.remeshFaces || !count ||
-      !count->remeshing.remeshed || built <= 0 || std::abs(built - asked) <= kPanelCountTolerance * asked) {
+      !count->remeshing.remeshed || built <= 0 || withinPanelCountTolerance(built, asked)) {
     first.sayOn(context);
     return mesh;
   }

@@ -97,8 +97,7 @@ Tried tryBuilding(const MakeRequest& request, const core::WorkContext& quiet, si
     if (roomOnTheBed(structureParts(job.structure), request.machine, kerf) < 1) return Tried::OffTheBed;
     panels = job.structure.panels.size();
     // (A panel count far from the one it names is not that way out: mends took too many.)
-    if (request.panels &&
-        std::abs(static_cast<double>(panels) - *request.panels) > kPanelCountTolerance * *request.panels) {
+    if (request.panels && !withinPanelCountTolerance(static_cast<double>(panels), *request.panels)) {
       return Tried::Refused;
     }
     return Tried::Builds;
