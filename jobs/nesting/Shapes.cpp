@@ -171,10 +171,24 @@ Shape turnedByRounding(const Shape& from, Shape shape) {
   return shape;
 }
 
-}  // namespace
+// The centroid of a polygon's area (the usual shoelace sums).
+IntPoint areaCentroid(const Path& path) {
+  double twiceArea = 0, x = 0, y = 0;
+  for (size_t i = 0; i < path.size(); ++i) {
+    const IntPoint& p = path[i];
+    const IntPoint& q = path[(i + 1) % path.size()];
+    const double cross =
+        static_cast<double>(p.X) * static_cast<double>(q.Y) - static_cast<double>(q.X) * static_cast<double>(p.Y);
+    twiceArea += cross;
+    x += static_cast<double>(p.X + q.X) * cross;
+    y += static_cast<double>(p.Y + q.Y) * cross;
+  }
+  if (twiceArea == 0) return path.empty() ? IntPoint{0, 0} : path.front();
+  return {std::llround(x / (3 * twiceArea)), std::llround(y / (3 * twiceArea))};
+}
 
-Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
-                const Shape* turnedFrom) {
+Shape builtShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
+                 const Shape* turnedFrom) {
   if (turnedFrom && quarterTurns(rotation) >= 0 && quarterTurns(turnedFrom->rotation) >= 0) {
     return turnedShape(*turnedFrom, (quarterTurns(rotation) - quarterTurns(turnedFrom->rotation) + 4) % 4, rotation);
   }
@@ -230,6 +244,15 @@ Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt r
     for (const Path& piece : shape.pieces) shape.pieceBoxes.push_back(boxOf(piece));
     for (const Path& piece : shape.negatedPieces) shape.negatedPieceBoxes.push_back(boxOf(piece));
   }
+  return shape;
+}
+
+}  // namespace
+
+Shape makeShape(const Polygon2& outline, double rotation, double spacing, cInt radiusStep, bool forNoFitPolygons,
+                const Shape* turnedFrom) {
+  Shape shape = builtShape(outline, rotation, spacing, radiusStep, forNoFitPolygons, turnedFrom);
+  shape.centroid = areaCentroid(shape.grown);
   return shape;
 }
 

@@ -93,6 +93,9 @@ struct Shape {
     double radius;
   };
   std::vector<Pole> poles;
+  // The centroid of `grown`'s area: the first layout ranks a part's
+  // rotations by where it puts their mass (CollisionPlacer::bestSpot()).
+  IntPoint centroid{0, 0};
   double diameter = 0;  // of `grown`'s box
   double size = 0;      // the square root of `grown`'s area
   // `grown` shrunk by kCollisionSlack: the compaction's collision test asks
