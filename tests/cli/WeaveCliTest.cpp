@@ -154,6 +154,10 @@ TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
   EXPECT_TRUE(summary.at("warnings").empty()) << made.err;
   const auto m = nlohmann::json::parse(readFile(out / "manifest.json"));
   EXPECT_EQ(expectWovenManifest(m, 90).size(), 10U);  // the truncated icosahedron's Petrie walks
+  // And by the independent checker, which also holds each crossing's two
+  // holes as far apart on its three panels and the panels apart on their sheets.
+  const CommandResult checked = run("python3 " + quoted(kSource / "tools/weavecheck.py") + " " + quoted(out));
+  EXPECT_EQ(checked.status, 0) << checked.out << checked.err;
   // Each sheet read by Ghostscript.
   for (size_t s = 1; s <= m.at("sheets").size(); ++s) {
     char name[32];
@@ -174,6 +178,16 @@ TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
   int groups = 0;
   for (std::string line; std::getline(obj, line);) groups += line.starts_with("g panel-");
   EXPECT_EQ(groups, 90);
+}
+
+// The independent checker of woven manifests (tools/weavecheck.py) finds
+// each kind of problem in its hand-made manifests: a glued crossing, holes
+// not aligned, panels overlapping, an outline crossing itself, a hole near
+// its outline, an up number missing.
+TEST(WeaveCli, TheIndependentCheckerFindsEachKindOfProblem) {
+  const CommandResult selftest = run("python3 " + quoted(kSource / "tools/weavecheck.py") + " --selftest");
+  EXPECT_EQ(selftest.status, 0) << selftest.out << selftest.err;
+  EXPECT_NE(selftest.out.find("7 passed, 0 failed"), std::string::npos) << selftest.out;
 }
 
 TEST(WeaveCli, ASingleCycleWeaveIsOneThread) {
