@@ -1,6 +1,7 @@
 #pragma once
 // The first layout: parts placed one by one in a given sequence, each as
-// far left and then as low as it goes, at a cost per part that does not
+// far left and then as low as it goes (of its rotations, the one whose
+// area's centroid lies leftmost there), at a cost per part that does not
 // grow as the sheets fill. No no-fit polygons: the places are tried
 // directly, with the collision detection of jagua-rs (Gardeyn and Wauters,
 // "A collision detection engine for 2D irregular cutting and packing
