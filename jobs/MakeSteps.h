@@ -37,10 +37,10 @@ geometry::Point3 builtSize(const geometry::Structure& structure);
 // neighbours or makes panels as wide as the hole, and a patch avoids it.
 std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh);
 
-// A plain-woven structure (dissertation ch. IV) of the mesh as built. The
-// ribbons follow the surface within the offset, so --size scales the mesh;
-// with no size or scale given it grows until every crossing has room for
-// its two holes.
+// A plain-woven structure (dissertation ch. IV) of the mesh as built, at
+// the size asked (--size, the structure's largest side, within half a
+// percent; --scale exactly); with no size or scale given it grows until
+// every crossing has room for its two holes.
 geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
                                const core::WorkContext& context);
 

@@ -486,6 +486,46 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
                 : "";
 }
 
+namespace {
+
+// --size is the woven structure's largest side as built (docs/CONTRACT.md,
+// "Units and scale"), its ribbons in 3D, not the mesh's: they stand off
+// the surface by the offset and round its corners, by a share that
+// depends a little on the scale (the offset and the holes' clearance do
+// not grow with it). The mesh is scaled to the size, then by the size over
+// the side as built until that is within kSizeTolerance. A weave that
+// cannot be built at the size asked is refused (the caller's advice names
+// a size that may do), not built at another size: a size other than the
+// one asked is of no use to the builders.
+geometry::Structure wovenAtSize(const MakeRequest& request, geometry::PolygonMesh& mesh,
+                                const geometry::WeaveOptions& weave, const core::WorkContext& context) {
+  constexpr int kMostResizes = 3;
+  const double size = *request.size;
+  const double meshSide = geometry::boundingBoxSize(mesh).maxCoeff();
+  if (meshSide > 0) {
+    for (geometry::Point3& p : mesh.positions) p *= size / meshSide;
+  }
+  geometry::Structure structure = geometry::buildWeaveStructure(mesh, weave, context);
+  for (int resize = 0;; ++resize) {
+    const double side = builtSize(structure).maxCoeff();
+    if (!(side > 0) || std::abs(side / size - 1) <= kSizeTolerance) break;
+    if (resize == kMostResizes) {
+      // (Not met on any of CGAL's 67 meshes woven at --panels 400 --size 36in: docs/PERFORMANCE.md.)
+      const core::LengthUnit unit = request.shownIn;
+      throw core::UserError(fmt::format(
+          "{}: woven, its largest side came out {}, not the {} asked, after {} "
+          "resizes; {} sets the size of the mesh itself",
+          request.mesh.string(), unit(side, 2), unit(size, 2), kMostResizes, request.names(Parameter::Scale)));
+    }
+    for (geometry::Point3& p : mesh.positions) p *= size / side;
+    structure = {};  // (the next weave's memory in its place, not beside it)
+    structure = geometry::buildWeaveStructure(mesh, weave, context);
+  }
+  return structure;
+}
+
+}  // namespace
+
 geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
                                const core::WorkContext& context) {
   const std::string name = request.mesh.string();
@@ -503,13 +543,8 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
   weave.names = request.names;
   weave.names.unit = request.shownIn;
   try {
-    if (request.size) {
-      const double side = geometry::boundingBoxSize(mesh).maxCoeff();
-      if (side > 0) {
-        for (geometry::Point3& p : mesh.positions) p *= *request.size / side;
-      }
-    }
-    if (request.size || request.scale) return geometry::buildWeaveStructure(mesh, weave, context);
+    if (request.size) return wovenAtSize(request, mesh, weave, context);
+    if (request.scale) return geometry::buildWeaveStructure(mesh, weave, context);
     geometry::GrownStructure built = geometry::buildWeaveStructureWithRoom(mesh, weave, context);
     sizing.grown = built.grown;
     const double kerf = request.kerf.value_or(request.material.kerf);

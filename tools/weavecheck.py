@@ -9,9 +9,11 @@ says alone and without any of Rotafab's code, what the builders of a
 plain-woven structure (the dissertation, ch. IV) rely on:
 
   labels     every edge number k is etched `up` once, on panel k (or a piece
-             of it), and `down` twice, on two other panels (IV.4); every
-             panel has one underlined neighbour number (`neighbor`), naming
-             one of its neighbours, not itself (IV.4, Figure 42).
+             of it), and `down` twice (IV.4; panel k itself may be one of
+             the two, where a single thread goes round a leaf face of its
+             tree and under, then over, one edge); every panel has one
+             underlined neighbour number (`neighbor`), naming one of its
+             neighbours (IV.4, Figure 42).
   holes      each crossing (edge) has its holes on the three panels that meet
              there: 3 or 6 in all, as many on each panel (two of the three
              may be one panel, with twice as many); none is missing unless
@@ -21,7 +23,8 @@ plain-woven structure (the dissertation, ch. IV) rely on:
   aligned    where a crossing has two holes on each of its panels, they are
              the same two points of the surface on each: unfolding keeps
              lengths, so the two holes are as far apart on every panel, within
-             1% (and 0.01 in).
+             1% (and 0.01 in). A panel and the pieces cut off it share one
+             frame; a panel that is two of the three holds two pairs.
   outlines   every part's outline is a simple polygon (no two of its sides
              cross), and no two parts on a sheet overlap once placed
              (`placement`: turn about the origin, then move).
@@ -120,6 +123,46 @@ def crossing_pairs(polygons, cell=0.5):
                     yield key
 
 
+def crossing_spans(on, panel_of_part):
+    """How far apart a crossing's two holes are on each of its panels, [(span, panel)]: a panel (with the
+    pieces cut off it, in its frame) holds a pair, or two pairs where it is two of the three panels, paired
+    as the other panel's pair says. Empty when no panel holds a single pair to go by."""
+    per_panel = defaultdict(list)
+    for name, hs in on.items():
+        per_panel[panel_of_part[name]] += hs
+    span = lambda p, q: math.hypot(p[0] - q[0], p[1] - q[1])
+    pairs = {pid: span(*hs) for pid, hs in per_panel.items() if len(hs) == 2}
+    if not pairs:
+        return []
+    reference = next(iter(pairs.values()))
+    spans = [(d, pid) for pid, d in pairs.items()]
+    for pid, hs in per_panel.items():
+        if len(hs) == 4:
+            pairing = min(([(0, 1), (2, 3)], [(0, 2), (1, 3)], [(0, 3), (1, 2)]),
+                          key=lambda ps: sum(abs(span(hs[i], hs[j]) - reference) for i, j in ps))
+            spans += [(span(hs[i], hs[j]), pid) for i, j in pairing]
+    return spans
+
+
+def interior_point(outline):
+    """A point strictly inside a simple polygon: the middle of the widest run inside it along a line across
+    the middle of its box."""
+    x0, y0, x1, y1 = box(outline)
+    for fraction in (0.5, 0.37, 0.63, 0.21, 0.79):
+        y = y0 + fraction * (y1 - y0)
+        xs = []
+        n = len(outline)
+        for i in range(n):
+            (ax, ay), (bx, by) = outline[i], outline[(i + 1) % n]
+            if (ay > y) != (by > y):
+                xs.append(ax + (y - ay) * (bx - ax) / (by - ay))
+        xs.sort()
+        runs = [(xs[k + 1] - xs[k], (xs[k] + xs[k + 1]) / 2) for k in range(0, len(xs) - 1, 2)]
+        if runs:
+            return max(runs)[1], y
+    return outline[0]
+
+
 def placed(outline, placement):
     turn = math.radians(placement.get("rotation", 0.0))
     c, s = math.cos(turn), math.sin(turn)
@@ -182,16 +225,17 @@ def check(manifest, allow_glue=False):
                     holes[hole["edge"]][name].append((x, y, d))
         if len(neighbours) != 1:
             report.add("labels", "panel %d: %d underlined neighbour numbers, want 1" % (pid, len(neighbours)))
-        elif neighbours[0] == pid or neighbours[0] not in panel.get("neighbors", []):
+        elif neighbours[0] not in panel.get("neighbors", []):
             report.add("labels", "panel %d: its underlined number %s is not one of its neighbours %s"
                        % (pid, neighbours[0], panel.get("neighbors")))
+    if sorted(ids) != list(range(1, n + 1)):
+        report.add("labels", "the panels are not numbered 1 to %d" % n)
     glued = 0
     for edge in range(1, n + 1):
         if up[edge] != [edge]:
             report.add("labels", "edge %d: `up` on panels %s, want on panel %d alone" % (edge, up[edge], edge))
-        if len(down[edge]) != 2 or edge in down[edge]:
-            report.add("labels", "edge %d: `down` on panels %s, want two panels other than %d"
-                       % (edge, down[edge], edge))
+        if len(down[edge]) != 2:
+            report.add("labels", "edge %d: `down` on panels %s, want two" % (edge, down[edge]))
         on = holes.get(edge, {})
         total = sum(len(v) for v in on.values())
         if total == 0:
@@ -207,20 +251,14 @@ def check(manifest, allow_glue=False):
         if total not in (3, 6) or not even:
             report.add("holes", "edge %d: holes per panel %s, want as many on each of three panels (3 or 6 in all)"
                        % (edge, dict(per_panel)))
-        spans = []
-        for name, hs in on.items():
-            for a in range(len(hs)):
-                for b in range(a + 1, len(hs)):
-                    spans.append((math.hypot(hs[a][0] - hs[b][0], hs[a][1] - hs[b][1]), name))
-        if total == 6 and len(spans) >= 3:
-            longest = max(s for s, _ in spans)
-            shortest = min(s for s, _ in spans)
-            if longest - shortest > max(0.01, 0.01 * longest):
-                report.add("aligned", "edge %d: its two holes are %s apart on its panels, not the same points"
-                           % (edge, ", ".join("%.4f in on %s" % s for s in sorted(spans))))
-    for panel in panels:
-        if panel["id"] not in ids:
-            continue
+        if total == 6:
+            spans = crossing_spans(on, panel_of_part)
+            if spans:
+                longest = max(s for s, _ in spans)
+                shortest = min(s for s, _ in spans)
+                if longest - shortest > max(0.01, 0.01 * longest):
+                    report.add("aligned", "edge %d: its two holes are %s apart on its panels, not the same points"
+                               % (edge, ", ".join("%.4f in on panel %s" % s for s in sorted(spans))))
     # Outlines: simple, and apart on their sheet.
     by_sheet = defaultdict(list)
     for panel in panels:
@@ -241,6 +279,7 @@ def check(manifest, allow_glue=False):
                                                                              placed_parts[q][0]))
         # One part wholly inside another crosses no side: test a corner.
         boxes = [box(o) for o in outlines]
+        interiors = [interior_point(o) for o in outlines]
         order = sorted(range(len(outlines)), key=lambda k: boxes[k][0])
         for a_index, a in enumerate(order):
             for b in order[a_index + 1:]:
@@ -250,11 +289,10 @@ def check(manifest, allow_glue=False):
                     continue
                 if boxes[b][1] > boxes[a][3] or boxes[a][1] > boxes[b][3]:
                     continue
-                if inside(outlines[a], *outlines[b][0]) or inside(outlines[b], *outlines[a][0]):
-                    if distance_to_outline(outlines[a], *outlines[b][0]) > TOLERANCE:
-                        reported.add((a, b))
-                        report.add("outlines", "sheet %s: parts %s and %s overlap" % (sheet, placed_parts[a][0],
-                                                                                     placed_parts[b][0]))
+                if inside(outlines[a], *interiors[b]) or inside(outlines[b], *interiors[a]):
+                    reported.add((a, b))
+                    report.add("outlines", "sheet %s: parts %s and %s overlap" % (sheet, placed_parts[a][0],
+                                                                                 placed_parts[b][0]))
     return report, n, glued
 
 
@@ -297,6 +335,17 @@ def selftest():
         ("an outline crossing itself", woven(twisted=True), {"outlines": 1}),
         ("a hole near its outline", woven(near=True), {"holes": 1, "aligned": 1}),
     ]
+    turned = woven()
+    # Panel 2 turned a quarter about its origin: [0, 2] x [0, 2] goes to [-2, 0] x [0, 2], then moved by 4: onto panel 1.
+    turned["panels"][1]["placement"] = {"x": 4.5, "y": 0, "rotation": 90}
+    cases.append(("a turned panel overlapping another", turned, {"outlines": 1}))
+    nested = woven()
+    nested["panels"][1]["outline"] = square(0.5, 0.5, 1)
+    nested["panels"][1]["holes"] = [{"edge": e, "xy": xy, "diameter": 0.05} for e, xy in
+                                    [(1, (0.75, 1.0)), (1, (1.25, 1.0)), (2, (0.75, 1.2)), (2, (1.25, 1.2)),
+                                     (3, (0.75, 0.8)), (3, (1.25, 0.8))]]
+    nested["panels"][1]["placement"] = {"x": 3, "y": 0, "rotation": 0}
+    cases.append(("a panel wholly inside another", nested, {"outlines": 1, "aligned": 3}))
     bad_labels = woven()
     bad_labels["panels"][0]["labels"] = [l for l in bad_labels["panels"][0]["labels"] if l["role"] != "up"]
     cases.append(("an up number missing", bad_labels, {"labels": 1}))
@@ -315,7 +364,8 @@ def main(argv):
     if "--selftest" in argv:
         return selftest()
     args = [a for a in argv if not a.startswith("--")]
-    if len(args) != 1:
+    unknown = [a for a in argv if a.startswith("--") and a not in ("--allow-glue", "--json")]
+    if len(args) != 1 or unknown:
         print("usage: weavecheck.py OUT_DIR_OR_MANIFEST [--allow-glue] [--json] | --selftest", file=sys.stderr)
         return 2
     path = args[0]
@@ -324,8 +374,10 @@ def main(argv):
     try:
         with open(path) as f:
             manifest = json.load(f)
+        if manifest.get("structure") != "weave":
+            raise ValueError("its structure is %r, not \"weave\"" % manifest.get("structure"))
         report, panels, glued = check(manifest, allow_glue="--allow-glue" in argv)
-    except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
+    except (OSError, ValueError, KeyError, TypeError, IndexError, AttributeError) as e:
         print("weavecheck: %s: cannot read the manifest: %s" % (path, e), file=sys.stderr)
         return 2
     if "--json" in argv:

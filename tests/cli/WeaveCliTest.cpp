@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -182,12 +183,13 @@ TEST(WeaveCli, TheSoccerBallIsNinetyPanelsOfTenThreadsWithSpecsWovenManifest) {
 
 // The independent checker of woven manifests (tools/weavecheck.py) finds
 // each kind of problem in its hand-made manifests: a glued crossing, holes
-// not aligned, panels overlapping, an outline crossing itself, a hole near
-// its outline, an up number missing.
+// not aligned, panels overlapping (one turned onto another, one wholly
+// inside another), an outline crossing itself, a hole near its outline,
+// an up number missing.
 TEST(WeaveCli, TheIndependentCheckerFindsEachKindOfProblem) {
   const CommandResult selftest = run("python3 " + quoted(kSource / "tools/weavecheck.py") + " --selftest");
   EXPECT_EQ(selftest.status, 0) << selftest.out << selftest.err;
-  EXPECT_NE(selftest.out.find("7 passed, 0 failed"), std::string::npos) << selftest.out;
+  EXPECT_NE(selftest.out.find("9 passed, 0 failed"), std::string::npos) << selftest.out;
 }
 
 TEST(WeaveCli, ASingleCycleWeaveIsOneThread) {
@@ -203,6 +205,9 @@ TEST(WeaveCli, ASingleCycleWeaveIsOneThread) {
     const int faces = nlohmann::json::parse(inspected.out).at("faces");
     // A spanning tree of the dual: one edge fewer than faces, each crossed over once.
     EXPECT_EQ(expectWovenManifest(m, static_cast<size_t>(faces - 1)), std::set<int>{1});
+    // (A panel there may be two of a crossing's three: under, then over, one edge.)
+    const CommandResult checked = run("python3 " + quoted(kSource / "tools/weavecheck.py") + " " + quoted(out));
+    EXPECT_EQ(checked.status, 0) << checked.out << checked.err;
   }
 }
 
@@ -224,6 +229,23 @@ TEST(WeaveCli, AnOpenMeshIsFilledByDefaultAndKeepingItsHolesIsRefused) {
   EXPECT_NE(refused.err.find("the surface is open (1 boundary loop); --holes fill or patch builds it"),
             std::string::npos)
       << refused.err;
+}
+
+// --size is the woven structure's largest side as built (its ribbons stand
+// off the surface and round its corners), within half a percent, as for
+// the band structure; the files say the size the builders will get.
+TEST(WeaveCli, TheSizeAskedIsTheWovenStructuresLargestSideAsBuilt) {
+  TempDir dir;
+  for (const char* mesh : {"genus2.obj", "torus.obj"}) {
+    SCOPED_TRACE(mesh);
+    const auto out = dir.path() / mesh;
+    const CommandResult made = run(kCli + " make " + quoted(kSource / "examples" / mesh) +
+                                   " --structure weave --size 24in --layout rows --out " + quoted(out));
+    ASSERT_EQ(made.status, 0) << made.err;
+    const auto size = nlohmann::json::parse(readFile(out / "manifest.json")).at("size");
+    const double largest = std::max({size[0].get<double>(), size[1].get<double>(), size[2].get<double>()});
+    EXPECT_NEAR(largest, 24.0, 24.0 * 0.005) << size.dump();
+  }
 }
 
 // What the manifest lacks, make said: the crossings glued (edge numbers
