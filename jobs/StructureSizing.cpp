@@ -64,6 +64,7 @@ constexpr int kStalledRounds = 5;
 constexpr double kMostMendedShare = 0.4;
 // --size is kept within this share.
 constexpr double kSizeTolerance = 0.005;
+bool withinSizeTolerance(double side, double size) { return std::abs(side / size - 1) <= kSizeTolerance; }
 
 // --size is the structure's largest side (docs/CONTRACT.md, "Units and
 // scale"), and the structure is smaller than the mesh (its vertex bands are
@@ -282,7 +283,7 @@ class MendingBuild {
   bool resizedAfterMending(const geometry::Structure& structure) {
     if (!request_.size || mends_.count() == 0 || resized_) return false;
     const double side = builtSize(structure).maxCoeff();
-    if (!(side > 0) || std::abs(side / *request_.size - 1) <= kSizeTolerance) return false;
+    if (!(side > 0) || withinSizeTolerance(side, *request_.size)) return false;
     for (geometry::Point3& p : mesh_.positions) p *= *request_.size / side;
     resized_ = true;
     return true;
@@ -508,7 +509,7 @@ geometry::Structure wovenAtSize(const MakeRequest& request, geometry::PolygonMes
   geometry::Structure structure = geometry::buildWeaveStructure(mesh, weave, context);
   for (int resize = 0;; ++resize) {
     const double side = builtSize(structure).maxCoeff();
-    if (!(side > 0) || std::abs(side / size - 1) <= kSizeTolerance) break;
+    if (!(side > 0) || withinSizeTolerance(side, size)) break;
     if (resize == kMostResizes) {
       // (Not met on any of CGAL's 67 meshes woven at --panels 400 --size 36in: docs/PERFORMANCE.md.)
       const core::LengthUnit unit = request.shownIn;
