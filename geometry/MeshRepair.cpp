@@ -252,15 +252,19 @@ std::string MeshRepair::line(core::LengthUnit unit) const {
     what = fmt::format("collapsed {} face{} of zero area (collinear corners) into {} neighbours", count, one ? "" : "s",
                        one ? "its" : "their");
   } else if (kind == "merge-narrow-band") {
-    what =
-        fmt::format("merged the two faces beside {} band{} too narrow for a fastener or its number into one panel each",
-                    count, one ? "" : "s");
+    what = fmt::format(
+        "merged the two faces beside {} edge{} whose band or crossing was too narrow for a fastener or "
+        "its number into one face each",
+        count, one ? "" : "s");
   } else if (kind == "flip-narrow-band") {
-    what = fmt::format("flipped {} edge{} of a sliver beside a band too narrow for a fastener or its number", count,
-                       one ? "" : "s");
+    what =
+        fmt::format("flipped {} edge{} of a sliver beside a band or crossing too narrow for a fastener or its number",
+                    count, one ? "" : "s");
   } else if (kind == "collapse-short-edge") {
-    what = fmt::format("collapsed {} short edge{} or sliver{} whose band had no room for a fastener or its number",
-                       count, one ? "" : "s", one ? "" : "s");
+    what = fmt::format(
+        "collapsed {} short edge{} or sliver{} whose band or crossing had no room for a fastener or "
+        "its number",
+        count, one ? "" : "s", one ? "" : "s");
   } else {
     what = fmt::format("{}: {}", kind, count);
   }

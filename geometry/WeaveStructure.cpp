@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -83,6 +84,16 @@ struct WovenRibbons {
   RibbonCollisions collisions;
   int narrowed = 0;
   std::vector<WovenPanel> woven;
+  // Per edge (crossing), its two vertices in the mesh woven: where the
+  // design is mended when the crossing has no room (MeshMending.h).
+  std::vector<std::array<int, 2>> edgeEnds;
+
+  // `error` with the mesh vertices of its crossings' edges (`edges`: indices of regions).
+  [[nodiscard]] NoRoomForHoleError withPlaces(NoRoomForHoleError error, const std::vector<int>& edges) const {
+    error.places.clear();
+    for (int e : edges) error.places.push_back(edgeEnds[static_cast<size_t>(e)]);
+    return error;
+  }
 };
 
 WovenRibbons ribbonsOf(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context) {
@@ -92,6 +103,10 @@ WovenRibbons ribbonsOf(const PolygonMesh& mesh, const WeaveOptions& options, con
   twistForWeave(rs, options.cycles, lowestFace(mesh, options.up));
   out.weave = traceThreads(rs);
   out.regions = edgeRegions(mesh, rs);
+  out.edgeEnds.resize(out.regions.size());
+  for (size_t e = 0; e < out.regions.size(); ++e) {
+    out.edgeEnds[e] = {rs.origin(2 * static_cast<int>(e)), rs.target(2 * static_cast<int>(e))};
+  }
   context.check();
   context.report({"geometry", "ribbons", 0, 0});
   if (options.narrowWhereRibbonsMeet) {
@@ -167,27 +182,28 @@ std::vector<CrossingPanels> crossingPanelsOf(const std::vector<WovenPanel>& wove
   return crossings;
 }
 
-// Whether each crossing's holes have room: those without are glued when
-// asked (or when one crossing in a hundred at most, as a band
-// decomposition may glue a few bands in MakeJob's sizing, rather than the
-// whole structure grow for a sliver), else the mesh must grow
-// (NoRoomForHoleError, with the scale all but those need); single and
+// Whether each crossing's holes have room: those without are glued only
+// when asked (--glue-narrow: a builder glues them), else the weave is
+// refused there (NoRoomForHoleError, with the scale that gives every one
+// room, and the crossings' edges, where make mends the design); single and
 // narrow holes are warned of. Returns the crossings glued (1).
 std::vector<char> judgeRoomForHoles(const std::vector<CrossingHoles>& holes,
-                                    const std::vector<CrossingPanels>& crossings, const std::vector<int>& edgeNumber,
-                                    const WeaveOptions& options, Structure& result) {
+                                    const std::vector<CrossingPanels>& crossings, const WovenRibbons& w,
+                                    const std::vector<int>& edgeNumber, const WeaveOptions& options,
+                                    Structure& result) {
   const double d = options.fastener;
   const size_t crossingCount = holes.size();
   std::vector<char> glued(crossingCount, 0);
-  int withoutRoom = 0, narrow = 0, single = 0;
+  int narrow = 0, single = 0;
   double scaleNeeded = 1, narrowest = kClearance;
   int first = 0, narrowestEdge = 0;
   std::vector<double> scales;
+  std::vector<int> withoutRoom;  // indices of regions
   for (size_t e = 0; e < crossingCount; ++e) {
     if (crossings[e].panel[0] < 0) continue;
     const double c = holes[e].clearance;
     if (c < kLeastClearance) {
-      ++withoutRoom;
+      withoutRoom.push_back(static_cast<int>(e));
       const double scale = holes[e].scaleNeeded();
       scales.push_back(scale);
       if (first == 0 || scale > scaleNeeded) first = edgeNumber[e];
@@ -199,38 +215,33 @@ std::vector<char> judgeRoomForHoles(const std::vector<CrossingHoles>& holes,
       if (c < narrowest) narrowest = c, narrowestEdge = edgeNumber[e];
     }
   }
-  const size_t mayGlue = static_cast<size_t>(result.edges) / 100;
-  if (withoutRoom > 0 && (options.glueCrossingsWithoutRoom || static_cast<size_t>(withoutRoom) <= mayGlue)) {
-    for (size_t e = 0; e < crossingCount; ++e) {
-      if (crossings[e].panel[0] >= 0 && holes[e].clearance < kLeastClearance) {
-        glued[e] = 1;
-        result.glued.push_back(edgeNumber[e]);
-      }
+  const auto count = static_cast<int>(withoutRoom.size());
+  if (count > 0 && options.glueCrossingsWithoutRoom) {
+    for (int e : withoutRoom) {
+      glued[static_cast<size_t>(e)] = 1;
+      result.glued.push_back(edgeNumber[static_cast<size_t>(e)]);
     }
     std::sort(result.glued.begin(), result.glued.end());
     std::string some;
     for (size_t i = 0; i < std::min<size_t>(result.glued.size(), 5); ++i) {
       some += fmt::format("{}{}", i ? ", " : "", result.glued[i]);
     }
-    result.warnings.push_back(fmt::format(
-        "{} crossing{} no room for a {} fastener hole {:g} diameter from its panels' outlines, so no "
-        "hole: glue {} (edge{} {}{})",
-        withoutRoom, withoutRoom == 1 ? " has" : "s have", options.names.unit(d, 3), kLeastClearance,
-        withoutRoom == 1 ? "it" : "them", withoutRoom == 1 ? "" : "s", some, result.glued.size() > 5 ? ", ..." : ""));
-    withoutRoom = 0;
-  }
-  if (withoutRoom > 0) {
+    result.warnings.push_back(
+        fmt::format("{} crossing{} no room for a {} fastener hole {:g} diameter from its panels' outlines, so no "
+                    "hole: glue {} (edge{} {}{})",
+                    count, count == 1 ? " has" : "s have", options.names.unit(d, 3), kLeastClearance,
+                    count == 1 ? "it" : "them", count == 1 ? "" : "s", some, result.glued.size() > 5 ? ", ..." : ""));
+  } else if (count > 0) {
     std::sort(scales.begin(), scales.end(), std::greater<>());
-    scaleNeeded = scales[std::min(mayGlue, scales.size() - 1)];
     NoRoomForHoleError error(
         fmt::format("edge {}: its crossing has no room for two {} holes {:g} diameter from the outlines of "
                     "its three panels{}",
                     first, options.names.unit(d, 3), kLeastClearance,
-                    withoutRoom > 1 ? fmt::format(" (nor have {} other crossings)", withoutRoom - 1) : ""),
+                    count > 1 ? fmt::format(" (nor have {} other crossings)", count - 1) : ""),
         1, scaleNeeded, d, options.names);
-    error.bands = withoutRoom;
+    error.bands = count;
     error.scales = scales;
-    throw error;
+    throw w.withPlaces(error, withoutRoom);
   }
   if (single > 0) {
     result.warnings.push_back(
@@ -297,15 +308,17 @@ Panel panelOf(const WeaveLayout& layout, size_t k) {
 // middle, each down edge's at its end, all reading along the thread; the
 // neighbouring edge's number underlined beside the middle one
 // (docs/WEAVE.md, 1.12, A12). Returns the rows the labels lie on; names
-// those that do not fit in `unfitted`.
-std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, std::vector<std::string>& unfitted) {
+// those that do not fit in `unfitted`, and the crossings (indices of
+// regions) they belong at in `unfittedAt`.
+std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, std::vector<std::string>& unfitted,
+                            std::vector<int>& unfittedAt) {
   const WovenPanel& w = layout.w.woven[i];
   const int reach = layout.reach;
   std::vector<Circle> circles;
   for (const PanelHole& hole : panel.holes) circles.push_back({hole.xy, hole.diameter / 2});
   std::vector<TextBox> taken;
   std::vector<int> labelRows;
-  const auto place = [&](const std::string& label, int edge, LabelRole role, int row, int first, int last,
+  const auto place = [&](const std::string& label, int edge, int crossing, LabelRole role, int row, int first, int last,
                          const std::vector<Point2>& candidates) {
     const std::vector<Point2> region = w.outlineOfRows(std::max(first, 0), std::min(last, w.rows() - 1));
     const std::string text = labelText(label);
@@ -313,6 +326,7 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
                              circles, taken, candidates);
     if (!box) {
       unfitted.push_back(fmt::format("{} {} on panel {}", roleName(role), label, panel.id));
+      unfittedAt.push_back(crossing);
       return;
     }
     taken.push_back(*box);
@@ -343,7 +357,7 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
         if (row >= 0 && row < w.rows()) rows.push_back(row);
       }
     }
-    place(std::to_string(panel.id), panel.id, LabelRole::Up, u, u - reach, u + reach,
+    place(std::to_string(panel.id), panel.id, w.upEdge, LabelRole::Up, u, u - reach, u + reach,
           weaving::labelCandidates(w, rows));
   }
   // The neighbouring edge: the panel under this one met first turning
@@ -361,7 +375,7 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
     std::vector<int> rows = weaving::rowsFrom(w, u + 1, u + reach);
     const auto other = weaving::rowsFrom(w, u - 1, u - reach);
     rows.insert(rows.end(), other.begin(), other.end());
-    place(std::to_string(neighbour), neighbour, LabelRole::Neighbor, u, u - reach, u + reach,
+    place(std::to_string(neighbour), neighbour, w.upEdge, LabelRole::Neighbor, u, u - reach, u + reach,
           weaving::labelCandidates(w, rows));
   }
   for (int end = 0; end < 2; ++end) {
@@ -372,18 +386,22 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
     std::vector<int> rows = weaving::rowsFrom(w, row + outwards, row + outwards * reach);
     const auto inwards = weaving::rowsFrom(w, row - outwards, row - outwards * reach);
     rows.insert(rows.end(), inwards.begin(), inwards.end());
-    place(std::to_string(number), number, LabelRole::Down, row, row - reach, row + reach,
-          weaving::labelCandidates(w, rows));
+    place(std::to_string(number), number, w.downEdges[static_cast<size_t>(end)], LabelRole::Down, row, row - reach,
+          row + reach, weaving::labelCandidates(w, rows));
   }
   return labelRows;
 }
 
-// Labels that did not fit, and panels that fold over themselves even cut
-// in three (refused: nobody could cut and build them) or were cut apart.
-void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf, const std::vector<char>& stillFolded,
-                 const PolygonMesh& mesh, const WeaveOptions& options, Structure& result) {
-  if (auto warning = unetchedLabelsWarning(unfittedOf, "ribbon", options.names.unit))
-    result.warnings.push_back(std::move(*warning));
+// Panels that fold over themselves even cut in three (refused: nobody
+// could cut and build them), labels that did not fit, and panels cut
+// apart. A label that fits nowhere leaves a panel nobody can place (IV.4:
+// the builders find each panel's place by its numbers), so its crossings
+// have no room as a hole's do (NoRoomForHoleError::forLabels(), mended or
+// refused by make); only with glue asked for is it warned of instead.
+void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf,
+                 const std::vector<std::vector<int>>& unfittedAt, const std::vector<char>& stillFolded,
+                 const PolygonMesh& mesh, const WovenRibbons& w, const std::vector<int>& edgeNumber,
+                 const WeaveOptions& options, Structure& result) {
   std::vector<int> overlapping;
   for (size_t k = 0; k < result.panels.size(); ++k) {
     if (stillFolded[k]) overlapping.push_back(result.panels[k].id);
@@ -394,7 +412,7 @@ void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf, const 
     // Not a panel anyone could cut and build: its ribbon folds over
     // itself, mostly where it turns about a thin face's sharp corner
     // more tightly than it is wide, and no cut across it unfolds it.
-    throw std::invalid_argument(fmt::format(
+    throw UnfoldOverlapError(fmt::format(
         "panel{} {}{} would fold over {} when unfolded, even cut in three: {} ribbon turns about a face's corner "
         "more sharply than it is wide (thin faces); simplifying the mesh to fewer, evener faces ({} N, fewer than "
         "its {}) may weave it",
@@ -402,6 +420,25 @@ void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf, const 
         overlapping.size() == 1 ? "itself" : "themselves", overlapping.size() == 1 ? "its" : "each",
         options.names(Parameter::Panels), mesh.faceCount()));
   }
+  std::set<int> crossings;  // indices of regions
+  int firstAt = -1;
+  std::string first;
+  for (size_t i = 0; i < unfittedAt.size(); ++i) {
+    crossings.insert(unfittedAt[i].begin(), unfittedAt[i].end());
+    if (firstAt < 0 && !unfittedAt[i].empty()) firstAt = unfittedAt[i].front(), first = unfittedOf[i].front();
+  }
+  if (!crossings.empty() && !options.glueCrossingsWithoutRoom) {
+    const auto count = static_cast<int>(crossings.size());
+    NoRoomForHoleError error = NoRoomForHoleError::forLabels(
+        fmt::format("edge {}: label {} fits nowhere on its ribbon, even at {}{}",
+                    edgeNumber[static_cast<size_t>(firstAt)], first, options.names.unit(kSmallestLabel, 3),
+                    count > 1 ? fmt::format(" (nor do labels at {} other crossings)", count - 1) : ""),
+        1, options.names);
+    error.bands = count;
+    throw w.withPlaces(error, std::vector<int>(crossings.begin(), crossings.end()));
+  }
+  if (auto warning = unetchedLabelsWarning(unfittedOf, "ribbon", options.names.unit))
+    result.warnings.push_back(std::move(*warning));
   size_t pieces = 0, cut = 0;
   for (const Panel& panel : result.panels) {
     pieces += panel.pieces.size();
@@ -538,7 +575,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     shape.width = w.edgeWidths[e];
     holes[e] = weaving::placeCrossingHoles(w.regions[e], crossings[e], woven, outlines, shape, d);
   });
-  const std::vector<char> glued = judgeRoomForHoles(holes, crossings, numbering.edgeNumber, options, result);
+  const std::vector<char> glued = judgeRoomForHoles(holes, crossings, w, numbering.edgeNumber, options, result);
   context.check();
 
   // Per panel, its holes: two (or one) at each of its three crossings.
@@ -560,18 +597,21 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   const WeaveLayout layout{w, numbering, crossings, outlines, holesOf, font, std::max(1, options.shape.samples / 2)};
   result.panels.resize(woven.size());
   std::vector<std::vector<std::string>> unfittedOf(woven.size());
-  std::vector<char> stillFolded(woven.size(), 0);  // per panel: crosses itself even cut
+  std::vector<std::vector<int>> unfittedAt(woven.size());  // each label's crossing
+  std::vector<char> stillFolded(woven.size(), 0);          // per panel: crosses itself even cut
   context.parallelFor(numbering.order.size(), [&](size_t k) {
     const size_t i = static_cast<size_t>(numbering.order[k]);
     Panel panel = panelOf(layout, k);
-    const std::vector<int> labelRows = labelPanel(layout, i, panel, unfittedOf[i]);
+    const std::vector<int> labelRows = labelPanel(layout, i, panel, unfittedOf[i], unfittedAt[i]);
     if (core::crossesItself(panel.outline)) {
       weaving::cutApart(woven[i], panel, holeRowsOf[i], labelRows, d, font, unfittedOf[i]);
+      // (A piece's name belongs with the panel's own crossing.)
+      unfittedAt[i].resize(unfittedOf[i].size(), woven[i].upEdge);
       stillFolded[k] = core::crossesItself(panel.outline) ? 1 : 0;
     }
     result.panels[k] = std::move(panel);
   });
-  judgePanels(unfittedOf, stillFolded, mesh, options, result);
+  judgePanels(unfittedOf, unfittedAt, stillFolded, mesh, w, numbering.edgeNumber, options, result);
   judgeRibbons(w, numbering.edgeNumber, options, result);
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   result.fasteners = 0;

@@ -31,9 +31,9 @@ struct WeaveOptions {
   // warn of them.
   bool narrowWhereRibbonsMeet = true;
   double fastener = 0.125;  // hole diameter, inches
-  // Glue every crossing without room for its holes (with a warning), not
-  // only one in a hundred: when the size at which they have room would not
-  // fit the bed (MakeJob's sizing, as a band decomposition's).
+  // Glue every crossing without room for its holes (with a warning), and
+  // leave off the labels that fit nowhere (warned of), rather than throw
+  // NoRoomForHoleError: --glue-narrow, and the measuring build of --size.
   bool glueCrossingsWithoutRoom = false;
   int up = 1;  // the vertical axis for "lowest": 0 x, 1 y, 2 z
   ParameterNames names = parameterInWords;
@@ -44,8 +44,10 @@ struct WeaveOptions {
 // The first thread is the one over the lowest crossing, then each time the
 // thread that crosses most of the threads placed; each from its lowest
 // crossing over onwards. Throws InvalidMeshError or std::invalid_argument
-// (NoRoomForHoleError when a crossing has no room for its two holes) with
-// one line, and core::Cancelled. Progress: phase "geometry", steps "weaving
+// (NoRoomForHoleError when a crossing has no room for even one hole, or a
+// label of it none on its ribbon, with the mesh vertices of those
+// crossings' edges in `places`; UnfoldOverlapError when a panel would fold
+// over itself even cut in three) with one line, and core::Cancelled. Progress: phase "geometry", steps "weaving
 // threads", "ribbons", "crossing holes" (of the crossings), "labels" (of the
 // panels).
 Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& options, const core::WorkContext& context);

@@ -47,7 +47,6 @@ class Lap {
 
 using making::builtSize;
 using making::builtStructure;
-using making::builtWeave;
 using making::importedMesh;
 using making::oneFaceCapAdvice;
 using making::Sizing;
@@ -132,7 +131,7 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format(
         "{}: {}{}{}", name, error.what(),
-        sizing.grown > 1 && !sizing.bedLimited
+        sizing.grown > 1
             ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
                           "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
                           sizing.grown, request.structure == geometry::StructureKind::Weave ? "crossing" : "band",

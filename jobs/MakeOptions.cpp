@@ -215,15 +215,14 @@ const std::vector<MakeOption>& makeOptionTable() {
       MakeOption("score-folds", V::Flag, "Score the folds between each vertex band and its bands", &M::scoreFolds)
           .only(OptionFor::Band),
       MakeOption("keep-faces", V::Flag,
-                 "Keep every face as drawn: a band with no room for its fastener stops the job, rather than its\n"
-                 "short edge or the sliver beside it being collapsed (a repair, listed in manifest.json)",
-                 &M::keepFaces)
-          .only(OptionFor::Band),
+                 "Keep every face as drawn: a band (or a weave's crossing) with no room for its fastener stops the\n"
+                 "job, rather than its short edge or the sliver beside it being collapsed (a repair, listed in\n"
+                 "manifest.json)",
+                 &M::keepFaces),
       MakeOption("glue-narrow", V::Flag,
-                 "Glue the bands that have no room for a fastener even after mending, rather than stop the job\n"
-                 "(manifest.txt lists them)",
-                 &M::glueNarrow)
-          .only(OptionFor::Band),
+                 "Glue the bands (or a weave's crossings) that have no room for a fastener even after mending,\n"
+                 "rather than stop the job (manifest.txt lists them)",
+                 &M::glueNarrow),
       MakeOption("time", V::Number,
                  "Nesting time budget in seconds, first layout included: the best layout found\n"
                  "by then is kept; parts the first layout has not reached by then go in rows (with a note)",

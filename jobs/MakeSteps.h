@@ -25,8 +25,7 @@ geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts
 
 // How the structure's size was chosen, when make chose it.
 struct Sizing {
-  double grown = 1;         // times the default size (1: as it was)
-  bool bedLimited = false;  // limited by the bed or by the narrowest bands, which are glued
+  double grown = 1;  // times the default size (1: as it was)
 };
 
 // The sides of the box of the structure as built (its panels in 3D).
@@ -37,21 +36,17 @@ geometry::Point3 builtSize(const geometry::Structure& structure);
 // neighbours or makes panels as wide as the hole, and a patch avoids it.
 std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh);
 
-// A plain-woven structure (dissertation ch. IV) of the mesh as built, at
-// the size asked (--size, the structure's largest side, within half a
-// percent; --scale exactly); with no size or scale given it grows until
-// every crossing has room for its two holes.
-geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
-                               const core::WorkContext& context);
-
-// A band structure (dissertation ch. V) of the mesh as built, at the size
-// asked (--size within half a percent, --scale exactly) or the default,
-// grown by at most 10% where that alone gives every band room for its
-// fastener. A band still without room has its short edge or a sliver beside
-// it collapsed (MeshMending.h; not with --keep-faces), recorded among
-// `built`'s repairs; where no mend gives it room, the bands are glued with
-// --glue-narrow, or make stops with the size and the fastener at which it
-// builds as drawn. `built.start`: the flood fill's first face.
+// The structure asked for, a band decomposition (dissertation ch. V) or a
+// plain-woven structure (ch. IV), of the mesh as built, at the size asked
+// (--size, the structure's largest side as built, within half a percent;
+// --scale exactly) or the default, grown by at most 10% where that alone
+// gives every band room for its fastener (every crossing for its holes).
+// A label that fits nowhere counts as its band or crossing without room. A band or crossing still
+// without room has its short edge or a sliver beside it collapsed
+// (MeshMending.h; not with --keep-faces), recorded among `built`'s
+// repairs; where no mend gives it room, it is glued with --glue-narrow, or
+// make stops with the size and the fastener at which it builds as drawn.
+// `built.start`: the band flood fill's first face.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
 
@@ -65,7 +60,7 @@ inline bool withinPanelCountTolerance(double panels, int asked) {
 
 // The mesh imported and its structure built, as make builds it (the import
 // and geometry phases; `job`'s mesh counts, structure and import seconds
-// filled in). With --panels N, a band structure whose panels are more than
+// filled in). With --panels N, a structure whose panels are more than
 // kPanelCountTolerance more or fewer than N (its mends collapse faces,
 // creases hold the remesh off its target) is remeshed once more, aiming off
 // by that share; one refused for bands without room is tried at nearby

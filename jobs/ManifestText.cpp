@@ -121,7 +121,7 @@ std::string describeJoins(const Step& step) {
   text += "join to ";
   for (size_t j = 0; j < step.step.joins.size(); ++j) {
     const geometry::AssemblyJoin& join = step.step.joins[j];
-    // A band with no room for a hole (the structure at the largest size that fits the bed) is glued.
+    // A band with no room for a hole, glued as --glue-narrow asks.
     text += join.fasteners == 0 ? fmt::format("{}panel {} at edge {} (glue it: no room for a fastener", j ? ", " : "",
                                               join.panel, join.edge)
                                 : fmt::format("{}panel {} at edge {} ({} fastener{}", j ? ", " : "", join.panel,

@@ -66,15 +66,78 @@ constexpr double kMostMendedShare = 0.4;
 constexpr double kSizeTolerance = 0.005;
 bool withinSizeTolerance(double side, double size) { return std::abs(side / size - 1) <= kSizeTolerance; }
 
-// --size is the structure's largest side (docs/CONTRACT.md, "Units and
-// scale"), and the structure is smaller than the mesh (its vertex bands are
-// cut back at the corners), by a ratio that does not depend on the scale:
-// measured on a first build (glued, so that no band's room stops it), then
-// the mesh scaled by it.
-void scaleToBuiltSize(geometry::PolygonMesh& mesh, double size, geometry::BandOptions band,
+// What make builds of the mesh: a band decomposition (ch. V) or a
+// plain-woven structure (ch. IV), with the options asked; the same sizing,
+// mends and refusals serve both. A band's room is its fastener's, a
+// crossing's its two holes'.
+class StructureBuilder {
+ public:
+  StructureBuilder(const MakeRequest& request, std::optional<int> start) : kind_(request.structure) {
+    const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
+    geometry::ParameterNames names = request.names;
+    names.unit = request.shownIn;
+    band_.tension = request.tension;
+    band_.samples = request.samples;
+    band_.fastener = fastener;
+    band_.start = start;
+    band_.up = request.up;
+    band_.scoreFolds = request.scoreFolds;
+    band_.names = names;
+    weave_.cycles = request.cycles;
+    // A width asked for is kept (and ribbons that meet at it are warned of);
+    // the default is the widest, narrowed where ribbons would meet.
+    weave_.shape.width = request.width.value_or(weave_.shape.width);
+    weave_.narrowWhereRibbonsMeet = !request.width;
+    weave_.shape.curve = request.curve;
+    weave_.shape.offset = request.offset.value_or(std::max(request.material.thickness / 2, kLeastOffset));
+    weave_.shape.samples = request.samples;
+    weave_.fastener = fastener;
+    weave_.up = request.up;
+    weave_.names = names;
+  }
+
+  [[nodiscard]] bool woven() const { return kind_ == geometry::StructureKind::Weave; }
+  // What has room or not: "band" or "crossing".
+  [[nodiscard]] const char* place() const { return woven() ? "crossing" : "band"; }
+  [[nodiscard]] double fastener() const { return woven() ? weave_.fastener : band_.fastener; }
+  void setFastener(double fastener) { (woven() ? weave_.fastener : band_.fastener) = fastener; }
+  // Places without room glued, not refused.
+  void setGlue(bool glue) { (woven() ? weave_.glueCrossingsWithoutRoom : band_.glueBandsWithoutRoom) = glue; }
+
+  [[nodiscard]] geometry::Structure build(const geometry::PolygonMesh& mesh, const core::WorkContext& context) const {
+    return woven() ? geometry::buildWeaveStructure(mesh, weave_, context)
+                   : geometry::buildBandStructure(mesh, band_, context);
+  }
+  // Grown until every place has room (growUntilRoom, Structure.h).
+  [[nodiscard]] geometry::GrownStructure buildWithRoom(geometry::PolygonMesh& mesh,
+                                                       const core::WorkContext& context) const {
+    return woven() ? geometry::buildWeaveStructureWithRoom(mesh, weave_, context)
+                   : geometry::buildBandStructureWithRoom(mesh, band_, context);
+  }
+
+ private:
+  geometry::StructureKind kind_;
+  geometry::BandOptions band_;
+  geometry::WeaveOptions weave_;
+};
+
+// --size is the structure's largest side as built (docs/CONTRACT.md,
+// "Units and scale"), not the mesh's: a band decomposition is smaller than
+// its mesh (its vertex bands are cut back at the corners), a weave's
+// ribbons stand off the surface by the offset and round its corners. The
+// mesh is scaled to the size, then measured on a first build (glued, so
+// that no place's room stops it) and scaled by the size over the side as
+// built. (The band's ratio does not depend on the scale; the weave's
+// depends a little, as its offset and the holes' clearance do not grow
+// with it: MendingBuild resizes it again until within kSizeTolerance.)
+void scaleToBuiltSize(geometry::PolygonMesh& mesh, double size, StructureBuilder builder,
                       const core::WorkContext& context) {
-  band.glueBandsWithoutRoom = true;
-  const double side = builtSize(geometry::buildBandStructure(mesh, band, context)).maxCoeff();
+  const double meshSide = geometry::boundingBoxSize(mesh).maxCoeff();
+  if (meshSide > 0) {
+    for (geometry::Point3& p : mesh.positions) p *= size / meshSide;
+  }
+  builder.setGlue(true);
+  const double side = builtSize(builder.build(mesh, context)).maxCoeff();
   if (side > 0) {
     for (geometry::Point3& p : mesh.positions) p *= size / side;
   }
@@ -120,8 +183,8 @@ double innerEdges(const geometry::PolygonMesh& mesh) {
   return sides / 2;
 }
 
-// What make says when bands have no room and no mend gives it: the size,
-// and the fastener at this size, at which every band of `mesh` (as drawn,
+// What make says when bands (or crossings) have no room and no mend gives
+// it: the size, and the fastener at this size, at which every one of `mesh` (as drawn,
 // before any mend) has room for its holes and its number, each found by
 // building it; where that size's panels miss the bed, the fastener alone.
 // (A smaller fastener is what a larger size is for the holes, every length
@@ -132,25 +195,26 @@ struct Advice {
   std::string text;
   bool tried = false;  // built, not estimated
 };
-Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, const geometry::BandOptions& band,
+Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh, const StructureBuilder& builder,
                    bool labels, const core::WorkContext& context) {
   const auto& names = request.names;
   const auto buildsWith = [&](double fastener) {
     if (!(fastener > 0)) return false;
-    geometry::BandOptions smaller = band;
-    smaller.fastener = fastener;
+    StructureBuilder smaller = builder;
+    smaller.setFastener(fastener);
     try {
-      geometry::buildBandStructure(mesh, smaller, context);
+      (void)smaller.build(mesh, context);
       return true;
-    } catch (const geometry::NoRoomForHoleError&) {
-      return false;
+    } catch (const std::invalid_argument&) {
+      return false;  // (no room, or a panel that folds over itself: not a way out either way)
     }
   };
   const std::string glue = labels ? std::string() : fmt::format("; {} glues them", names(Parameter::GlueNarrow));
+  const std::string place = builder.place();
   geometry::PolygonMesh larger = mesh;
   try {
-    const geometry::GrownStructure grown = geometry::buildBandStructureWithRoom(larger, band, context);
-    const double smaller = std::floor(band.fastener / grown.grown * 1000) / 1000;
+    const geometry::GrownStructure grown = builder.buildWithRoom(larger, context);
+    const double smaller = std::floor(builder.fastener() / grown.grown * 1000) / 1000;
     const double side = std::ceil(builtSize(grown.structure).maxCoeff());
     const core::LengthUnit unit = request.shownIn;
     const std::string size = fmt::format("{} {}", names(Parameter::Size), unit.value(side, 0, 1));
@@ -163,7 +227,7 @@ Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh
                             names(Parameter::Fastener), unit.value(smaller, 3, -1), unit(side, 0), glue),
                 true};
       }
-      return {fmt::format("at {} every band has room, but a panel is larger than the bed{}", unit(side, 0), glue)};
+      return {fmt::format("at {} every {} has room, but a panel is larger than the bed{}", unit(side, 0), place, glue)};
     }
     return {fastenerBuilds ? fmt::format("{} or larger builds it as drawn (tried), or {} {} at this size{}", size,
                                          names(Parameter::Fastener), unit.value(smaller, 3, -1), glue)
@@ -171,12 +235,14 @@ Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh
             true};
   } catch (const geometry::NoRoomForHoleError& error) {
     if (error.labels) return {"at no larger size tried did every number have room"};
-    return {roomAdvice(request, mesh, band.fastener, error.scaleNeeded, "band", true)};
+    return {roomAdvice(request, mesh, builder.fastener(), error.scaleNeeded, place, true)};
+  } catch (const std::invalid_argument&) {
+    return {};  // (larger, a panel folds over itself: make tries a panel count instead)
   }
 }
 
-// The band structure at the size asked or the default, mended where its
-// bands have no room (builtStructure(), MakeSteps.h).
+// The structure (band or weave) at the size asked or the default, mended
+// where its bands or crossings have no room (builtStructure(), MakeSteps.h).
 class MendingBuild {
  public:
   MendingBuild(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built, Sizing& sizing,
@@ -186,27 +252,19 @@ class MendingBuild {
         built_(built),
         sizing_(sizing),
         context_(context),
-        name_(request.mesh.string()) {
-    band_.tension = request.tension;
-    band_.samples = request.samples;
-    band_.fastener = request.fastener.value_or(request.material.fastenerDiameter);
-    band_.start = built.start;
-    band_.up = request.up;
-    band_.scoreFolds = request.scoreFolds;
-    band_.names = request.names;
-    band_.names.unit = request.shownIn;
-  }
+        name_(request.mesh.string()),
+        builder_(request, built.start) {}
 
   geometry::Structure build() {
-    if (request_.size) scaleToBuiltSize(mesh_, *request_.size, band_, context_);
+    if (request_.size) scaleToBuiltSize(mesh_, *request_.size, builder_, context_);
     asDrawn_ = mesh_;
     for (int round = 0;; ++round) {
       try {
-        geometry::Structure structure = geometry::buildBandStructure(mesh_, band_, context_);
-        if (resizedAfterMending(structure)) continue;
+        geometry::Structure structure = builder_.build(mesh_, context_);
+        if (resizedToTheSizeAsked(structure)) continue;
         return finished(std::move(structure));
       } catch (const geometry::NoRoomForHoleError& error) {
-        // The default size grows by at most kMostGrowth, where that alone gives every band room.
+        // The default size grows by at most kMostGrowth, where that alone gives every place room.
         const bool scaleChosen = !request_.size && !request_.scale;
         if (scaleChosen && round == 0 && !error.estimate && error.scaleNeeded <= kMostGrowth) {
           for (geometry::Point3& p : mesh_.positions) p *= error.scaleNeeded;
@@ -275,17 +333,32 @@ class MendingBuild {
     }
     unmended_ = Unmended{mesh_, mends_, error};
     if (!mendedWhereNarrow(mesh_, error, merges_, mends_)) return false;
-    context_.report({"geometry", "narrow bands mended", static_cast<size_t>(mends_.count()), 0});
+    context_.report(
+        {"geometry", fmt::format("narrow {}s mended", builder_.place()), static_cast<size_t>(mends_.count()), 0});
     return true;
   }
 
-  // A mend moves a few vertices, and may move the box's side a little: --size kept.
-  bool resizedAfterMending(const geometry::Structure& structure) {
-    if (!request_.size || mends_.count() == 0 || resized_) return false;
+  // --size kept within kSizeTolerance: a mend moves a few vertices, and
+  // may move the box's side a little; a weave's side as built depends a
+  // little on its scale. Resized at most kMostResizes times, then refused
+  // rather than built at another size (of no use to the builders; not met
+  // on any of CGAL's meshes woven at --panels 400 --size 36in,
+  // docs/PERFORMANCE.md).
+  bool resizedToTheSizeAsked(const geometry::Structure& structure) {
+    constexpr int kMostResizes = 3;
+    if (!request_.size) return false;
+    const double size = *request_.size;
     const double side = builtSize(structure).maxCoeff();
-    if (!(side > 0) || withinSizeTolerance(side, *request_.size)) return false;
-    for (geometry::Point3& p : mesh_.positions) p *= *request_.size / side;
-    resized_ = true;
+    if (!(side > 0) || withinSizeTolerance(side, size)) return false;
+    if (resizes_ == kMostResizes) {
+      const core::LengthUnit unit = request_.shownIn;
+      throw core::UserError(
+          fmt::format("{}: built, its largest side came out {}, not the {} asked, after {} "
+                      "resizes; {} sets the size of the mesh itself",
+                      name_, unit(side, 2), unit(size, 2), kMostResizes, request_.names(Parameter::Scale)));
+    }
+    for (geometry::Point3& p : mesh_.positions) p *= size / side;
+    ++resizes_;
     return true;
   }
 
@@ -293,26 +366,33 @@ class MendingBuild {
     if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, request_.shownIn, context_);
     if (sizing_.grown > 1) {
       const core::LengthUnit unit = request_.shownIn;
-      context_.note(
-          fmt::format("{}: scaled to a mean edge of {}, not {} ({:.0f}% larger, {} at its largest side): at "
-                      "that size every band has room for its {} fastener; {} or {} sets the size",
-                      name_, unit(geometry::kMeanEdgeInches * sizing_.grown, 2), unit(geometry::kMeanEdgeInches, 2),
-                      100 * (sizing_.grown - 1), unit(builtSize(structure).maxCoeff(), 1), unit(band_.fastener, 3),
-                      request_.names(Parameter::Size), request_.names(Parameter::Scale)));
+      context_.note(fmt::format(
+          "{}: scaled to a mean edge of {}, not {} ({:.0f}% larger, {} at its largest side): at "
+          "that size{} every {} has room for its {} fastener{}; {} or {} sets the size",
+          name_, unit(geometry::kMeanEdgeInches * sizing_.grown, 2), unit(geometry::kMeanEdgeInches, 2),
+          100 * (sizing_.grown - 1), unit(builtSize(structure).maxCoeff(), 1),
+          // (A weave's scale asked is an estimate, which mends may have made up.)
+          mends_.count() > 0 ? ", and its narrow places mended," : "", builder_.place(), unit(builder_.fastener(), 3),
+          builder_.woven() ? " holes" : "", request_.names(Parameter::Size), request_.names(Parameter::Scale)));
     }
     return structure;
   }
 
-  // Bands without room that no mend gives room: glued if asked, else the job refused with a way out.
+  // Places without room that no mend gives room: glued if asked, else the job refused with a way out.
   geometry::Structure withoutRoom(const geometry::NoRoomForHoleError& error) {
     const auto& names = request_.names;
     if (request_.glueNarrow) {
-      band_.glueBandsWithoutRoom = true;
-      geometry::Structure glued = finished(geometry::buildBandStructure(mesh_, band_, context_));
+      builder_.setGlue(true);
+      geometry::Structure built = builder_.build(mesh_, context_);
+      while (resizedToTheSizeAsked(built)) built = builder_.build(mesh_, context_);
+      geometry::Structure glued = finished(std::move(built));
       const size_t n = glued.glued.size();
-      glued.warnings.push_back(fmt::format("{} band{} without room for a {} fastener {} glued, as {} asks", n,
-                                           plural(static_cast<int>(n)), request_.shownIn(band_.fastener, 3),
-                                           n == 1 ? "is" : "are", names(Parameter::GlueNarrow)));
+      // (Where only labels had no room, the build's own warning names those left off.)
+      if (n > 0)
+        glued.warnings.push_back(fmt::format("{} {}{} without room for a {} fastener {} glued, as {} asks", n,
+                                             builder_.place(), plural(static_cast<int>(n)),
+                                             request_.shownIn(builder_.fastener(), 3), n == 1 ? "is" : "are",
+                                             names(Parameter::GlueNarrow)));
       return glued;
     }
     const std::string after = mends_.count() > 0   ? fmt::format(" after {} narrow place{} mended", mends_.count(),
@@ -321,7 +401,7 @@ class MendingBuild {
                                                    : std::string();
     // (make's own tries of a way out need only know that this one failed.)
     const Advice advice =
-        request_.adviseWayOut ? triedAdvice(request_, asDrawn_, band_, error.labels, context_) : Advice{};
+        request_.adviseWayOut ? triedAdvice(request_, asDrawn_, builder_, error.labels, context_) : Advice{};
     throw StructureRefused(name_, error.bandsWithoutRoom + after, advice.text, advice.tried);
   }
 
@@ -332,11 +412,12 @@ class MendingBuild {
   Sizing& sizing_;
   const core::WorkContext& context_;
   const std::string name_;
-  geometry::BandOptions band_;
+  StructureBuilder builder_;
   geometry::Mends mends_;
   std::optional<Unmended> unmended_;
   std::optional<geometry::NoRoomForHoleError> lastError_;
-  bool resized_ = false, mendsStopped_ = false, merges_ = true;
+  bool mendsStopped_ = false, merges_ = true;
+  int resizes_ = 0;
   // The fewest bands without room a round has left, and the rounds since.
   struct Progress {
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
@@ -355,13 +436,11 @@ geometry::PolygonMesh importedAndBuilt(const MakeRequest& request, PlannedJob& j
   job.seconds.import += std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
   context.check();
   side = geometry::boundingBoxSize(mesh).maxCoeff();
-  job.structure = request.structure == geometry::StructureKind::Weave
-                      ? builtWeave(request, mesh, sizing, context)
-                      : builtStructure(request, mesh, job.mesh, sizing, context);
+  job.structure = builtStructure(request, mesh, job.mesh, sizing, context);
   return mesh;
 }
 
-// One more build of `request`'s band structure, its remesh aiming at
+// One more build of `request`'s structure, its remesh aiming at
 // `faces`, quietly: what it says is kept in `said`. Empty where it is
 // refused. (Its import's seconds are added to `job`'s either way.)
 struct AnotherBuild {
@@ -433,7 +512,7 @@ std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& re
   return std::nullopt;
 }
 
-// A band structure built for --panels N with more than kPanelCountTolerance
+// A structure (band or weave) built for --panels N with more than kPanelCountTolerance
 // more or fewer panels than N (mends collapse faces, a remesh held by creases
 // misses its target): remeshed once more, aiming off by the share it missed,
 // and built again, quietly; that second build is kept where it comes nearer
@@ -445,19 +524,21 @@ geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, Planned
   const auto& count = job.mesh.panelCount;
   const int asked = request.panels.value_or(0);
   const auto built = static_cast<int>(job.structure.panels.size());
-  if (request.structure != geometry::StructureKind::Band || !request.panels || request.remeshFaces || !count ||
-      !count->remeshing.remeshed || built <= 0 || withinPanelCountTolerance(built, asked)) {
+  if (!request.panels || request.remeshFaces || !count || !count->remeshing.remeshed || built <= 0 ||
+      withinPanelCountTolerance(built, asked)) {
     first.sayOn(context);
     return mesh;
   }
-  // (The remesher's own count is near the target, not on it, where creases hold vertices.)
-  const auto faces = static_cast<int>(std::lround(static_cast<double>(asked) * asked / built));
+  // (The remesher's own count is near the target, not on it, where creases
+  // hold vertices; a band's panel is a face, a weave's an edge, its first
+  // aim two faces for three panels.)
+  const auto faces = static_cast<int>(std::lround(static_cast<double>(count->remeshing.asked) * asked / built));
   const core::SaidLater said;
   std::optional<AnotherBuild> second = anotherBuild(request, faces, job, said, context);
   const std::string name = request.mesh.string();
   if (second && std::abs(second->panels() - asked) < std::abs(built - asked)) {
     context.note(
-        fmt::format("{}: the even triangles aiming at {} gave {} panels as built: remeshed again, aiming at "
+        fmt::format("{}: the even triangles for {} panels gave {} panels as built: remeshed again, aiming at "
                     "{} faces, which gives {}",
                     name, asked, built, faces, second->panels()));
     return kept(std::move(*second), said, job, sizing, context);
@@ -489,115 +570,20 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
 
 namespace {
 
-// --size is the woven structure's largest side as built (docs/CONTRACT.md,
-// "Units and scale"), its ribbons in 3D, not the mesh's: they stand off
-// the surface by the offset and round its corners, by a share that
-// depends a little on the scale (the offset and the holes' clearance do
-// not grow with it). The mesh is scaled to the size, then by the size over
-// the side as built until that is within kSizeTolerance. A weave that
-// cannot be built at the size asked is refused (the caller's advice names
-// a size that may do), not built at another size: a size other than the
-// one asked is of no use to the builders.
-geometry::Structure wovenAtSize(const MakeRequest& request, geometry::PolygonMesh& mesh,
-                                const geometry::WeaveOptions& weave, const core::WorkContext& context) {
-  constexpr int kMostResizes = 3;
-  const double size = *request.size;
-  const double meshSide = geometry::boundingBoxSize(mesh).maxCoeff();
-  if (meshSide > 0) {
-    for (geometry::Point3& p : mesh.positions) p *= size / meshSide;
-  }
-  geometry::Structure structure = geometry::buildWeaveStructure(mesh, weave, context);
-  for (int resize = 0;; ++resize) {
-    const double side = builtSize(structure).maxCoeff();
-    if (!(side > 0) || withinSizeTolerance(side, size)) break;
-    if (resize == kMostResizes) {
-      // (Not met on any of CGAL's 67 meshes woven at --panels 400 --size 36in: docs/PERFORMANCE.md.)
-      const core::LengthUnit unit = request.shownIn;
-      throw core::UserError(fmt::format(
-          "{}: woven, its largest side came out {}, not the {} asked, after {} "
-          "resizes; {} sets the size of the mesh itself",
-          request.mesh.string(), unit(side, 2), unit(size, 2), kMostResizes, request.names(Parameter::Scale)));
-    }
-    for (geometry::Point3& p : mesh.positions) p *= size / side;
-    structure = {};  // (the next weave's memory in its place, not beside it)
-    structure = geometry::buildWeaveStructure(mesh, weave, context);
-  }
-  return structure;
-}
-
-}  // namespace
-
-geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, Sizing& sizing,
-                               const core::WorkContext& context) {
+// The weave's refusals say, where a face closes a hole, what closes it.
+geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
+                               Sizing& sizing, const core::WorkContext& context) {
   const std::string name = request.mesh.string();
-  geometry::WeaveOptions weave;
-  weave.cycles = request.cycles;
-  // A width asked for is kept (and ribbons that meet at it are warned of);
-  // the default is the widest, narrowed where ribbons would meet.
-  weave.shape.width = request.width.value_or(weave.shape.width);
-  weave.narrowWhereRibbonsMeet = !request.width;
-  weave.shape.curve = request.curve;
-  weave.shape.offset = request.offset.value_or(std::max(request.material.thickness / 2, kLeastOffset));
-  weave.shape.samples = request.samples;
-  weave.fastener = request.fastener.value_or(request.material.fastenerDiameter);
-  weave.up = request.up;
-  weave.names = request.names;
-  weave.names.unit = request.shownIn;
   try {
-    if (request.size) return wovenAtSize(request, mesh, weave, context);
-    if (request.scale) return geometry::buildWeaveStructure(mesh, weave, context);
-    geometry::GrownStructure built = geometry::buildWeaveStructureWithRoom(mesh, weave, context);
-    sizing.grown = built.grown;
-    const double kerf = request.kerf.value_or(request.material.kerf);
-    if (built.grown > 1 && roomOnTheBed(structureParts(built.structure), request.machine, kerf) < 1) {
-      // The size at which every crossing has room makes a panel larger than
-      // the bed (a mesh whose faces differ much in size): as for a band
-      // decomposition, the largest size that fits the bed, no smaller than
-      // the default, and the crossings without room there glued.
-      weave.glueCrossingsWithoutRoom = true;
-      constexpr int kShrinkAttempts = 3;
-      const double grownAtFirst = built.grown;
-      geometry::Structure glued = std::move(built.structure);
-      double room = roomOnTheBed(structureParts(glued), request.machine, kerf);
-      for (int attempt = 1; attempt <= kShrinkAttempts && room < 1; ++attempt) {
-        // (1% to spare: a label's size does not grow with the rest; never below the default size)
-        const double shrink = std::max(0.99 * room, 1 / sizing.grown);
-        if (!(shrink < 1)) break;
-        for (geometry::Point3& p : mesh.positions) p *= shrink;
-        sizing.grown *= shrink;
-        context.report({"geometry", "smaller, for the bed", static_cast<size_t>(attempt), 0});
-        glued = geometry::buildWeaveStructure(mesh, weave, context);
-        room = roomOnTheBed(structureParts(glued), request.machine, kerf);
-      }
-      // (Still over the bed: the planner's refusal names the panel, with the size advice.)
-      if (room < 1) return glued;
-      sizing.bedLimited = true;
-      const core::LengthUnit unit = request.shownIn;
-      context.note(
-          fmt::format("{}: scaled to a mean edge of {}, not {}, the largest size that fits the bed, below the {} "
-                      "at which every crossing has room for {} fastener holes; {} crossing{} without room {} glued; {} "
-                      "N, fewer and evener faces, needs less",
-                      name, unit(geometry::kMeanEdgeInches * sizing.grown, 2), unit(geometry::kMeanEdgeInches, 2),
-                      unit(geometry::kMeanEdgeInches * grownAtFirst, 2), unit(weave.fastener, 3), glued.glued.size(),
-                      plural(static_cast<int>(glued.glued.size())), glued.glued.size() == 1 ? "is" : "are",
-                      request.names(Parameter::Panels)));
-      return glued;
-    }
-    if (built.grown > 1) {
-      const core::LengthUnit unit = request.shownIn;
-      context.note(fmt::format(
-          "{}: scaled to a mean edge of {}, not {}, the smallest size at which its crossings have room "
-          "for {} fastener holes, all but one in a hundred ({} crossing{} had none at the default size); {} or "
-          "{} sets the size",
-          name, unit(geometry::kMeanEdgeInches * built.grown, 2), unit(geometry::kMeanEdgeInches, 2),
-          unit(weave.fastener, 3), built.bandsWithoutRoom, plural(built.bandsWithoutRoom),
-          request.names(Parameter::Size), request.names(Parameter::Scale)));
-    }
-    return std::move(built.structure);
+    return MendingBuild(request, mesh, built, sizing, context).build();
   } catch (const geometry::NoRoomForHoleError& error) {
-    // (An estimate: the ribbons' offset does not grow with the mesh.)
-    throw core::UserError(fmt::format("{}: {}; {}", name, error.bandsWithoutRoom,
-                                      roomAdvice(request, mesh, weave.fastener, error.scaleNeeded, "crossing", true)));
+    // (Not thrown once the mends are done, which refuse with a way out; as builtStructure's.)
+    const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
+    throw StructureRefused(name, error.bandsWithoutRoom,
+                           roomAdvice(request, mesh, fastener, error.scaleNeeded, "crossing", true), false);
+  } catch (const geometry::UnfoldOverlapError& error) {
+    // (Panels that fold over themselves: fewer, evener faces or a size may weave it.)
+    throw StructureRefused(name, error.what(), "", false);
   } catch (const geometry::FoldedEdgeError& error) {
     // Where one of the two faces closes a hole, say what closes it, and
     // that an open surface flat there has no inside to weave around.
@@ -624,11 +610,16 @@ geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh
             : std::string("with triangles that lie back against the surface beside it")));
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format("{}: {}{}", name, error.what(), oneFaceCapAdvice(request, mesh)));
+  } catch (const geometry::InvalidMeshError& error) {
+    throw core::UserError(fmt::format("{}: {}", name, error.what()));
   }
 }
 
+}  // namespace
+
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context) {
+  if (request.structure == geometry::StructureKind::Weave) return builtWeave(request, mesh, built, sizing, context);
   try {
     return MendingBuild(request, mesh, built, sizing, context).build();
   } catch (const geometry::NoRoomForHoleError& error) {
@@ -662,7 +653,9 @@ geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, 
     first.sayOn(context);
     // A refusal offers a way out that was built, never a guess.
     if (refused.tried || !refused.sizeMayHelp || !request.adviseWayOut) throw;
-    throw core::UserError(withTriedWayOut(request, refused, side, job.mesh.faces, context));
+    // (A band's panel is a face, a weave's an edge.)
+    const int panels = request.structure == geometry::StructureKind::Weave ? job.mesh.edges : job.mesh.faces;
+    throw core::UserError(withTriedWayOut(request, refused, side, panels, context));
   } catch (...) {
     first.sayOn(context);
     throw;

@@ -146,8 +146,9 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
     size_t built = 0;
     const Tried result = tryBuilding(changed, quiet, built);
     if (result == Tried::Builds) {
-      return fmt::format("{}: {}; {} builds it (tried: {} panels, every band fastened and every number etched)", name,
-                         refused.place, change.options(request), built);
+      return fmt::format("{}: {}; {} builds it (tried: {} panels, every {} fastened and every number etched)", name,
+                         refused.place, change.options(request), built,
+                         request.structure == geometry::StructureKind::Weave ? "crossing" : "band");
     }
     if (result == Tried::OffTheBed && change.size) offTheBedAt[panels] = *change.size;
     ++tries;
