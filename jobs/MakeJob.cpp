@@ -131,13 +131,12 @@ PlannedJob planJob(const MakeRequest& request, const core::WorkContext& context)
   } catch (const std::invalid_argument& error) {
     throw core::UserError(fmt::format(
         "{}: {}{}{}", name, error.what(),
-        sizing.grown > 1
-            ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
-                          "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
-                          sizing.grown, request.structure == geometry::StructureKind::Weave ? "crossing" : "band",
-                          request.structure == geometry::StructureKind::Weave ? " holes" : "",
-                          request.names(Parameter::Fastener), request.names(Parameter::Panels))
-            : "",
+        sizing.grown > 1 ? fmt::format(" at {:.2f} times the default size, the smallest at which every {} has room for "
+                                       "its fastener{}; a smaller {}, or fewer and evener faces ({} N), needs less",
+                                       sizing.grown, making::roomPlace(request.structure),
+                                       request.structure == geometry::StructureKind::Weave ? " holes" : "",
+                                       request.names(Parameter::Fastener), request.names(Parameter::Panels))
+                         : "",
         oneFaceCapAdvice(request, mesh)));
   }
   job.meshFile = request.mesh;

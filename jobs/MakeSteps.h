@@ -19,6 +19,12 @@ namespace rotafab::jobs::making {
 
 inline const char* plural(int n) { return n == 1 ? "" : "s"; }
 
+// What has room for its fastener, or not: a band decomposition's band, a
+// plain weave's crossing.
+inline const char* roomPlace(geometry::StructureKind kind) {
+  return kind == geometry::StructureKind::Weave ? "crossing" : "band";
+}
+
 // The mesh as read, checked, repaired, merged and remeshed as asked, its
 // holes filled if asked, at construction size; `counts` says what it was and what was done.
 geometry::PolygonMesh importedMesh(const MakeRequest& request, BuiltMesh& counts, const core::WorkContext& context);

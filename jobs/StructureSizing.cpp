@@ -97,8 +97,7 @@ class StructureBuilder {
   }
 
   [[nodiscard]] bool woven() const { return kind_ == geometry::StructureKind::Weave; }
-  // What has room or not: "band" or "crossing".
-  [[nodiscard]] const char* place() const { return woven() ? "crossing" : "band"; }
+  [[nodiscard]] const char* place() const { return roomPlace(kind_); }
   [[nodiscard]] double fastener() const { return woven() ? weave_.fastener : band_.fastener; }
   void setFastener(double fastener) { (woven() ? weave_.fastener : band_.fastener) = fastener; }
   // Places without room glued, not refused.
@@ -125,17 +124,14 @@ class StructureBuilder {
 // "Units and scale"), not the mesh's: a band decomposition is smaller than
 // its mesh (its vertex bands are cut back at the corners), a weave's
 // ribbons stand off the surface by the offset and round its corners. The
-// mesh is scaled to the size, then measured on a first build (glued, so
-// that no place's room stops it) and scaled by the size over the side as
+// mesh, scaled to the size, is measured on a first build (glued, so that
+// no place's room stops it) and scaled by the size over the side as
 // built. (The band's ratio does not depend on the scale; the weave's
 // depends a little, as its offset and the holes' clearance do not grow
 // with it: MendingBuild resizes it again until within kSizeTolerance.)
+// `mesh` comes at the size asked (constructionScale).
 void scaleToBuiltSize(geometry::PolygonMesh& mesh, double size, StructureBuilder builder,
                       const core::WorkContext& context) {
-  const double meshSide = geometry::boundingBoxSize(mesh).maxCoeff();
-  if (meshSide > 0) {
-    for (geometry::Point3& p : mesh.positions) p *= size / meshSide;
-  }
   builder.setGlue(true);
   const double side = builtSize(builder.build(mesh, context)).maxCoeff();
   if (side > 0) {
@@ -570,69 +566,62 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
 
 namespace {
 
-// The weave's refusals say, where a face closes a hole, what closes it.
-geometry::Structure builtWeave(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
-                               Sizing& sizing, const core::WorkContext& context) {
+// A weave refused at an edge whose two faces fold back onto each other:
+// where one of them closes a hole, what closes it, and that an open
+// surface flat there has no inside to weave around.
+std::string foldedEdgeRefusal(const MakeRequest& request, const geometry::PolygonMesh& mesh,
+                              const geometry::FoldedEdgeError& error) {
   const std::string name = request.mesh.string();
-  try {
-    return MendingBuild(request, mesh, built, sizing, context).build();
-  } catch (const geometry::NoRoomForHoleError& error) {
-    // (Not thrown once the mends are done, which refuse with a way out; as builtStructure's.)
-    const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
-    throw StructureRefused(name, error.bandsWithoutRoom,
-                           roomAdvice(request, mesh, fastener, error.scaleNeeded, "crossing", true), false);
-  } catch (const geometry::UnfoldOverlapError& error) {
-    // (Panels that fold over themselves: fewer, evener faces or a size may weave it.)
-    throw StructureRefused(name, error.what(), "", false);
-  } catch (const geometry::FoldedEdgeError& error) {
-    // Where one of the two faces closes a hole, say what closes it, and
-    // that an open surface flat there has no inside to weave around.
-    const auto closesAHole = [&](int face) {
-      return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
-             mesh.sourceFace[static_cast<size_t>(face)] == -1;
-    };
-    const int closing = (closesAHole(error.leftFace) ? 1 : 0) + (closesAHole(error.rightFace) ? 1 : 0);
-    if (closing == 0) throw core::UserError(fmt::format("{}: {}", name, error.what()));
-    if (closing == 2) {
-      throw core::UserError(
-          fmt::format("{}: {}: both close a hole, with triangles folded onto each other; an open "
-                      "surface that is flat about its hole has no inside to weave around",
-                      name, error.what()));
-    }
-    throw core::UserError(fmt::format(
-        "{}: {}: one of them closes a hole, {}; an open surface that is flat about its hole has no inside to weave "
-        "around with either",
-        name, error.what(),
-        request.holes == HolesMode::Fill
-            ? fmt::format("with one face ({} patch closes it with triangles like the mesh's own, which bend with a "
-                          "bent hole)",
-                          request.names(Parameter::Holes))
-            : std::string("with triangles that lie back against the surface beside it")));
-  } catch (const std::invalid_argument& error) {
-    throw core::UserError(fmt::format("{}: {}{}", name, error.what(), oneFaceCapAdvice(request, mesh)));
-  } catch (const geometry::InvalidMeshError& error) {
-    throw core::UserError(fmt::format("{}: {}", name, error.what()));
+  const auto closesAHole = [&](int face) {
+    return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
+           mesh.sourceFace[static_cast<size_t>(face)] == -1;
+  };
+  const int closing = (closesAHole(error.leftFace) ? 1 : 0) + (closesAHole(error.rightFace) ? 1 : 0);
+  if (closing == 0) return fmt::format("{}: {}", name, error.what());
+  if (closing == 2) {
+    return fmt::format(
+        "{}: {}: both close a hole, with triangles folded onto each other; an open "
+        "surface that is flat about its hole has no inside to weave around",
+        name, error.what());
   }
+  return fmt::format(
+      "{}: {}: one of them closes a hole, {}; an open surface that is flat about its hole has no inside to weave "
+      "around with either",
+      name, error.what(),
+      request.holes == HolesMode::Fill
+          ? fmt::format("with one face ({} patch closes it with triangles like the mesh's own, which bend with a "
+                        "bent hole)",
+                        request.names(Parameter::Holes))
+          : std::string("with triangles that lie back against the surface beside it"));
 }
 
 }  // namespace
 
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context) {
-  if (request.structure == geometry::StructureKind::Weave) return builtWeave(request, mesh, built, sizing, context);
+  const std::string name = request.mesh.string();
+  const bool woven = request.structure == geometry::StructureKind::Weave;
   try {
     return MendingBuild(request, mesh, built, sizing, context).build();
   } catch (const geometry::NoRoomForHoleError& error) {
-    // (The measuring build of --size glues; a tab's estimate may still be thrown.)
+    // (Not thrown once the mends are done, which refuse with a way out: the
+    // measuring build of --size glues, but a band's tab may still throw its
+    // estimate. A weave's scale asked is always one.)
     const double fastener = request.fastener.value_or(request.material.fastenerDiameter);
-    throw StructureRefused(request.mesh.string(), error.bandsWithoutRoom,
-                           roomAdvice(request, mesh, fastener, error.scaleNeeded, "band", error.estimate), false);
+    throw StructureRefused(
+        name, error.bandsWithoutRoom,
+        roomAdvice(request, mesh, fastener, error.scaleNeeded, roomPlace(request.structure), woven || error.estimate),
+        false);
   } catch (const geometry::UnfoldOverlapError& error) {
-    throw StructureRefused(request.mesh.string(), error.what(), "", false);
+    // (Panels that overlap or fold over themselves: fewer, evener faces or a size may build it.)
+    throw StructureRefused(name, error.what(), "", false);
+  } catch (const geometry::FoldedEdgeError& error) {
+    throw core::UserError(foldedEdgeRefusal(request, mesh, error));
   } catch (const std::invalid_argument& error) {
-    throw StructureRefused(request.mesh.string(), error.what(), "", false, false);
+    throw StructureRefused(name, error.what() + (woven ? oneFaceCapAdvice(request, mesh) : std::string()), "", false,
+                           false);
   } catch (const geometry::InvalidMeshError& error) {
-    throw StructureRefused(request.mesh.string(), error.what(), "", false, false);
+    throw StructureRefused(name, error.what(), "", false, false);
   }
 }
 

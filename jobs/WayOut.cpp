@@ -147,8 +147,7 @@ std::string withTriedWayOut(const MakeRequest& request, const StructureRefused& 
     const Tried result = tryBuilding(changed, quiet, built);
     if (result == Tried::Builds) {
       return fmt::format("{}: {}; {} builds it (tried: {} panels, every {} fastened and every number etched)", name,
-                         refused.place, change.options(request), built,
-                         request.structure == geometry::StructureKind::Weave ? "crossing" : "band");
+                         refused.place, change.options(request), built, roomPlace(request.structure));
     }
     if (result == Tried::OffTheBed && change.size) offTheBedAt[panels] = *change.size;
     ++tries;
