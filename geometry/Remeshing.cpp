@@ -476,6 +476,11 @@ class IsotropicRemesher {
     return false;
   }
 
+  bool joinedByAFeature(TriMesh::VertexHandle a, TriMesh::VertexHandle b) const {
+    const auto halfedge = tri_.find_halfedge(a, b);
+    return halfedge.is_valid() && tri_.status(tri_.edge_handle(halfedge)).feature();
+  }
+
   // (4) Each vertex moved toward the area-weighted centroid of its faces,
   // within its tangent plane; a feature vertex toward the middle of its two
   // feature neighbours; corners stay.
@@ -486,14 +491,16 @@ class IsotropicRemesher {
       const Point3 p = at(vertex);
       if (tri_.status(vertex).feature()) {
         Point3 sum = Point3::Zero();
-        int count = 0;
+        std::vector<TriMesh::VertexHandle> along;
         for (const auto out : tri_.voh_range(vertex)) {
           if (tri_.status(out.edge()).feature()) {
             sum += at(out.to());
-            ++count;
+            along.push_back(out.to());
           }
         }
-        if (count == 2) moved[vertex.idx()] = (p + sum / 2) / 2;
+        // (Three feature vertices joined in a loop stay: each relaxed toward
+        // the other two, the loop shrinks to a point, its faces to none.)
+        if (along.size() == 2 && !joinedByAFeature(along[0], along[1])) moved[vertex.idx()] = (p + sum / 2) / 2;
         continue;
       }
       Point3 centroid = Point3::Zero();

@@ -76,8 +76,19 @@ PanelCount remeshedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
   if (after.genus != before.genus || after.components != before.components ||
       after.boundaryLoops != before.boundaryLoops || !analysis.problems.empty()) {
     // No collapse breaks the link condition; this is the proof.
-    throw core::UserError(fmt::format("{}: remeshed to {} faces it would not keep its topology; build it without {}",
-                                      name, remeshing.facesAfter, request.names(Parameter::Panels)));
+    std::string what;
+    if (!analysis.problems.empty()) {
+      what = analysis.problems.front().message;
+    } else if (after.genus != before.genus) {
+      what = fmt::format("genus {}, not {}", after.genus.value_or(-1), before.genus.value_or(-1));
+    } else if (after.components != before.components) {
+      what = fmt::format("{} parts, not {}", after.components, before.components);
+    } else {
+      what = fmt::format("{} boundary loops, not {}", after.boundaryLoops, before.boundaryLoops);
+    }
+    throw core::UserError(
+        fmt::format("{}: remeshed to {} faces it would not keep its topology ({}); build it without {}", name,
+                    remeshing.facesAfter, what, request.names(Parameter::Panels)));
   }
   const double diagonal = geometry::boundingBoxDiagonal(mesh);
   context.note(fmt::format(

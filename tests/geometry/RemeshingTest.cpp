@@ -189,6 +189,20 @@ TEST(Remeshing, TheTorusKeepsItsHole) {
   EXPECT_GE(smallestOverMedian(mesh), 1.0 / 3);
 }
 
+// CGAL's machined parts at a weave's 400 panels: a crease that ends up a
+// loop of three vertices, each relaxed toward the other two, once shrank
+// to a point and left faces of no area (a usable mesh no more).
+TEST(Remeshing, MachinedPartsWithSmallCreaseLoopsStayUsable) {
+  for (const char* name : {"anchor.off", "handle.off", "couplingdown.off", "oblong.off"}) {
+    SCOPED_TRACE(name);
+    PolygonMesh original = importMesh(test::publicMesh(test::cgalMesh(name)).string()).mesh;
+    analyzeMesh(original);
+    PolygonMesh mesh = original;
+    remeshEvenly(mesh, 267, test::context());
+    expectSameTopology(original, mesh);
+  }
+}
+
 TEST(Remeshing, AMeshWithAboutTheFacesAskedIsKeptAsDrawn) {
   PolygonMesh mesh = torus(12, 12);  // 144 quads
   const PolygonMesh original = mesh;
