@@ -5,8 +5,10 @@
 // one panel per input face, flat and ready for the planner, in assembly
 // order, and the 3D surface of each for rendering (Structure.h).
 
+#include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "core/WorkContext.h"
 #include "geometry/Parameters.h"
@@ -35,6 +37,11 @@ struct BandOptions {
 class UnfoldOverlapError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
+  int panels = 1;  // how many fold
+  // Where a mend of the design may unfold them (a weave's: the two
+  // vertices of each folding panel's own edge, whose region a sliver beside
+  // it made thin, MeshMending.h); empty where none is known to.
+  std::vector<std::array<int, 2>> places;
 };
 
 // The mesh must be usable (analyzeMesh), already at construction size

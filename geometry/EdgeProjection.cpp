@@ -33,7 +33,7 @@ std::vector<EdgeRegion> edgeRegions(const PolygonMesh& mesh, const RotationSyste
     // Two faces folded flat onto each other, or a face of no area: no plane.
     if (!(across.norm() > 1e-6)) {
       throw FoldedEdgeError(name() + ": its two faces fold back onto each other, so no plane lies between them",
-                            static_cast<int>(left), static_cast<int>(right));
+                            static_cast<int>(left), static_cast<int>(right), std::array{vs, vt});
     }
     region.normal = across.normalized();
     const auto projected = [&](const Point3& p) {

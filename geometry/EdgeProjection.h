@@ -12,6 +12,7 @@
 // out, normalised. Eq. 4.15-4.16 give the projected centres relative to
 // the midpoint; here they are points.
 
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,9 +42,10 @@ struct EdgeRegion {
 // has nothing across the edge: no plane to project on); the faces' indices.
 class FoldedEdgeError : public std::invalid_argument {
  public:
-  FoldedEdgeError(const std::string& what, int leftFace, int rightFace)
-      : std::invalid_argument(what), leftFace(leftFace), rightFace(rightFace) {}
+  FoldedEdgeError(const std::string& what, int leftFace, int rightFace, std::array<int, 2> ends)
+      : std::invalid_argument(what), leftFace(leftFace), rightFace(rightFace), ends(ends) {}
   int leftFace, rightFace;
+  std::array<int, 2> ends;  // the edge's two vertices
 };
 
 // Per edge of `rs` (built from `mesh`). Throws FoldedEdgeError naming the

@@ -480,7 +480,7 @@ MeshRepair collapseDegenerateFaces(PolygonMesh& mesh) {
   return repair;
 }
 
-Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges) {
+Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges, bool flipsFirst) {
   Mends mends;
   MeshRepair& repair = mends.collapsed;
   MeshRepair& merged = mends.merged;
@@ -515,8 +515,9 @@ Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>&
     std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& p, const auto& q) {
       return collapser.length(p[0], p[1]) < collapser.length(q[0], q[1]);
     });
-    bool mended = collapsedOne(candidates);
-    if (!mended) mended = flippedNear(collapser, mesh, u, v, mends.flipped);
+    bool mended = flipsFirst && flippedNear(collapser, mesh, u, v, mends.flipped);
+    if (!mended) mended = collapsedOne(candidates);
+    if (!mended && !flipsFirst) mended = flippedNear(collapser, mesh, u, v, mends.flipped);
     if (!mended && merges && collapser.mayMerge(u, v)) {
       if (merged.count == 0)
         merged.first = fmt::format("edge ({}, {})", mesh.sourceVertexIndex(u), mesh.sourceVertexIndex(v));

@@ -68,6 +68,11 @@ MeshRepair collapseDegenerateFaces(PolygonMesh& mesh);
 // go, and vertices no face uses. Returns the mends (count 0: none could be
 // made), each "first" naming the first edge by its vertices in the file's
 // numbering.
-Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges = true);
+// With `flipsFirst`, the flip is tried before any collapse: a flip keeps
+// every vertex where it is, and a weave's crossing has room as its edge's
+// region is wide (its two face centres far from the edge, eq. 4.2-4.11),
+// which a flip toward the Delaunay triangulation gives it.
+Mends mendNarrowPlaces(PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges = true,
+                       bool flipsFirst = false);
 
 }  // namespace rotafab::geometry

@@ -89,7 +89,8 @@ struct WovenRibbons {
   std::vector<std::array<int, 2>> edgeEnds;
 
   // `error` with the mesh vertices of its crossings' edges (`edges`: indices of regions).
-  [[nodiscard]] NoRoomForHoleError withPlaces(NoRoomForHoleError error, const std::vector<int>& edges) const {
+  template <typename Error>
+  [[nodiscard]] Error withPlaces(Error error, const std::vector<int>& edges) const {
     error.places.clear();
     for (int e : edges) error.places.push_back(edgeEnds[static_cast<size_t>(e)]);
     return error;
@@ -400,11 +401,11 @@ std::vector<int> labelPanel(const WeaveLayout& layout, size_t i, Panel& panel, s
 // refused by make); only with glue asked for is it warned of instead.
 void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf,
                  const std::vector<std::vector<int>>& unfittedAt, const std::vector<char>& stillFolded,
-                 const PolygonMesh& mesh, const WovenRibbons& w, const std::vector<int>& edgeNumber,
-                 const WeaveOptions& options, Structure& result) {
-  std::vector<int> overlapping;
+                 const std::vector<int>& upEdges, const PolygonMesh& mesh, const WovenRibbons& w,
+                 const std::vector<int>& edgeNumber, const WeaveOptions& options, Structure& result) {
+  std::vector<int> overlapping, edges;
   for (size_t k = 0; k < result.panels.size(); ++k) {
-    if (stillFolded[k]) overlapping.push_back(result.panels[k].id);
+    if (stillFolded[k]) overlapping.push_back(result.panels[k].id), edges.push_back(upEdges[k]);
   }
   if (!overlapping.empty()) {
     std::string some;
@@ -412,13 +413,15 @@ void judgePanels(const std::vector<std::vector<std::string>>& unfittedOf,
     // Not a panel anyone could cut and build: its ribbon folds over
     // itself, mostly where it turns about a thin face's sharp corner
     // more tightly than it is wide, and no cut across it unfolds it.
-    throw UnfoldOverlapError(fmt::format(
+    UnfoldOverlapError error(fmt::format(
         "panel{} {}{} would fold over {} when unfolded, even cut in three: {} ribbon turns about a face's corner "
         "more sharply than it is wide (thin faces); simplifying the mesh to fewer, evener faces ({} N, fewer than "
         "its {}) may weave it",
         plural(overlapping.size()), some, overlapping.size() > 5 ? ", ..." : "",
         overlapping.size() == 1 ? "itself" : "themselves", overlapping.size() == 1 ? "its" : "each",
         options.names(Parameter::Panels), mesh.faceCount()));
+    error.panels = static_cast<int>(overlapping.size());
+    throw w.withPlaces(error, edges);
   }
   std::set<int> crossings;  // indices of regions
   int firstAt = -1;
@@ -599,8 +602,10 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
   std::vector<std::vector<std::string>> unfittedOf(woven.size());
   std::vector<std::vector<int>> unfittedAt(woven.size());  // each label's crossing
   std::vector<char> stillFolded(woven.size(), 0);          // per panel: crosses itself even cut
+  std::vector<int> upEdges(woven.size());                  // per panel: its own edge (an index of regions)
   context.parallelFor(numbering.order.size(), [&](size_t k) {
     const size_t i = static_cast<size_t>(numbering.order[k]);
+    upEdges[k] = woven[i].upEdge;
     Panel panel = panelOf(layout, k);
     const std::vector<int> labelRows = labelPanel(layout, i, panel, unfittedOf[i], unfittedAt[i]);
     if (core::crossesItself(panel.outline)) {
@@ -611,7 +616,7 @@ Structure buildWeaveStructure(const PolygonMesh& mesh, const WeaveOptions& optio
     }
     result.panels[k] = std::move(panel);
   });
-  judgePanels(unfittedOf, unfittedAt, stillFolded, mesh, w, numbering.edgeNumber, options, result);
+  judgePanels(unfittedOf, unfittedAt, stillFolded, upEdges, mesh, w, numbering.edgeNumber, options, result);
   judgeRibbons(w, numbering.edgeNumber, options, result);
   // A fastener per hole position, through the three panels of its crossing (docs/WEAVE.md, A11).
   result.fasteners = 0;

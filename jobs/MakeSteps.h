@@ -48,15 +48,17 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
 // --scale exactly) or the default, grown by at most 10% where that alone
 // gives every band room for its fastener (every crossing for its holes).
 // A label that fits nowhere counts as its band or crossing without room. A band or crossing still
-// without room has its short edge or a sliver beside it collapsed
-// (MeshMending.h; not with --keep-faces), recorded among `built`'s
-// repairs; where no mend gives it room, it is glued with --glue-narrow, or
-// make stops with the size and the fastener at which it builds as drawn.
+// without room, or a woven panel folding over itself at its own edge, has
+// its short edge or a sliver beside it collapsed (MeshMending.h; not with
+// --keep-faces), recorded among `built`'s repairs; a weave not cleared
+// that way is mended again from the design as drawn, a flip first. Where
+// no mend gives it room, it is glued with --glue-narrow, or make stops
+// with the size and the fastener at which it builds as drawn.
 // `built.start`: the band flood fill's first face.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);
 
-// The panels of a band structure built for --panels N may differ from N by
+// The panels of a structure built for --panels N may differ from N by
 // this share at most: the mends of narrow bands collapse faces, and a panel
 // that would overlap itself is split in two.
 inline constexpr double kPanelCountTolerance = 0.05;
@@ -69,8 +71,10 @@ inline bool withinPanelCountTolerance(double panels, int asked) {
 // filled in). With --panels N, a structure whose panels are more than
 // kPanelCountTolerance more or fewer than N (its mends collapse faces,
 // creases hold the remesh off its target) is remeshed once more, aiming off
-// by that share; one refused for bands without room is tried at nearby
-// counts of even triangles, within that share of N, before the refusal. Only
+// by that share (and about that aim, at nearby counts, where it misses
+// again); one refused for bands or crossings without room, or panels
+// folding, is tried at nearby counts of even triangles, within that share
+// of N, before the refusal. Only
 // the build kept says its notes. A refusal is a UserError naming a way out
 // that was built (request.adviseWayOut). Returns the mesh as built.
 geometry::PolygonMesh builtAsAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,

@@ -139,14 +139,16 @@ void scaleToBuiltSize(geometry::PolygonMesh& mesh, double size, StructureBuilder
   }
 }
 
-// Mends the design where each band of `error` has no room (MeshMending.h;
-// `merges`: faces may be merged where no edge collapses), if that keeps the mesh usable and its topology; adds what it
+// Mends the design at each of `places` (the edges of bands or crossings
+// without room, or of panels that fold; MeshMending.h: `merges`, faces may
+// be merged where no edge collapses; `flipsFirst`, a flip is tried before a
+// collapse), if that keeps the mesh usable and its topology; adds what it
 // did to `mends`. Returns whether it did anything.
-bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const geometry::NoRoomForHoleError& error, bool merges,
-                       geometry::Mends& mends) {
-  if (error.places.empty()) return false;
+bool mendedWhereNarrow(geometry::PolygonMesh& mesh, const std::vector<std::array<int, 2>>& places, bool merges,
+                       bool flipsFirst, geometry::Mends& mends) {
+  if (places.empty()) return false;
   geometry::PolygonMesh before = mesh;
-  const geometry::Mends made = geometry::mendNarrowPlaces(mesh, error.places, merges);
+  const geometry::Mends made = geometry::mendNarrowPlaces(mesh, places, merges, flipsFirst);
   if (made.count() == 0) return false;
   const geometry::MeshAnalysis was = geometry::analyzeMesh(before), is = geometry::analyzeMesh(mesh);
   if (!is.usable() || is.topology.genus != was.topology.genus || is.topology.components != was.topology.components ||
@@ -237,8 +239,15 @@ Advice triedAdvice(const MakeRequest& request, const geometry::PolygonMesh& mesh
   }
 }
 
+// Whether `face` of `mesh` closes a hole (--holes fill's or patch's).
+bool closesAHole(const geometry::PolygonMesh& mesh, int face) {
+  return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
+         mesh.sourceFace[static_cast<size_t>(face)] == -1;
+}
+
 // The structure (band or weave) at the size asked or the default, mended
-// where its bands or crossings have no room (builtStructure(), MakeSteps.h).
+// where its bands or crossings have no room, or its woven panels fold
+// (builtStructure(), MakeSteps.h).
 class MendingBuild {
  public:
   MendingBuild(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built, Sizing& sizing,
@@ -252,8 +261,23 @@ class MendingBuild {
         builder_(request, built.start) {}
 
   geometry::Structure build() {
-    if (request_.size) scaleToBuiltSize(mesh_, *request_.size, builder_, context_);
+    if (request_.size) {
+      try {
+        scaleToBuiltSize(mesh_, *request_.size, builder_, context_);
+      } catch (const geometry::UnfoldOverlapError&) {
+        // (Panels folding, or two faces folded flat, mended below: the
+        // first build that unfolds is resized to the size asked.)
+      } catch (const geometry::FoldedEdgeError&) {
+      }
+    }
     asDrawn_ = mesh_;
+    return mendedBuild();
+  }
+
+ private:
+  // Built, mended round after round where places have no room or panels
+  // fold; refused (or glued, as asked) where no mend helps.
+  geometry::Structure mendedBuild() {
     for (int round = 0;; ++round) {
       try {
         geometry::Structure structure = builder_.build(mesh_, context_);
@@ -269,6 +293,20 @@ class MendingBuild {
         }
         if (mended(error)) continue;
         return withoutRoom(error);
+      } catch (const geometry::FoldedEdgeError& error) {
+        // (Two faces folded flat onto each other where a remesh or a mend
+        // left them, not a hole's cap: foldedEdgeRefusal() says why that is refused.)
+        if (!closesAHole(mesh_, error.leftFace) && !closesAHole(mesh_, error.rightFace) &&
+            foldsMended({error.ends}, 1, false)) {
+          continue;
+        }
+        if (mendedTheOtherWay()) return mendedBuild();
+        throw;
+      } catch (const geometry::UnfoldOverlapError& error) {
+        if (foldsMended(error.places, error.panels, true)) continue;
+        if (mendedTheOtherWay()) return mendedBuild();
+        if (mends_.count() == 0) throw;
+        throw geometry::UnfoldOverlapError(fmt::format("{}, after {}", error.what(), mendedCount()));
       } catch (const std::invalid_argument&) {
         if (!unmended_) throw;
         if (retriedWithoutMerges()) continue;
@@ -282,7 +320,29 @@ class MendingBuild {
     }
   }
 
- private:
+  // A weave whose mends, a collapse first, left places without room or
+  // panels folding: mended again from the design as drawn, a flip first
+  // (mendNarrowPlaces()), which moves no vertex and widens an edge's
+  // region where a collapse moved the thin place on. (Each way clears
+  // meshes the other does not: CGAL's dino and elk one way, its cylinder
+  // the other, docs/PERFORMANCE.md.) Says whether it starts again.
+  bool mendedTheOtherWay() {
+    if (flipsFirst_ || !builder_.woven() || mends_.count() == 0) return false;
+    flipsFirst_ = true;
+    mesh_ = asDrawn_;
+    sizing_.grown = 1;
+    mends_ = {};
+    unmended_.reset();
+    lastError_.reset();
+    mendsStopped_ = false;
+    merges_ = true;
+    resizes_ = 0;
+    holesProgress_ = labelsProgress_ = foldsProgress_ = {};
+    rounds_ = 0;
+    context_.report({"geometry", fmt::format("mending the {}s again, a flip first", builder_.place()), 0, 0});
+    return true;
+  }
+
   // What the mesh was before the last mend, and why it was mended.
   struct Unmended {
     geometry::PolygonMesh mesh;
@@ -328,10 +388,34 @@ class MendingBuild {
       }
     }
     unmended_ = Unmended{mesh_, mends_, error};
-    if (!mendedWhereNarrow(mesh_, error, merges_, mends_)) return false;
+    if (!mendedWhereNarrow(mesh_, error.places, merges_, flipsFirst_, mends_)) return false;
     context_.report(
         {"geometry", fmt::format("narrow {}s mended", builder_.place()), static_cast<size_t>(mends_.count()), 0});
     return true;
+  }
+
+  // Panels of a weave that fold over themselves at their own crossing,
+  // where a sliver beside its edge makes the edge's region thin and the
+  // ribbon's rows there nearly along it: the sliver collapsed or flipped
+  // as a narrow place is, round after round while fewer panels fold.
+  // (`counted`: rounds go on while fewer panels fold; an edge folded flat
+  // stops the build at the first, and mends go on for kMendRounds.)
+  bool foldsMended(const std::vector<std::array<int, 2>>& places, int panels, bool counted) {
+    if (places.empty() || request_.keepFaces || mendsStopped_ || ++rounds_ > kMendRounds) return false;
+    if (counted) {
+      if (panels < foldsProgress_.fewest) {
+        foldsProgress_ = {panels, 0};
+      } else if (++foldsProgress_.stalled >= kStalledRounds) {
+        return false;
+      }
+    }
+    if (!mendedWhereNarrow(mesh_, places, false, flipsFirst_, mends_)) return false;
+    context_.report({"geometry", "folding panels mended", static_cast<size_t>(mends_.count()), 0});
+    return true;
+  }
+
+  std::string mendedCount() const {
+    return fmt::format("{} narrow place{} mended", mends_.count(), mends_.count() == 1 ? " was" : "s were");
   }
 
   // --size kept within kSizeTolerance: a mend moves a few vertices, and
@@ -359,6 +443,12 @@ class MendingBuild {
   }
 
   geometry::Structure finished(geometry::Structure structure) {
+    if (flipsFirst_) {
+      context_.note(
+          fmt::format("{}: mended from the mesh as drawn a second time, a flip tried before a collapse: "
+                      "mended a collapse first, it left {}s without room or panels folding",
+                      name_, builder_.place()));
+    }
     if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, request_.shownIn, context_);
     if (sizing_.grown > 1) {
       const core::LengthUnit unit = request_.shownIn;
@@ -376,6 +466,7 @@ class MendingBuild {
 
   // Places without room that no mend gives room: glued if asked, else the job refused with a way out.
   geometry::Structure withoutRoom(const geometry::NoRoomForHoleError& error) {
+    if (mendedTheOtherWay()) return mendedBuild();
     const auto& names = request_.names;
     if (request_.glueNarrow) {
       builder_.setGlue(true);
@@ -391,8 +482,7 @@ class MendingBuild {
                                              names(Parameter::GlueNarrow)));
       return glued;
     }
-    const std::string after = mends_.count() > 0   ? fmt::format(" after {} narrow place{} mended", mends_.count(),
-                                                               mends_.count() == 1 ? " was" : "s were")
+    const std::string after = mends_.count() > 0   ? " after " + mendedCount()
                               : request_.keepFaces ? fmt::format(" ({} keeps every face)", names(Parameter::KeepFaces))
                                                    : std::string();
     // (make's own tries of a way out need only know that this one failed.)
@@ -412,13 +502,13 @@ class MendingBuild {
   geometry::Mends mends_;
   std::optional<Unmended> unmended_;
   std::optional<geometry::NoRoomForHoleError> lastError_;
-  bool mendsStopped_ = false, merges_ = true;
+  bool mendsStopped_ = false, merges_ = true, flipsFirst_ = false;
   int resizes_ = 0;
   // The fewest bands without room a round has left, and the rounds since.
   struct Progress {
     int fewest = std::numeric_limits<int>::max(), stalled = 0;
   };
-  Progress holesProgress_, labelsProgress_;
+  Progress holesProgress_, labelsProgress_, foldsProgress_;
   int rounds_ = 0;
 };
 
@@ -481,38 +571,59 @@ geometry::PolygonMesh kept(AnotherBuild&& built, const core::SaidLater& said, Pl
 constexpr std::array kNearbyPanelShares{0.97, 1.03, 0.99, 1.01, 0.95, 1.05};
 constexpr double kNearbySeconds = 20;
 
-// A band structure refused at --panels N, built of a nearby count of even
-// triangles (kNearbyPanelShares), each quietly; the first that builds with
-// its panels within kPanelCountTolerance of N is kept, and said.
-std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
-                                                           const core::WorkContext& context) {
-  if (!request.panels || request.remeshFaces || request.structure != geometry::StructureKind::Band) return {};
-  const int asked = *request.panels;
+// A build of a nearby count of even triangles, kept with what it said.
+struct NearbyBuild {
+  AnotherBuild built;
+  int faces = 0;
+  core::SaidLater said;
+};
+
+// Remeshed to `centre` faces times each of kNearbyPanelShares in turn (a
+// count in `tried` skipped, and added), each built quietly: the first
+// whose panels come within kPanelCountTolerance of --panels N. No try
+// begins after kNearbySeconds.
+std::optional<NearbyBuild> nearbyBuild(const MakeRequest& request, double centre, std::set<int>& tried, PlannedJob& job,
+                                       const core::WorkContext& context) {
   const auto began = std::chrono::steady_clock::now();
-  std::set<int> tried{asked};
   for (const double share : kNearbyPanelShares) {
     context.check();
-    const auto faces = static_cast<int>(std::lround(asked * share));
+    const auto faces = static_cast<int>(std::lround(centre * share));
     if (!tried.insert(faces).second) continue;  // (a small count: the same target)
     if (std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count() > kNearbySeconds) break;
     context.report({"geometry", fmt::format("trying {} even triangles", faces), 0, 0});
     const core::SaidLater said;
     std::optional<AnotherBuild> built = anotherBuild(request, faces, job, said, context);
-    if (!built || !withinPanelCountTolerance(built->panels(), asked)) continue;
-    context.note(
-        fmt::format("{}: the even triangles aiming at {} left a band without room that no mend gave it: "
-                    "remeshed again, aiming at {} faces",
-                    request.mesh.string(), asked, faces));
-    return kept(std::move(*built), said, job, sizing, context);
+    if (!built || !withinPanelCountTolerance(built->panels(), *request.panels)) continue;
+    return NearbyBuild{std::move(*built), faces, said};
   }
   return std::nullopt;
+}
+
+// A structure refused at --panels N, built of a nearby count of even
+// triangles (nearbyBuild()); the first that builds with its panels within
+// kPanelCountTolerance of N is kept, and said. (A band's panel is a face; a
+// weave's an edge, 3/2 of a closed triangle mesh's faces.)
+std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
+                                                           const core::WorkContext& context) {
+  if (!request.panels || request.remeshFaces) return {};
+  const int asked = *request.panels;
+  const double centre = asked * (request.structure == geometry::StructureKind::Weave ? 2.0 / 3.0 : 1.0);
+  std::set<int> tried{static_cast<int>(std::lround(centre))};
+  std::optional<NearbyBuild> nearby = nearbyBuild(request, centre, tried, job, context);
+  if (!nearby) return std::nullopt;
+  context.note(
+      fmt::format("{}: the even triangles for {} panels left a {} without room that no mend gave it: remeshed again, "
+                  "aiming at {} faces",
+                  request.mesh.string(), asked, roomPlace(request.structure), nearby->faces));
+  return kept(std::move(nearby->built), nearby->said, job, sizing, context);
 }
 
 // A structure (band or weave) built for --panels N with more than kPanelCountTolerance
 // more or fewer panels than N (mends collapse faces, a remesh held by creases
 // misses its target): remeshed once more, aiming off by the share it missed,
 // and built again, quietly; that second build is kept where it comes nearer
-// the count asked, else the first. Says the first build's notes (`first`),
+// the count asked, else the first nearbyBuild() about that aim within
+// kPanelCountTolerance of N, else the first. Says the first build's notes (`first`),
 // or the second's, and which was kept.
 geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, PlannedJob& job, Sizing& sizing,
                                              geometry::PolygonMesh mesh, const core::SaidLater& first,
@@ -538,6 +649,15 @@ geometry::PolygonMesh withThePanelCountAsked(const MakeRequest& request, Planned
                     "{} faces, which gives {}",
                     name, asked, built, faces, second->panels()));
     return kept(std::move(*second), said, job, sizing, context);
+  }
+  // (Another sampling about that aim, where the mends of this one took many faces.)
+  std::set<int> tried{count->remeshing.asked, faces};
+  if (std::optional<NearbyBuild> nearby = nearbyBuild(request, faces, tried, job, context)) {
+    context.note(
+        fmt::format("{}: the even triangles for {} panels gave {} panels as built: remeshed again, aiming at "
+                    "{} faces, which gives {}",
+                    name, asked, built, nearby->faces, nearby->built.panels()));
+    return kept(std::move(nearby->built), nearby->said, job, sizing, context);
   }
   first.sayOn(context);
   context.note(
@@ -572,11 +692,7 @@ namespace {
 std::string foldedEdgeRefusal(const MakeRequest& request, const geometry::PolygonMesh& mesh,
                               const geometry::FoldedEdgeError& error) {
   const std::string name = request.mesh.string();
-  const auto closesAHole = [&](int face) {
-    return face >= 0 && static_cast<size_t>(face) < mesh.sourceFace.size() &&
-           mesh.sourceFace[static_cast<size_t>(face)] == -1;
-  };
-  const int closing = (closesAHole(error.leftFace) ? 1 : 0) + (closesAHole(error.rightFace) ? 1 : 0);
+  const int closing = (closesAHole(mesh, error.leftFace) ? 1 : 0) + (closesAHole(mesh, error.rightFace) ? 1 : 0);
   if (closing == 0) return fmt::format("{}: {}", name, error.what());
   if (closing == 2) {
     return fmt::format(
