@@ -258,13 +258,13 @@ std::string MeshRepair::line(core::LengthUnit unit) const {
         count, one ? "" : "s");
   } else if (kind == "flip-narrow-band") {
     what = fmt::format(
-        "flipped {} edge{} of a sliver beside a band or crossing too narrow for a fastener or its number "
-        "(or a woven panel folding there)",
+        "flipped {} edge{} of a sliver beside a band or crossing too narrow for a fastener or its number, or "
+        "a panel folding",
         count, one ? "" : "s");
   } else if (kind == "collapse-short-edge") {
     what = fmt::format(
         "collapsed {} short edge{} or sliver{} whose band or crossing had no room for a fastener or "
-        "its number (or whose woven panel folded there)",
+        "its number, or whose panel folded",
         count, one ? "" : "s", one ? "" : "s");
   } else {
     what = fmt::format("{}: {}", kind, count);

@@ -50,10 +50,12 @@ std::string oneFaceCapAdvice(const MakeRequest& request, const geometry::Polygon
 // A label that fits nowhere counts as its band or crossing without room. A band or crossing still
 // without room, or a woven panel folding over itself at its own edge, has
 // its short edge or a sliver beside it collapsed (MeshMending.h; not with
-// --keep-faces), recorded among `built`'s repairs; a weave not cleared
-// that way is mended again from the design as drawn, a flip first. Where
-// no mend gives it room, it is glued with --glue-narrow, or make stops
-// with the size and the fastener at which it builds as drawn.
+// --keep-faces), recorded among `built`'s repairs, and so has an edge a
+// remesh or a mend folded flat; a weave not cleared that way is mended
+// again from the design as drawn, a flip first. Where no mend gives a band
+// or crossing room, it is glued with --glue-narrow, or make stops with the
+// size and the fastener at which it builds as drawn; panels still folding
+// stop it with the advice of fewer, evener faces.
 // `built.start`: the band flood fill's first face.
 geometry::Structure builtStructure(const MakeRequest& request, geometry::PolygonMesh& mesh, BuiltMesh& built,
                                    Sizing& sizing, const core::WorkContext& context);

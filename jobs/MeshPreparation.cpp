@@ -80,7 +80,8 @@ PanelCount remeshedMesh(const MakeRequest& request, geometry::PolygonMesh& mesh,
     if (!analysis.problems.empty()) {
       what = analysis.problems.front().message;
     } else if (after.genus != before.genus) {
-      what = fmt::format("genus {}, not {}", after.genus.value_or(-1), before.genus.value_or(-1));
+      const auto genus = [](const std::optional<int>& g) { return g ? std::to_string(*g) : std::string("none"); };
+      what = fmt::format("genus {}, not {}", genus(after.genus), genus(before.genus));
     } else if (after.components != before.components) {
       what = fmt::format("{} parts, not {}", after.components, before.components);
     } else {

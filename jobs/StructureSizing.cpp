@@ -265,8 +265,11 @@ class MendingBuild {
       try {
         scaleToBuiltSize(mesh_, *request_.size, builder_, context_);
       } catch (const geometry::UnfoldOverlapError&) {
-        // (Panels folding, or two faces folded flat, mended below: the
-        // first build that unfolds is resized to the size asked.)
+        // (A weave's panels folding, or two faces folded flat, mended
+        // below: the first build that unfolds is resized to the size asked,
+        // and a refusal's way out is measured on the mesh at that size,
+        // not the structure's, a few percent apart.)
+        if (!builder_.woven()) throw;
       } catch (const geometry::FoldedEdgeError&) {
       }
     }
@@ -275,6 +278,11 @@ class MendingBuild {
   }
 
  private:
+  // The fewest bands without room (or panels folding) a round has left, and the rounds since.
+  struct Progress {
+    int fewest = std::numeric_limits<int>::max(), stalled = 0;
+  };
+
   // Built, mended round after round where places have no room or panels
   // fold; refused (or glued, as asked) where no mend helps.
   geometry::Structure mendedBuild() {
@@ -297,16 +305,25 @@ class MendingBuild {
         // (Two faces folded flat onto each other where a remesh or a mend
         // left them, not a hole's cap: foldedEdgeRefusal() says why that is refused.)
         if (!closesAHole(mesh_, error.leftFace) && !closesAHole(mesh_, error.rightFace) &&
-            foldsMended({error.ends}, 1, false)) {
+            foldsMended({error.ends}, 1, foldedEdgesProgress_)) {
           continue;
+        }
+        if (unmended_) {
+          if (retriedWithoutMerges()) continue;
+          return withoutRoom(*lastError_);
         }
         if (mendedTheOtherWay()) return mendedBuild();
         throw;
       } catch (const geometry::UnfoldOverlapError& error) {
-        if (foldsMended(error.places, error.panels, true)) continue;
+        // (A weave's panels: the band's carry no places, and its mends are those of the bands without room.)
+        if (foldsMended(error.places, error.panels, foldsProgress_)) continue;
+        if (unmended_) {
+          if (retriedWithoutMerges()) continue;
+          return withoutRoom(*lastError_);
+        }
         if (mendedTheOtherWay()) return mendedBuild();
         if (mends_.count() == 0) throw;
-        throw geometry::UnfoldOverlapError(fmt::format("{}, after {}", error.what(), mendedCount()));
+        throw geometry::UnfoldOverlapError(fmt::format("after {}, {}", mendedCount(), error.what()));
       } catch (const std::invalid_argument&) {
         if (!unmended_) throw;
         if (retriedWithoutMerges()) continue;
@@ -327,7 +344,7 @@ class MendingBuild {
   // meshes the other does not: CGAL's dino and elk one way, its cylinder
   // the other, docs/PERFORMANCE.md.) Says whether it starts again.
   bool mendedTheOtherWay() {
-    if (flipsFirst_ || !builder_.woven() || mends_.count() == 0) return false;
+    if (flipsFirst_ || !builder_.woven() || rounds_ == 0) return false;
     flipsFirst_ = true;
     mesh_ = asDrawn_;
     sizing_.grown = 1;
@@ -337,7 +354,7 @@ class MendingBuild {
     mendsStopped_ = false;
     merges_ = true;
     resizes_ = 0;
-    holesProgress_ = labelsProgress_ = foldsProgress_ = {};
+    holesProgress_ = labelsProgress_ = foldsProgress_ = foldedEdgesProgress_ = {};
     rounds_ = 0;
     context_.report({"geometry", fmt::format("mending the {}s again, a flip first", builder_.place()), 0, 0});
     return true;
@@ -398,16 +415,14 @@ class MendingBuild {
   // where a sliver beside its edge makes the edge's region thin and the
   // ribbon's rows there nearly along it: the sliver collapsed or flipped
   // as a narrow place is, round after round while fewer panels fold.
-  // (`counted`: rounds go on while fewer panels fold; an edge folded flat
-  // stops the build at the first, and mends go on for kMendRounds.)
-  bool foldsMended(const std::vector<std::array<int, 2>>& places, int panels, bool counted) {
+  // (`progress`: the panels' own, or the edges folded flat's, which stop
+  // the build at the first: at most kStalledRounds of those in a row.)
+  bool foldsMended(const std::vector<std::array<int, 2>>& places, int panels, Progress& progress) {
     if (places.empty() || request_.keepFaces || mendsStopped_ || ++rounds_ > kMendRounds) return false;
-    if (counted) {
-      if (panels < foldsProgress_.fewest) {
-        foldsProgress_ = {panels, 0};
-      } else if (++foldsProgress_.stalled >= kStalledRounds) {
-        return false;
-      }
+    if (panels < progress.fewest) {
+      progress = {panels, 0};
+    } else if (++progress.stalled >= kStalledRounds) {
+      return false;
     }
     if (!mendedWhereNarrow(mesh_, places, false, flipsFirst_, mends_)) return false;
     context_.report({"geometry", "folding panels mended", static_cast<size_t>(mends_.count()), 0});
@@ -445,8 +460,8 @@ class MendingBuild {
   geometry::Structure finished(geometry::Structure structure) {
     if (flipsFirst_) {
       context_.note(
-          fmt::format("{}: mended from the mesh as drawn a second time, a flip tried before a collapse: "
-                      "mended a collapse first, it left {}s without room or panels folding",
+          fmt::format("{}: mended a second time from the mesh as drawn, a flip tried before a collapse "
+                      "(with a collapse first, {}s were left without room or panels folding)",
                       name_, builder_.place()));
     }
     if (mends_.count() > 0) recordMends(mends_, mesh_, built_, name_, request_.shownIn, context_);
@@ -465,7 +480,8 @@ class MendingBuild {
   }
 
   // Places without room that no mend gives room: glued if asked, else the job refused with a way out.
-  geometry::Structure withoutRoom(const geometry::NoRoomForHoleError& error) {
+  // (`error` a copy: the other way's start resets lastError_.)
+  geometry::Structure withoutRoom(geometry::NoRoomForHoleError error) {
     if (mendedTheOtherWay()) return mendedBuild();
     const auto& names = request_.names;
     if (request_.glueNarrow) {
@@ -504,11 +520,7 @@ class MendingBuild {
   std::optional<geometry::NoRoomForHoleError> lastError_;
   bool mendsStopped_ = false, merges_ = true, flipsFirst_ = false;
   int resizes_ = 0;
-  // The fewest bands without room a round has left, and the rounds since.
-  struct Progress {
-    int fewest = std::numeric_limits<int>::max(), stalled = 0;
-  };
-  Progress holesProgress_, labelsProgress_, foldsProgress_;
+  Progress holesProgress_, labelsProgress_, foldsProgress_, foldedEdgesProgress_;
   int rounds_ = 0;
 };
 
@@ -612,8 +624,8 @@ std::optional<geometry::PolygonMesh> withANearbyPanelCount(const MakeRequest& re
   std::optional<NearbyBuild> nearby = nearbyBuild(request, centre, tried, job, context);
   if (!nearby) return std::nullopt;
   context.note(
-      fmt::format("{}: the even triangles for {} panels left a {} without room that no mend gave it: remeshed again, "
-                  "aiming at {} faces",
+      fmt::format("{}: the even triangles for {} panels left a {} without room, or a panel folding, that no mend "
+                  "cleared: remeshed again, aiming at {} faces",
                   request.mesh.string(), asked, roomPlace(request.structure), nearby->faces));
   return kept(std::move(nearby->built), nearby->said, job, sizing, context);
 }
